@@ -1,0 +1,180 @@
+!> Flat interface for f2py (and a future C API): scalars, explicit-shape arrays, a status
+!> code and a message; derived types stay inside. Status 0 ok, 1 input error, 2 simulation
+!> error. The last run's samples and events stay here until the next simulate call, so
+!> Python can size its arrays before copying them out.
+module impact1d_api
+  use, intrinsic :: iso_c_binding, only: c_double, c_int
+  use impact1d_kinds, only: wp
+  use impact1d_error, only: error_type, status_ok, status_input
+  use impact1d_scene, only: scene_input, scene_type, n_real, n_text, real_names, text_names, &
+    i_title, i_f1_table, i_f2_table, i_method
+  use impact1d_io, only: read_scene_file, prepare_scene
+  use impact1d_output, only: memory_sink, column_names_text => column_names, event_names, n_columns
+  use impact1d_solver, only: run, run_stats
+  implicit none
+  private
+  public :: field_names, column_names, event_kind_names, read_scene, simulate, get_samples, get_events
+
+  type(memory_sink), save :: last_run
+
+contains
+
+  !> Names of the scene's real and text fields, space separated, in the order of the arrays.
+  subroutine field_names(real_field_names, text_field_names)
+    character(len=1024), intent(out) :: real_field_names, text_field_names
+    integer :: k
+    real_field_names = ''
+    text_field_names = ''
+    do k = 1, n_real
+      real_field_names = trim(real_field_names) // ' ' // trim(real_names(k))
+    end do
+    do k = 1, n_text
+      text_field_names = trim(text_field_names) // ' ' // trim(text_names(k))
+    end do
+    real_field_names = adjustl(real_field_names)
+    text_field_names = adjustl(text_field_names)
+  end subroutine field_names
+
+  !> Names of the sample columns, space separated.
+  subroutine column_names(names)
+    character(len=1024), intent(out) :: names
+    names = column_names_text
+  end subroutine column_names
+
+  !> Event kind names, space separated: code k is the k-th word.
+  subroutine event_kind_names(names)
+    character(len=1024), intent(out) :: names
+    integer :: k
+    names = ''
+    do k = 1, size(event_names)
+      names = trim(names) // ' ' // trim(event_names(k))
+    end do
+    names = adjustl(names)
+  end subroutine event_kind_names
+
+  !> Read and check a scene file ('.dat': VisSim-style parameters; else a namelist).
+  subroutine read_scene(path, n, values, given, title, f1_table, f2_table, method, status, message)
+    character(len=*), intent(in) :: path
+    integer(c_int), intent(in) :: n
+    real(c_double), intent(out) :: values(n)
+    integer(c_int), intent(out) :: given(n)
+    character(len=1024), intent(out) :: title, f1_table, f2_table, method
+    integer(c_int), intent(out) :: status
+    character(len=512), intent(out) :: message
+    type(scene_input) :: input
+    type(error_type), allocatable :: error
+
+    values = 0.0_c_double
+    given = 0
+    title = ''
+    f1_table = ''
+    f2_table = ''
+    method = ''
+    if (.not. field_count_ok(n, status, message)) return
+    call read_scene_file(path, input, error)
+    if (failed(error, status, message)) return
+    values = real(input%value, c_double)
+    given = merge(1_c_int, 0_c_int, input%given)
+    title = input%text(i_title)
+    f1_table = input%text(i_f1_table)
+    f2_table = input%text(i_f2_table)
+    method = input%text(i_method)
+  end subroutine read_scene
+
+  !> Check and run a scene given as flat fields; keep its samples and events for get_*.
+  subroutine simulate(n, values, given, title, f1_table, f2_table, method, n_samples, n_events, &
+      steps, energy_residual, status, message)
+    integer(c_int), intent(in) :: n
+    real(c_double), intent(in) :: values(n)
+    integer(c_int), intent(in) :: given(n)
+    character(len=*), intent(in) :: title, f1_table, f2_table, method
+    integer(c_int), intent(out) :: n_samples, n_events, steps
+    real(c_double), intent(out) :: energy_residual
+    integer(c_int), intent(out) :: status
+    character(len=512), intent(out) :: message
+    type(scene_input) :: input
+    type(scene_type) :: scene
+    type(run_stats) :: stats
+    type(error_type), allocatable :: error
+
+    n_samples = 0
+    n_events = 0
+    steps = 0
+    energy_residual = 0.0_c_double
+    if (.not. field_count_ok(n, status, message)) return
+    input%value = real(values, wp)
+    input%given = given /= 0
+    input%text(i_title) = title
+    input%text(i_f1_table) = f1_table
+    input%text(i_f2_table) = f2_table
+    input%text(i_method) = method
+    call prepare_scene(input, scene, error)
+    if (failed(error, status, message)) return
+    call last_run%reserve(scene%n_samples)
+    call run(scene, last_run, stats, error)
+    if (failed(error, status, message)) return
+    n_samples = last_run%n_samples
+    n_events = last_run%n_events
+    steps = stats%steps
+    energy_residual = stats%max_residual
+  end subroutine simulate
+
+  !> The last run's samples, one column per name of column_names.
+  subroutine get_samples(n_samples, n_cols, samples)
+    integer(c_int), intent(in) :: n_samples, n_cols
+    real(c_double), intent(out) :: samples(n_samples, n_cols)
+    samples = 0.0_c_double
+    if (.not. allocated(last_run%samples)) return
+    if (n_samples /= last_run%n_samples .or. n_cols /= n_columns) return
+    samples = last_run%samples(:n_samples, :)
+  end subroutine get_samples
+
+  !> The last run's events: time, kind code (1-based word of event_kind_names), velocities.
+  subroutine get_events(n_events, t, kind, v1_before, v2_before, v1_after, v2_after)
+    integer(c_int), intent(in) :: n_events
+    real(c_double), intent(out) :: t(n_events), v1_before(n_events), v2_before(n_events), &
+      v1_after(n_events), v2_after(n_events)
+    integer(c_int), intent(out) :: kind(n_events)
+    integer :: m
+    m = 0
+    if (allocated(last_run%event_time)) m = min(n_events, last_run%n_events)
+    t = 0.0_c_double
+    kind = 0
+    v1_before = 0.0_c_double
+    v2_before = 0.0_c_double
+    v1_after = 0.0_c_double
+    v2_after = 0.0_c_double
+    t(:m) = last_run%event_time(:m)
+    kind(:m) = last_run%event_kind(:m)
+    v1_before(:m) = last_run%event_v(1, :m)
+    v2_before(:m) = last_run%event_v(2, :m)
+    v1_after(:m) = last_run%event_v(3, :m)
+    v2_after(:m) = last_run%event_v(4, :m)
+  end subroutine get_events
+
+  logical function field_count_ok(n, status, message)
+    integer(c_int), intent(in) :: n
+    integer(c_int), intent(out) :: status
+    character(len=512), intent(out) :: message
+    field_count_ok = n == n_real
+    status = status_ok
+    message = ''
+    if (.not. field_count_ok) then
+      status = status_input
+      write(message, '(a, i0, a, i0)') 'internal: ', n, ' scene fields passed, expected ', n_real
+    end if
+  end function field_count_ok
+
+  logical function failed(error, status, message)
+    type(error_type), allocatable, intent(in) :: error
+    integer(c_int), intent(out) :: status
+    character(len=512), intent(out) :: message
+    failed = allocated(error)
+    status = status_ok
+    message = ''
+    if (failed) then
+      status = int(error%status, c_int)
+      message = error%message
+    end if
+  end function failed
+end module impact1d_api

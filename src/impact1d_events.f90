@@ -1,0 +1,155 @@
+!> Event location on a step's dense output. Every watched function (a gap, a sliding
+!> velocity) is a polynomial of degree <= 3 in the time theta since the step's start, so
+!> its roots are isolated between the extrema and none is missed: two crossings inside one
+!> step (a fast bounce, a graze) are found as surely as one.
+module impact1d_events
+  use impact1d_kinds, only: wp, eps_wp
+  implicit none
+  private
+  public :: hermite, earliest_crossing, poly_value, poly_slope
+
+contains
+
+  !> Cubic Hermite dense output of a displacement dx over [0, h] with end velocities v0, v1:
+  !> dx(theta) = c(1) theta + c(2) theta^2 + c(3) theta^3. Exact when the motion is a cubic,
+  !> as it is under piecewise-linear forcing. Built from the increment, not from positions,
+  !> so a gap far from the origin keeps its digits.
+  pure function hermite(dx, v0, v1, h) result(c)
+    real(wp), intent(in) :: dx, v0, v1, h
+    real(wp) :: c(3)
+    c(1) = v0
+    c(2) = (3.0_wp * dx / h - 2.0_wp * v0 - v1) / h
+    c(3) = (v0 + v1 - 2.0_wp * dx / h) / h**2
+  end function hermite
+
+  pure real(wp) function poly_value(p, theta)
+    real(wp), intent(in) :: p(0:3), theta
+    poly_value = p(0) + theta * (p(1) + theta * (p(2) + theta * p(3)))
+  end function poly_value
+
+  pure real(wp) function poly_slope(p, theta)
+    real(wp), intent(in) :: p(0:3), theta
+    poly_slope = p(1) + theta * (2.0_wp * p(2) + theta * 3.0_wp * p(3))
+  end function poly_slope
+
+  !> Earliest theta in [0, h] where p turns negative: the zero at the start of the first
+  !> piece of [0, h] (between consecutive roots) on which p falls below -tol. Returns a value
+  !> > h when there is none. tol keeps rounding-level wiggles of a resting function from
+  !> counting, while the reported time is the true zero, not the -tol crossing.
+  pure real(wp) function earliest_crossing(p, h, tol) result(theta)
+    real(wp), intent(in) :: p(0:3), h, tol
+    real(wp) :: nodes(8), crit(2)
+    integer :: n_nodes, n_crit, j
+    real(wp) :: a, b
+
+    theta = 2.0_wp * h + 1.0_wp
+    ! Cheap rejection, the common case: p cannot reach zero on [0, h].
+    if (p(0) - h * (abs(p(1)) + h * (abs(p(2)) + h * abs(p(3)))) > 0.0_wp) return
+
+    ! Monotone pieces between the extrema; a root is bracketed on each piece or absent.
+    call stationary_points(p, h, crit, n_crit)
+    n_nodes = 1
+    nodes(1) = 0.0_wp
+    a = 0.0_wp
+    do j = 1, n_crit + 1
+      if (j <= n_crit) then
+        b = crit(j)
+      else
+        b = h
+      end if
+      if (poly_value(p, a) * poly_value(p, b) < 0.0_wp) then
+        n_nodes = n_nodes + 1
+        nodes(n_nodes) = bracketed_root(p, a, b)
+      else if (poly_value(p, b) == 0.0_wp .and. b > 0.0_wp) then
+        n_nodes = n_nodes + 1
+        nodes(n_nodes) = b
+      end if
+      a = b
+    end do
+    if (nodes(n_nodes) < h) then
+      n_nodes = n_nodes + 1
+      nodes(n_nodes) = h
+    end if
+    do j = 1, n_nodes - 1
+      a = nodes(j)
+      b = nodes(j + 1)
+      if (min(poly_value(p, 0.5_wp * (a + b)), poly_value(p, b)) < -tol) then
+        theta = a
+        return
+      end if
+    end do
+  end function earliest_crossing
+
+  !> Zeros of p' strictly inside (0, h), ascending.
+  pure subroutine stationary_points(p, h, crit, n)
+    real(wp), intent(in) :: p(0:3), h
+    real(wp), intent(out) :: crit(2)
+    integer, intent(out) :: n
+    real(wp) :: qa, qb, qc, disc, q, r(2)
+    integer :: m, j
+    qa = 3.0_wp * p(3)
+    qb = 2.0_wp * p(2)
+    qc = p(1)
+    m = 0
+    if (qa == 0.0_wp) then
+      if (qb /= 0.0_wp) then
+        m = 1
+        r(1) = -qc / qb
+      end if
+    else
+      disc = qb**2 - 4.0_wp * qa * qc
+      if (disc >= 0.0_wp) then
+        ! Stable form: no cancellation between qb and the square root.
+        q = -0.5_wp * (qb + sign(sqrt(disc), qb))
+        if (q /= 0.0_wp) then
+          m = 2
+          r(1) = q / qa
+          r(2) = qc / q
+        else
+          m = 1
+          r(1) = 0.0_wp
+        end if
+      end if
+    end if
+    n = 0
+    do j = 1, m
+      if (r(j) > 0.0_wp .and. r(j) < h) then
+        n = n + 1
+        crit(n) = r(j)
+      end if
+    end do
+    if (n == 2) then
+      if (crit(1) > crit(2)) crit = crit([2, 1])
+    end if
+  end subroutine stationary_points
+
+  !> The root of p in (a, b), where p(a) and p(b) differ in sign: bisection to the last bit,
+  !> since a monotone piece has exactly one root and bisection cannot leave it.
+  pure real(wp) function bracketed_root(p, a0, b0) result(root)
+    real(wp), intent(in) :: p(0:3), a0, b0
+    real(wp) :: a, b, fa, mid, fm
+    integer :: iteration
+    a = a0
+    b = b0
+    fa = poly_value(p, a)
+    do iteration = 1, 200
+      mid = 0.5_wp * (a + b)
+      if (mid <= a .or. mid >= b) exit
+      fm = poly_value(p, mid)
+      if (fm == 0.0_wp) then
+        a = mid
+        b = mid
+        exit
+      end if
+      if ((fm < 0.0_wp) .eqv. (fa < 0.0_wp)) then
+        a = mid
+        fa = fm
+      else
+        b = mid
+      end if
+    end do
+    ! The earlier end: a crossing is never reported after the function went negative.
+    root = a
+    if (poly_value(p, b) >= 0.0_wp .and. fa < 0.0_wp) root = b
+  end function bracketed_root
+end module impact1d_events

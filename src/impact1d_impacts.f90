@@ -1,0 +1,66 @@
+!> Impact laws: Newton restitution on one contact, applied as an impulse along M^-1 n so
+!> that momentum is kept by slot impacts and a wall only reverses its body's velocity.
+module impact1d_impacts
+  use impact1d_kinds, only: wp
+  use impact1d_scene, only: scene_type, n_contacts, normal, i_slot_min, i_slot_max
+  implicit none
+  private
+  public :: normal_velocity, impulse, most_approaching, restitution_of, kinetic_energy
+
+contains
+
+  !> Rate of change of gap k.
+  pure real(wp) function normal_velocity(k, v)
+    integer, intent(in) :: k
+    real(wp), intent(in) :: v(2)
+    normal_velocity = dot_product(normal(:, k), v)
+  end function normal_velocity
+
+  !> Velocities after an impulse on contact k that leaves the normal velocity at -r times
+  !> its value before. For the slot this is the tutorial's two-body formula; for a wall v' = -r v.
+  pure function impulse(scene, k, r, v) result(v_after)
+    type(scene_type), intent(in) :: scene
+    integer, intent(in) :: k
+    real(wp), intent(in) :: r, v(2)
+    real(wp) :: v_after(2), p
+    p = -(1.0_wp + r) * normal_velocity(k, v) / dot_product(normal(:, k)**2, 1.0_wp / scene%mass)
+    v_after = v + normal(:, k) * p / scene%mass
+    ! A wall acts on its own body only: keep the other velocity bit for bit.
+    where (normal(:, k) == 0.0_wp) v_after = v
+  end function impulse
+
+  !> The closed contact approaching fastest (0 if none approaches faster than its tol).
+  pure integer function most_approaching(closed, v, tol) result(k_best)
+    logical, intent(in) :: closed(n_contacts)
+    real(wp), intent(in) :: v(2), tol(n_contacts)
+    integer :: k
+    real(wp) :: u_best
+    k_best = 0
+    u_best = 0.0_wp
+    do k = 1, n_contacts
+      if (.not. closed(k)) cycle
+      if (normal_velocity(k, v) < min(u_best, -tol(k))) then
+        k_best = k
+        u_best = normal_velocity(k, v)
+      end if
+    end do
+  end function most_approaching
+
+  !> Restitution used for contact k. When both slot limits are closed at once (a rigid link,
+  !> d_min = d_max) the link has no room to rebound: the bodies move as one (r = 0), where
+  !> elastic limits would otherwise exchange the relative velocity forever in zero time.
+  pure real(wp) function restitution_of(scene, k, closed)
+    type(scene_type), intent(in) :: scene
+    integer, intent(in) :: k
+    logical, intent(in) :: closed(n_contacts)
+    restitution_of = scene%restitution(k)
+    if ((k == i_slot_min .or. k == i_slot_max) .and. closed(i_slot_min) .and. closed(i_slot_max)) &
+      restitution_of = 0.0_wp
+  end function restitution_of
+
+  pure real(wp) function kinetic_energy(scene, v)
+    type(scene_type), intent(in) :: scene
+    real(wp), intent(in) :: v(2)
+    kinetic_energy = 0.5_wp * dot_product(scene%mass, v**2)
+  end function kinetic_energy
+end module impact1d_impacts

@@ -1,0 +1,353 @@
+!> Reading scenes: the namelist format, the tutorial's VisSim-style parameter files and
+!> force tables. Every problem comes back as an input error naming the file, line or variable.
+module impact1d_io
+  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+  use impact1d_kinds, only: wp
+  use impact1d_error, only: error_type, raise, status_input, fmt
+  use impact1d_scene, only: scene_input, scene_type, build_scene, validate, n_real, real_names, &
+    i_m1, i_m2, i_mu1, i_mu2, i_g, i_r_left, i_r_right, i_r_min, i_r_max, i_x_left, i_x_right, &
+    i_d_min, i_d_max, i_x1, i_x2, i_v1, i_v2, i_f1, i_f2, i_t_end, i_dt, i_dt_out, &
+    i_f1_amp, i_f1_period, i_f1_phase, i_f2_amp, i_f2_period, i_f2_phase, &
+    i_title, i_f1_table, i_f2_table, i_method
+  use impact1d_forcing, only: table_type
+  implicit none
+  private
+  public :: read_scene_file, prepare_scene, read_table
+
+  !> Marks a namelist variable the file did not set (no user writes the largest double).
+  real(wp), parameter :: absent = huge(1.0_wp)
+  character(len=*), parameter :: absent_text = achar(1)
+  character(len=*), parameter :: known_groups(7) = [character(len=7) :: &
+    'scene', 'bodies', 'walls', 'link', 'initial', 'forces', 'run']
+  !> The tutorial's parameter files list these, in its Table 1 order; g is 10 there.
+  integer, parameter :: dat_order(17) = [i_m1, i_m2, i_mu1, i_r_left, i_r_right, i_r_min, &
+    i_r_max, i_x_left, i_x_right, i_d_min, i_d_max, i_x1, i_x2, i_v1, i_v2, i_f1, i_f2]
+  real(wp), parameter :: dat_gravity = 10.0_wp
+
+contains
+
+  !> Read a scene file: '.dat' is a VisSim-style parameter file, anything else a namelist.
+  !> Checks what can be checked before the &run values are final.
+  subroutine read_scene_file(path, input, error)
+    character(len=*), intent(in) :: path
+    type(scene_input), intent(out) :: input
+    type(error_type), allocatable, intent(out) :: error
+    integer :: n
+    n = len_trim(path)
+    if (n == 0) then
+      call raise(error, status_input, 'no scene file given')
+      return
+    end if
+    if (n > 4) then
+      if (path(n - 3:n) == '.dat') then
+        call read_dat(trim(path), input, error)
+      else
+        call read_namelist(trim(path), input, error)
+      end if
+    else
+      call read_namelist(trim(path), input, error)
+    end if
+    if (allocated(error)) return
+    input%source = trim(path)
+    call validate(input, .false., error)
+    if (allocated(error)) error%message = trim(path) // ': ' // error%message
+  end subroutine read_scene_file
+
+  !> Read the force tables a checked input names, then build the model.
+  subroutine prepare_scene(input, scene, error)
+    type(scene_input), intent(in) :: input
+    type(scene_type), intent(out) :: scene
+    type(error_type), allocatable, intent(out) :: error
+    type(table_type) :: tables(2)
+    integer :: i
+    do i = 1, 2
+      if (len_trim(input%text(i_f1_table + i - 1)) == 0) cycle
+      call read_table(trim(input%text(i_f1_table + i - 1)), tables(i), error)
+      if (allocated(error)) then
+        error%message = 'f' // fmt(i) // '_table: ' // error%message
+        return
+      end if
+    end do
+    call build_scene(input, tables, scene, error)
+  end subroutine prepare_scene
+
+  subroutine read_namelist(path, input, error)
+    character(len=*), intent(in) :: path
+    type(scene_input), intent(inout) :: input
+    type(error_type), allocatable, intent(out) :: error
+    real(wp) :: m1, m2, mu1, mu2, g, x_left, r_left, x_right, r_right, d_min, r_min, d_max, r_max
+    real(wp) :: x1, v1, x2, v2, f1, f2, f1_amp, f1_period, f1_phase, f2_amp, f2_period, f2_phase
+    real(wp) :: t_end, dt, dt_out
+    character(len=1024) :: title, f1_table, f2_table, method
+    namelist /scene/ title
+    namelist /bodies/ m1, m2, mu1, mu2, g
+    namelist /walls/ x_left, r_left, x_right, r_right
+    namelist /link/ d_min, r_min, d_max, r_max
+    namelist /initial/ x1, v1, x2, v2
+    namelist /forces/ f1, f2, f1_table, f2_table, f1_amp, f1_period, f1_phase, f2_amp, f2_period, f2_phase
+    namelist /run/ t_end, dt, dt_out, method
+    logical :: present(size(known_groups))
+    integer :: unit, ios, j
+    character(len=512) :: message
+    real(wp) :: values(n_real)
+
+    call scan_groups(path, present, error)
+    if (allocated(error)) return
+    do j = 1, size(known_groups)
+      if (any(trim(known_groups(j)) == ['bodies ', 'initial', 'run    ']) .and. .not. present(j)) then
+        call raise(error, status_input, path // ': the required group &' // trim(known_groups(j)) // &
+          ' is missing')
+        return
+      end if
+    end do
+
+    m1 = absent; m2 = absent; mu1 = absent; mu2 = absent; g = absent
+    x_left = absent; r_left = absent; x_right = absent; r_right = absent
+    d_min = absent; r_min = absent; d_max = absent; r_max = absent
+    x1 = absent; v1 = absent; x2 = absent; v2 = absent; f1 = absent; f2 = absent
+    f1_amp = absent; f1_period = absent; f1_phase = absent
+    f2_amp = absent; f2_period = absent; f2_phase = absent
+    t_end = absent; dt = absent; dt_out = absent
+    title = absent_text; f1_table = absent_text; f2_table = absent_text; method = absent_text
+
+    open(newunit=unit, file=path, status='old', action='read', iostat=ios, iomsg=message)
+    if (ios /= 0) then
+      call raise(error, status_input, path // ': ' // trim(message))
+      return
+    end if
+    do j = 1, size(known_groups)
+      if (.not. present(j)) cycle
+      rewind(unit)
+      select case (trim(known_groups(j)))
+      case ('scene'); read(unit, nml=scene, iostat=ios, iomsg=message)
+      case ('bodies'); read(unit, nml=bodies, iostat=ios, iomsg=message)
+      case ('walls'); read(unit, nml=walls, iostat=ios, iomsg=message)
+      case ('link'); read(unit, nml=link, iostat=ios, iomsg=message)
+      case ('initial'); read(unit, nml=initial, iostat=ios, iomsg=message)
+      case ('forces'); read(unit, nml=forces, iostat=ios, iomsg=message)
+      case ('run'); read(unit, nml=run, iostat=ios, iomsg=message)
+      end select
+      if (ios /= 0) then
+        close(unit)
+        call raise(error, status_input, path // ': in &' // trim(known_groups(j)) // ': ' // trim(message))
+        return
+      end if
+    end do
+    close(unit)
+
+    values = [m1, m2, mu1, mu2, g, x_left, r_left, x_right, r_right, d_min, r_min, d_max, r_max, &
+      x1, v1, x2, v2, f1, f2, f1_amp, f1_period, f1_phase, f2_amp, f2_period, f2_phase, t_end, dt, dt_out]
+    input%given = values /= absent
+    input%value = merge(values, 0.0_wp, input%given)
+    input%text(i_title) = given_text(title)
+    input%text(i_f1_table) = beside(path, given_text(f1_table))
+    input%text(i_f2_table) = beside(path, given_text(f2_table))
+    input%text(i_method) = given_text(method)
+  end subroutine read_namelist
+
+  !> Which groups the file has; a misspelt group (&wall) is an error, not a silent absence.
+  subroutine scan_groups(path, present, error)
+    character(len=*), intent(in) :: path
+    logical, intent(out) :: present(size(known_groups))
+    type(error_type), allocatable, intent(out) :: error
+    integer :: unit, ios, line_number, start, finish, j
+    character(len=4096) :: line
+    character(len=512) :: message
+    character(len=:), allocatable :: name
+    logical :: any_content
+
+    present = .false.
+    any_content = .false.
+    open(newunit=unit, file=path, status='old', action='read', iostat=ios, iomsg=message)
+    if (ios /= 0) then
+      call raise(error, status_input, path // ': ' // trim(message))
+      return
+    end if
+    line_number = 0
+    do
+      read(unit, '(a)', iostat=ios) line
+      if (ios /= 0) exit
+      line_number = line_number + 1
+      start = verify(line, ' ' // achar(9))
+      if (start == 0) cycle
+      if (line(start:start) == '!') cycle
+      any_content = .true.
+      if (line(start:start) /= '&' .and. line(start:start) /= '$') cycle
+      finish = scan(line(start + 1:), ' /' // achar(9))
+      if (finish == 0) then
+        finish = len_trim(line)
+      else
+        finish = start + finish - 1
+      end if
+      name = lower(line(start + 1:finish))
+      if (name == 'end' .or. len(name) == 0) cycle
+      do j = 1, size(known_groups)
+        if (name == trim(known_groups(j))) exit
+      end do
+      if (j > size(known_groups)) then
+        close(unit)
+        call raise(error, status_input, path // ':' // fmt(line_number) // ': unknown group &' // name // &
+          ' (groups: &scene &bodies &walls &link &initial &forces &run)')
+        return
+      end if
+      present(j) = .true.
+    end do
+    close(unit)
+    if (.not. any_content) call raise(error, status_input, path // ': the file is empty')
+  end subroutine scan_groups
+
+  !> The tutorial's parameter file: 17 numbers, one per line, '#' starts a comment; an
+  !> optional 18th entry names a table added to f1 (the tutorial's triangle.dat button).
+  subroutine read_dat(path, input, error)
+    character(len=*), intent(in) :: path
+    type(scene_input), intent(inout) :: input
+    type(error_type), allocatable, intent(out) :: error
+    integer :: unit, ios, n_read, line_number, hash
+    character(len=4096) :: line
+    character(len=512) :: message
+    real(wp) :: value
+
+    open(newunit=unit, file=path, status='old', action='read', iostat=ios, iomsg=message)
+    if (ios /= 0) then
+      call raise(error, status_input, path // ': ' // trim(message))
+      return
+    end if
+    n_read = 0
+    line_number = 0
+    do
+      read(unit, '(a)', iostat=ios) line
+      if (ios /= 0) exit
+      line_number = line_number + 1
+      hash = index(line, '#')
+      if (hash > 0) line(hash:) = ' '
+      if (len_trim(line) == 0) cycle
+      n_read = n_read + 1
+      if (n_read <= size(dat_order)) then
+        read(line, *, iostat=ios) value
+        if (ios /= 0) then
+          close(unit)
+          call raise(error, status_input, path // ':' // fmt(line_number) // ': ''' // trim(adjustl(line)) // &
+            ''' is not a number (expected ' // trim(real_names(dat_order(n_read))) // ')')
+          return
+        end if
+        input%value(dat_order(n_read)) = value
+        input%given(dat_order(n_read)) = .true.
+      else if (n_read == size(dat_order) + 1) then
+        input%text(i_f1_table) = beside(path, trim(adjustl(line)))
+      else
+        close(unit)
+        call raise(error, status_input, path // ':' // fmt(line_number) // &
+          ': more entries than the 17 numbers and an f1 table file')
+        return
+      end if
+    end do
+    close(unit)
+    if (n_read < size(dat_order)) then
+      if (n_read == 0) then
+        call raise(error, status_input, path // ': the file is empty')
+      else
+        call raise(error, status_input, path // ': ' // fmt(n_read) // ' numbers, 17 expected; ' // &
+          trim(real_names(dat_order(n_read + 1))) // ' and after are missing')
+      end if
+      return
+    end if
+    ! One friction coefficient for both bodies, and the tutorial's gravity.
+    input%value(i_mu2) = input%value(i_mu1)
+    input%given(i_mu2) = .true.
+    input%value(i_g) = dat_gravity
+    input%given(i_g) = .true.
+  end subroutine read_dat
+
+  !> A two-column table 't f': '#' comments, times strictly increasing, at least one row.
+  subroutine read_table(path, table, error)
+    character(len=*), intent(in) :: path
+    type(table_type), intent(out) :: table
+    type(error_type), allocatable, intent(out) :: error
+    integer :: unit, ios, line_number, hash, n
+    character(len=4096) :: line
+    character(len=512) :: message
+    real(wp) :: row(2)
+    real(wp), allocatable :: t(:), f(:)
+
+    open(newunit=unit, file=path, status='old', action='read', iostat=ios, iomsg=message)
+    if (ios /= 0) then
+      call raise(error, status_input, path // ': ' // trim(message))
+      return
+    end if
+    allocate(t(16), f(16))
+    n = 0
+    line_number = 0
+    do
+      read(unit, '(a)', iostat=ios) line
+      if (ios /= 0) exit
+      line_number = line_number + 1
+      hash = index(line, '#')
+      if (hash > 0) line(hash:) = ' '
+      if (len_trim(line) == 0) cycle
+      read(line, *, iostat=ios) row
+      if (ios /= 0) then
+        call fail(': expected two numbers "t f", got ''' // trim(adjustl(line)) // '''')
+        return
+      end if
+      if (.not. all(ieee_is_finite(row))) then
+        call fail(': ' // trim(adjustl(line)) // ' is not finite')
+        return
+      end if
+      if (n > 0) then
+        if (row(1) <= t(n)) then
+          call fail(': time ' // fmt(row(1)) // ' does not increase (after ' // fmt(t(n)) // ')')
+          return
+        end if
+      end if
+      if (n == size(t)) then
+        t = [t, t]
+        f = [f, f]
+      end if
+      n = n + 1
+      t(n) = row(1)
+      f(n) = row(2)
+    end do
+    close(unit)
+    if (n == 0) then
+      call raise(error, status_input, path // ': the table has no rows')
+      return
+    end if
+    table%t = t(:n)
+    table%f = f(:n)
+  contains
+    subroutine fail(what)
+      character(len=*), intent(in) :: what
+      close(unit)
+      call raise(error, status_input, path // ':' // fmt(line_number) // what)
+    end subroutine fail
+  end subroutine read_table
+
+  !> A path written in a scene file is relative to that file's folder.
+  function beside(scene_path, path) result(resolved)
+    character(len=*), intent(in) :: scene_path, path
+    character(len=:), allocatable :: resolved
+    integer :: slash
+    resolved = trim(path)
+    if (len(resolved) == 0) return
+    if (resolved(1:1) == '/') return
+    slash = index(scene_path, '/', back=.true.)
+    if (slash > 0) resolved = scene_path(:slash) // resolved
+  end function beside
+
+  function given_text(text) result(given)
+    character(len=*), intent(in) :: text
+    character(len=:), allocatable :: given
+    given = ''
+    if (text /= absent_text) given = trim(text)
+  end function given_text
+
+  pure function lower(text) result(low)
+    character(len=*), intent(in) :: text
+    character(len=len(text)) :: low
+    integer :: j
+    low = text
+    do j = 1, len(text)
+      if (text(j:j) >= 'A' .and. text(j:j) <= 'Z') low(j:j) = achar(iachar(text(j:j)) + 32)
+    end do
+  end function lower
+end module impact1d_io

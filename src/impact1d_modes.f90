@@ -1,0 +1,220 @@
+!> Contact and friction modes: which contacts are held closed, which bodies are held by
+!> static friction, and which way sliding friction acts. Within a mode the accelerations are
+!> a linear function of the external forces only, a = gain (f(t) + f_slide), so the stepping
+!> loop pays two multiply-adds per stage for them.
+module impact1d_modes
+  use impact1d_kinds, only: wp, eps_wp
+  use impact1d_scene, only: scene_type, n_contacts, normal
+  implicit none
+  private
+  public :: mode_type, solve_mode, max_holds
+
+  !> Conditions a mode needs (contact force >= 0, |static friction| <= bound): at most two
+  !> locked rows, two conditions for a stuck body.
+  integer, parameter :: max_holds = 4
+
+  type :: mode_type
+    logical :: active(n_contacts) = .false.   !< contacts held closed (persistent)
+    logical :: stuck(2) = .false.             !< bodies held by static friction
+    real(wp) :: sgn(2) = 0.0_wp               !< sliding direction: friction is -c_i sgn_i
+    real(wp) :: f_slide(2) = 0.0_wp           !< the sliding friction forces -c_i sgn_i
+    real(wp) :: gain(2, 2) = 0.0_wp           !< a = gain (f + f_slide)
+    integer :: n_hold = 0
+    real(wp) :: hold_w(2, max_holds) = 0.0_wp !< hold_j = hold_w(:,j) . (f + f_slide) + hold_c(j) >= 0
+    real(wp) :: hold_c(max_holds) = 0.0_wp
+  contains
+    procedure :: acceleration
+    procedure :: holds
+  end type mode_type
+
+contains
+
+  !> Accelerations of both bodies under forces f in this mode.
+  pure function acceleration(self, f) result(a)
+    class(mode_type), intent(in) :: self
+    real(wp), intent(in) :: f(2)
+    real(wp) :: a(2)
+    a = matmul(self%gain, f + self%f_slide)
+  end function acceleration
+
+  !> Values of the mode's conditions under forces f: the mode ends when one turns negative.
+  pure function holds(self, f) result(h)
+    class(mode_type), intent(in) :: self
+    real(wp), intent(in) :: f(2)
+    real(wp) :: h(max_holds)
+    integer :: j
+    h = 0.0_wp
+    do j = 1, self%n_hold
+      h(j) = dot_product(self%hold_w(:, j), f + self%f_slide) + self%hold_c(j)
+    end do
+  end function holds
+
+  !> Solve the complementarity problem at one instant by enumeration (METHOD.md section 2).
+  !> candidate(k): contact k is closed with zero normal velocity; resting(i): body i is at
+  !> rest with friction; moving_sign(i): sign of v_i for the other bodies with friction.
+  !> f and df are the forces and their right derivative at that instant: a condition that
+  !> sits exactly at its bound is accepted only if it is not about to be violated.
+  !> Preference: more bodies stuck, then more contacts held. Only combinations whose locked
+  !> rows are independent are tried; that loses no solution (a vertex of the feasible
+  !> reaction set has independent rows, the other reactions sitting at a bound).
+  subroutine solve_mode(scene, f, df, candidate, resting, moving_sign, mode, found)
+    type(scene_type), intent(in) :: scene
+    real(wp), intent(in) :: f(2), df(2)
+    logical, intent(in) :: candidate(n_contacts), resting(2)
+    real(wp), intent(in) :: moving_sign(2)
+    type(mode_type), intent(out) :: mode
+    logical, intent(out) :: found
+    integer :: target_stuck, o1, o2, mask, n_active, target_active, k
+    integer :: option(2)
+    logical :: active(n_contacts)
+
+    found = .false.
+    do target_stuck = 2, 0, -1
+      do o1 = 0, 2
+        do o2 = 0, 2
+          option = [o1, o2]
+          ! option 0 = stuck, 1 = sliding +, 2 = sliding -; only resting bodies have a choice.
+          if ((.not. resting(1) .and. o1 /= 0) .or. (.not. resting(2) .and. o2 /= 0)) cycle
+          if (count(option == 0 .and. resting) /= target_stuck) cycle
+          do target_active = count(candidate), 0, -1
+            do mask = 0, 2**n_contacts - 1
+              active = [(btest(mask, k - 1), k = 1, n_contacts)]
+              if (any(active .and. .not. candidate)) cycle
+              n_active = count(active)
+              if (n_active /= target_active) cycle
+              call try_mode(scene, f, df, candidate, resting, moving_sign, option, active, mode, found)
+              if (found) return
+            end do
+          end do
+        end do
+      end do
+    end do
+  end subroutine solve_mode
+
+  subroutine try_mode(scene, f, df, candidate, resting, moving_sign, option, active, mode, found)
+    type(scene_type), intent(in) :: scene
+    real(wp), intent(in) :: f(2), df(2), moving_sign(2)
+    logical, intent(in) :: candidate(n_contacts), resting(2), active(n_contacts)
+    integer, intent(in) :: option(2)
+    type(mode_type), intent(inout) :: mode
+    logical, intent(out) :: found
+    real(wp) :: rows(2, 2), minv(2), s(2, 2), sinv(2, 2), det, k_gain(2, 2), jm(2, 2)
+    real(wp) :: load(2), w(2), tol, tol_rate, meff
+    integer :: m, i, k, p, row_body(2), row_contact(2)
+
+    found = .false.
+    minv = 1.0_wp / scene%mass
+    mode%active = active
+    mode%stuck = resting .and. option == 0
+    mode%sgn = moving_sign
+    do i = 1, 2
+      if (resting(i) .and. option(i) == 1) mode%sgn(i) = 1.0_wp
+      if (resting(i) .and. option(i) == 2) mode%sgn(i) = -1.0_wp
+    end do
+    mode%f_slide = -scene%friction * mode%sgn
+
+    ! Locked rows: held contacts (normal n_k) and stuck bodies (unit row e_i).
+    m = 0
+    row_body = 0
+    row_contact = 0
+    do k = 1, n_contacts
+      if (.not. active(k)) cycle
+      m = m + 1
+      if (m > 2) return
+      rows(m, :) = normal(:, k)
+      row_contact(m) = k
+    end do
+    do i = 1, 2
+      if (.not. mode%stuck(i)) cycle
+      m = m + 1
+      if (m > 2) return
+      rows(m, :) = 0.0_wp
+      rows(m, i) = 1.0_wp
+      row_body(m) = i
+    end do
+
+    ! M a = f + f_slide + J^T mu, J a = 0  =>  mu = K (f + f_slide), a = M^-1 (I + J^T K) (f + f_slide).
+    mode%gain = 0.0_wp
+    mode%gain(1, 1) = minv(1)
+    mode%gain(2, 2) = minv(2)
+    k_gain = 0.0_wp
+    if (m > 0) then
+      do p = 1, m
+        jm(p, :) = rows(p, :) * minv
+      end do
+      s(1:m, 1:m) = matmul(jm(1:m, :), transpose(rows(1:m, :)))
+      if (m == 1) then
+        sinv(1, 1) = 1.0_wp / s(1, 1)
+      else
+        det = s(1, 1) * s(2, 2) - s(1, 2) * s(2, 1)
+        ! Dependent rows (a wall and a stuck body on the same body, both slot limits).
+        if (abs(det) <= 1.0e-12_wp * s(1, 1) * s(2, 2)) return
+        sinv = reshape([s(2, 2), -s(2, 1), -s(1, 2), s(1, 1)], [2, 2]) / det
+      end if
+      k_gain(1:m, :) = -matmul(sinv(1:m, 1:m), jm(1:m, :))
+      do i = 1, 2
+        mode%gain(i, :) = mode%gain(i, :) + minv(i) * matmul(rows(1:m, i), k_gain(1:m, :))
+      end do
+      ! Make the held motion exact, not rounding-small: a body on a wall or stuck does not
+      ! creep, a closed slot moves both bodies alike.
+      if (m == 2) mode%gain = 0.0_wp
+      do p = 1, m
+        do i = 1, 2
+          if (rows(p, i) /= 0.0_wp .and. rows(p, 3 - i) == 0.0_wp) mode%gain(i, :) = 0.0_wp
+        end do
+        if (rows(p, 1) /= 0.0_wp .and. rows(p, 2) /= 0.0_wp) then
+          mode%gain(1, :) = 0.5_wp * (mode%gain(1, :) + mode%gain(2, :))
+          mode%gain(2, :) = mode%gain(1, :)
+        end if
+      end do
+    end if
+
+    load = f + mode%f_slide
+    tol = 1.0e3_wp * eps_wp * (sum(abs(f)) + 2.0_wp * sum(scene%friction)) + tiny(1.0_wp)
+    tol_rate = 1.0e3_wp * eps_wp * sum(abs(df))
+
+    mode%n_hold = 0
+    do p = 1, m
+      if (row_contact(p) > 0) then
+        call add_hold(k_gain(p, :), 0.0_wp)                       ! contact force >= 0
+      else
+        i = row_body(p)
+        call add_hold(-k_gain(p, :), scene%friction(i))           ! static friction <= c_i
+        call add_hold(k_gain(p, :), scene%friction(i))            ! static friction >= -c_i
+      end if
+    end do
+    do p = 1, mode%n_hold
+      if (.not. admissible(mode%hold_w(:, p), mode%hold_c(p))) return
+    end do
+    ! A closed contact left free must not close further; a body leaving rest must move the
+    ! way its friction assumes. Both are written in force units so one tolerance serves.
+    do k = 1, n_contacts
+      if (.not. candidate(k) .or. active(k)) cycle
+      meff = 1.0_wp / dot_product(normal(:, k)**2, minv)
+      w = meff * matmul(normal(:, k), mode%gain)
+      if (.not. admissible(w, 0.0_wp)) return
+    end do
+    do i = 1, 2
+      if (.not. resting(i) .or. mode%stuck(i)) cycle
+      w = scene%mass(i) * mode%sgn(i) * mode%gain(i, :)
+      if (.not. admissible(w, 0.0_wp)) return
+    end do
+    found = .true.
+
+  contains
+
+    subroutine add_hold(weights, constant)
+      real(wp), intent(in) :: weights(2), constant
+      mode%n_hold = mode%n_hold + 1
+      mode%hold_w(:, mode%n_hold) = weights
+      mode%hold_c(mode%n_hold) = constant
+    end subroutine add_hold
+
+    logical function admissible(weights, constant)
+      real(wp), intent(in) :: weights(2), constant
+      real(wp) :: value
+      value = dot_product(weights, load) + constant
+      admissible = value > tol .or. (value >= -tol .and. dot_product(weights, df) >= -tol_rate)
+    end function admissible
+  end subroutine try_mode
+end module impact1d_modes

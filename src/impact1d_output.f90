@@ -1,0 +1,236 @@
+!> Where a run's samples and events go. The solver talks to an abstract sink, so the CLI
+!> streams to files (memory constant in run length) while Python collects arrays.
+module impact1d_output
+  use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char
+  use impact1d_kinds, only: wp
+  use impact1d_error, only: error_type, raise, status_input, fmt
+  use impact1d_scene, only: scene_input, real_names, n_real, i_title, i_method, i_g, i_dt_out, &
+    i_dt, default_gravity
+  implicit none
+  private
+  public :: sink_type, memory_sink, file_sink, n_columns, column_names, n_event_kinds, event_names
+  public :: event_impact, event_rest, event_release, event_stick, event_slip, make_folder
+
+  integer, parameter :: n_columns = 10
+  character(len=*), parameter :: column_names = &
+    't x1 v1 x2 v2 ke work friction_loss impact_loss residual'
+
+  !> Event kinds: impact on contact k is code k; rest, release add 4 and 8; stick, slip of
+  !> body i are 12 + i and 14 + i.
+  integer, parameter :: n_event_kinds = 16
+  integer, parameter :: event_impact = 0, event_rest = 4, event_release = 8, event_stick = 12, &
+    event_slip = 14
+  character(len=*), parameter :: event_names(n_event_kinds) = [character(len=17) :: &
+    'left', 'right', 'slot_min', 'slot_max', 'rest_left', 'rest_right', 'rest_slot_min', &
+    'rest_slot_max', 'release_left', 'release_right', 'release_slot_min', 'release_slot_max', &
+    'stick1', 'stick2', 'slip1', 'slip2']
+
+  type, abstract :: sink_type
+  contains
+    procedure(put_sample_interface), deferred :: put_sample
+    procedure(put_event_interface), deferred :: put_event
+  end type sink_type
+
+  abstract interface
+    !> One output row: t x1 v1 x2 v2 ke work friction_loss impact_loss residual.
+    subroutine put_sample_interface(self, row)
+      import :: sink_type, wp, n_columns
+      class(sink_type), intent(inout) :: self
+      real(wp), intent(in) :: row(n_columns)
+    end subroutine put_sample_interface
+    !> One event: time, kind code, velocities before and after.
+    subroutine put_event_interface(self, t, kind, v_before, v_after)
+      import :: sink_type, wp
+      class(sink_type), intent(inout) :: self
+      real(wp), intent(in) :: t, v_before(2), v_after(2)
+      integer, intent(in) :: kind
+    end subroutine put_event_interface
+  end interface
+
+  !> Keeps everything in arrays (the Python side copies them out).
+  type, extends(sink_type) :: memory_sink
+    real(wp), allocatable :: samples(:, :)
+    integer :: n_samples = 0
+    real(wp), allocatable :: event_time(:), event_v(:, :)
+    integer, allocatable :: event_kind(:)
+    integer :: n_events = 0
+  contains
+    procedure :: put_sample => memory_put_sample
+    procedure :: put_event => memory_put_event
+    procedure :: reserve => memory_reserve
+  end type memory_sink
+
+  !> Streams rows to NAME.dat and NAME.events.dat, written under temporary names and renamed
+  !> only when the run succeeds: a failed run never leaves a truncated file under the final name.
+  type, extends(sink_type) :: file_sink
+    integer :: unit = 0, event_unit = 0
+    logical :: is_open = .false.
+    character(len=:), allocatable :: path, event_path
+  contains
+    procedure :: put_sample => file_put_sample
+    procedure :: put_event => file_put_event
+    procedure :: open => file_open
+    procedure :: close => file_close
+  end type file_sink
+
+  interface
+    integer(c_int) function c_rename(old, new) bind(C, name='rename')
+      import :: c_int, c_char
+      character(kind=c_char), intent(in) :: old(*), new(*)
+    end function c_rename
+    integer(c_int) function c_mkdir(path, mode) bind(C, name='mkdir')
+      import :: c_int, c_char
+      character(kind=c_char), intent(in) :: path(*)
+      integer(c_int), value :: mode
+    end function c_mkdir
+  end interface
+
+  character(len=*), parameter :: row_format = '(*(es25.16e3))'
+
+contains
+
+  subroutine memory_reserve(self, n_samples)
+    class(memory_sink), intent(inout) :: self
+    integer, intent(in) :: n_samples
+    if (allocated(self%samples)) deallocate(self%samples)
+    allocate(self%samples(n_samples, n_columns))
+    self%n_samples = 0
+    if (allocated(self%event_time)) deallocate(self%event_time, self%event_v, self%event_kind)
+    allocate(self%event_time(64), self%event_v(4, 64), self%event_kind(64))
+    self%n_events = 0
+  end subroutine memory_reserve
+
+  subroutine memory_put_sample(self, row)
+    class(memory_sink), intent(inout) :: self
+    real(wp), intent(in) :: row(n_columns)
+    self%n_samples = self%n_samples + 1
+    self%samples(self%n_samples, :) = row
+  end subroutine memory_put_sample
+
+  subroutine memory_put_event(self, t, kind, v_before, v_after)
+    class(memory_sink), intent(inout) :: self
+    real(wp), intent(in) :: t, v_before(2), v_after(2)
+    integer, intent(in) :: kind
+    real(wp), allocatable :: times(:), velocities(:, :)
+    integer, allocatable :: kinds(:)
+    integer :: n
+    n = self%n_events
+    if (n == size(self%event_time)) then
+      ! Geometric growth: events are rare next to steps, copies are amortised.
+      allocate(times(2 * n), velocities(4, 2 * n), kinds(2 * n))
+      times(:n) = self%event_time
+      velocities(:, :n) = self%event_v
+      kinds(:n) = self%event_kind
+      call move_alloc(times, self%event_time)
+      call move_alloc(velocities, self%event_v)
+      call move_alloc(kinds, self%event_kind)
+    end if
+    n = n + 1
+    self%n_events = n
+    self%event_time(n) = t
+    self%event_kind(n) = kind
+    self%event_v(:, n) = [v_before, v_after]
+  end subroutine memory_put_event
+
+  !> Open OUT (and OUT's events file) under temporary names and write the headers.
+  subroutine file_open(self, path, input, error)
+    class(file_sink), intent(inout) :: self
+    character(len=*), intent(in) :: path
+    type(scene_input), intent(in) :: input
+    type(error_type), allocatable, intent(out) :: error
+    integer :: ios, k
+    character(len=512) :: message
+
+    self%path = path
+    self%event_path = events_path(path)
+    open(newunit=self%unit, file=self%path // '.part', status='replace', action='write', &
+      iostat=ios, iomsg=message)
+    if (ios /= 0) then
+      call raise(error, status_input, 'cannot write output ' // path // ': ' // trim(message))
+      return
+    end if
+    open(newunit=self%event_unit, file=self%event_path // '.part', status='replace', action='write', &
+      iostat=ios, iomsg=message)
+    if (ios /= 0) then
+      close(self%unit, status='delete')
+      call raise(error, status_input, 'cannot write output ' // self%event_path // ': ' // trim(message))
+      return
+    end if
+    self%is_open = .true.
+    write(self%unit, '(a)') '# impact1d output'
+    write(self%unit, '(a)') '# title = ' // trim(input%text(i_title))
+    if (allocated(input%source)) write(self%unit, '(a)') '# scene = ' // input%source
+    if (len_trim(input%text(i_method)) > 0) then
+      write(self%unit, '(a)') '# method = ' // trim(input%text(i_method))
+    else
+      write(self%unit, '(a)') '# method = event'
+    end if
+    do k = 1, n_real
+      if (input%given(k)) then
+        write(self%unit, '(a)') '# ' // trim(real_names(k)) // ' = ' // fmt(input%value(k))
+      else if (k == i_g) then
+        write(self%unit, '(a)') '# g = ' // fmt(default_gravity)
+      else if (k == i_dt_out) then
+        write(self%unit, '(a)') '# dt_out = ' // fmt(input%value(i_dt))
+      end if
+    end do
+    write(self%unit, '(a)') '# ' // column_names
+    write(self%event_unit, '(a)') '# impact1d events'
+    write(self%event_unit, '(a)') '# t kind v1_before v2_before v1_after v2_after'
+  end subroutine file_open
+
+  subroutine file_put_sample(self, row)
+    class(file_sink), intent(inout) :: self
+    real(wp), intent(in) :: row(n_columns)
+    write(self%unit, row_format) row
+  end subroutine file_put_sample
+
+  subroutine file_put_event(self, t, kind, v_before, v_after)
+    class(file_sink), intent(inout) :: self
+    real(wp), intent(in) :: t, v_before(2), v_after(2)
+    integer, intent(in) :: kind
+    write(self%event_unit, '(es25.16e3, 1x, a17, 4es25.16e3)') t, event_names(kind), v_before, v_after
+  end subroutine file_put_event
+
+  !> Close the files; keep them under their final names only if the run succeeded.
+  subroutine file_close(self, keep, error)
+    class(file_sink), intent(inout) :: self
+    logical, intent(in) :: keep
+    type(error_type), allocatable, intent(out) :: error
+    integer(c_int) :: status
+    if (.not. self%is_open) return
+    self%is_open = .false.
+    if (.not. keep) then
+      close(self%unit, status='delete')
+      close(self%event_unit, status='delete')
+      return
+    end if
+    close(self%unit)
+    close(self%event_unit)
+    status = c_rename(self%path // '.part' // c_null_char, self%path // c_null_char)
+    if (status == 0) status = c_rename(self%event_path // '.part' // c_null_char, self%event_path // c_null_char)
+    if (status /= 0) call raise(error, status_input, 'cannot rename the finished output to ' // self%path)
+  end subroutine file_close
+
+  !> NAME.dat -> NAME.events.dat (NAME -> NAME.events.dat without the extension).
+  pure function events_path(path) result(events)
+    character(len=*), intent(in) :: path
+    character(len=:), allocatable :: events
+    integer :: n
+    n = len(path)
+    if (n > 4) then
+      if (path(n - 3:) == '.dat') then
+        events = path(:n - 4) // '.events.dat'
+        return
+      end if
+    end if
+    events = path // '.events.dat'
+  end function events_path
+
+  !> Create a folder if it is missing (an existing one is fine).
+  subroutine make_folder(path)
+    character(len=*), intent(in) :: path
+    integer(c_int) :: status
+    status = c_mkdir(path // c_null_char, int(o'755', c_int))
+  end subroutine make_folder
+end module impact1d_output

@@ -1,0 +1,303 @@
+!> The scene: what the user wrote (scene_input: named values, each given or not) and the
+!> checked model the solver runs (scene_type). One validator serves the CLI and Python.
+module impact1d_scene
+  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+  use impact1d_kinds, only: wp, eps_wp
+  use impact1d_error, only: error_type, raise, status_input, fmt
+  use impact1d_forcing, only: forcing_type, table_type
+  implicit none
+  private
+  public :: n_real, n_text, real_names, text_names, scene_input, scene_type, build_scene, validate
+  public :: n_contacts, contact_names, normal, i_left, i_right, i_slot_min, i_slot_max
+  public :: i_m1, i_m2, i_mu1, i_mu2, i_g, i_x_left, i_r_left, i_x_right, i_r_right, i_d_min, &
+    i_r_min, i_d_max, i_r_max, i_x1, i_v1, i_x2, i_v2, i_f1, i_f2, i_f1_amp, i_f1_period, &
+    i_f1_phase, i_f2_amp, i_f2_period, i_f2_phase, i_t_end, i_dt, i_dt_out
+  public :: i_title, i_f1_table, i_f2_table, i_method, max_samples, default_gravity
+
+  integer, parameter :: n_real = 28, n_text = 4
+  !> Names of the real inputs, as in the namelist and in Python's Scene, in this order.
+  character(len=*), parameter :: real_names(n_real) = [character(len=9) :: &
+    'm1', 'm2', 'mu1', 'mu2', 'g', 'x_left', 'r_left', 'x_right', 'r_right', &
+    'd_min', 'r_min', 'd_max', 'r_max', 'x1', 'v1', 'x2', 'v2', 'f1', 'f2', &
+    'f1_amp', 'f1_period', 'f1_phase', 'f2_amp', 'f2_period', 'f2_phase', 't_end', 'dt', 'dt_out']
+  character(len=*), parameter :: text_names(n_text) = [character(len=8) :: &
+    'title', 'f1_table', 'f2_table', 'method']
+  integer, parameter :: i_m1 = 1, i_m2 = 2, i_mu1 = 3, i_mu2 = 4, i_g = 5, i_x_left = 6, &
+    i_r_left = 7, i_x_right = 8, i_r_right = 9, i_d_min = 10, i_r_min = 11, i_d_max = 12, &
+    i_r_max = 13, i_x1 = 14, i_v1 = 15, i_x2 = 16, i_v2 = 17, i_f1 = 18, i_f2 = 19, &
+    i_f1_amp = 20, i_f1_period = 21, i_f1_phase = 22, i_f2_amp = 23, i_f2_period = 24, &
+    i_f2_phase = 25, i_t_end = 26, i_dt = 27, i_dt_out = 28
+  integer, parameter :: i_title = 1, i_f1_table = 2, i_f2_table = 3, i_method = 4
+
+  !> The four optional unilateral constraints: gap_k = normal(:,k) . x + offset_k >= 0.
+  integer, parameter :: n_contacts = 4, i_left = 1, i_right = 2, i_slot_min = 3, i_slot_max = 4
+  character(len=*), parameter :: contact_names(n_contacts) = [character(len=8) :: &
+    'left', 'right', 'slot_min', 'slot_max']
+  real(wp), parameter :: normal(2, n_contacts) = reshape( &
+    [1.0_wp, 0.0_wp, 0.0_wp, -1.0_wp, -1.0_wp, 1.0_wp, 1.0_wp, -1.0_wp], [2, n_contacts])
+
+  real(wp), parameter :: default_gravity = 9.80665_wp
+  !> Output rows a run may produce: beyond this the user almost surely meant a larger dt_out.
+  integer, parameter :: max_samples = 10000000
+
+  !> A scene as written: values and texts, each given or absent.
+  type :: scene_input
+    real(wp) :: value(n_real) = 0.0_wp
+    logical :: given(n_real) = .false.
+    character(len=1024) :: text(n_text) = ''
+    character(len=:), allocatable :: source
+  end type scene_input
+
+  !> The checked model. Friction bound c_i = mu_i m_i g.
+  type :: scene_type
+    character(len=:), allocatable :: title, method
+    real(wp) :: mass(2), friction(2)
+    logical :: has_contact(n_contacts) = .false.
+    real(wp) :: offset(n_contacts) = 0.0_wp, restitution(n_contacts) = 1.0_wp
+    real(wp) :: x0(2), v0(2)
+    type(forcing_type) :: forcing
+    real(wp) :: t_end, dt, dt_out
+    integer :: n_samples
+  end type scene_type
+
+contains
+
+  !> Check what the user wrote. With require_run false the &run values may still come from
+  !> overrides (the CLI's options, Python's keywords), so their absence is not yet an error.
+  subroutine validate(input, require_run, error)
+    type(scene_input), intent(in) :: input
+    logical, intent(in) :: require_run
+    type(error_type), allocatable, intent(out) :: error
+    integer :: k
+    real(wp) :: gap, scale
+
+    do k = 1, n_real
+      if (input%given(k) .and. .not. ieee_is_finite(input%value(k))) then
+        call raise(error, status_input, trim(real_names(k)) // ' = ' // fmt(input%value(k)) // &
+          ' is not a finite number')
+        return
+      end if
+    end do
+    call require([i_m1, i_m2, i_x1, i_x2])
+    if (allocated(error)) return
+    if (require_run) call require([i_t_end, i_dt])
+    if (allocated(error)) return
+
+    call positive(i_m1); call positive(i_m2)
+    if (allocated(error)) return
+    call nonnegative(i_mu1); call nonnegative(i_mu2)
+    if (allocated(error)) return
+    if (input%given(i_g) .and. input%value(i_g) < 0.0_wp .and. (value_or(i_mu1, 0.0_wp) > 0.0_wp &
+        .or. value_or(i_mu2, 0.0_wp) > 0.0_wp)) then
+      call raise(error, status_input, 'g = ' // fmt(input%value(i_g)) // &
+        ' is negative with friction: the normal force m g must not pull the bodies off the surface')
+      return
+    end if
+    call restitution(i_r_left, i_x_left); call restitution(i_r_right, i_x_right)
+    call restitution(i_r_min, i_d_min); call restitution(i_r_max, i_d_max)
+    if (allocated(error)) return
+    if (input%given(i_x_left) .and. input%given(i_x_right)) then
+      if (input%value(i_x_left) >= input%value(i_x_right)) then
+        call raise(error, status_input, 'x_left = ' // fmt(input%value(i_x_left)) // &
+          ' must be less than x_right = ' // fmt(input%value(i_x_right)))
+        return
+      end if
+    end if
+    if (input%given(i_d_min) .and. input%given(i_d_max)) then
+      if (input%value(i_d_min) > input%value(i_d_max)) then
+        call raise(error, status_input, 'd_min = ' // fmt(input%value(i_d_min)) // &
+          ' must not exceed d_max = ' // fmt(input%value(i_d_max)))
+        return
+      end if
+    end if
+    call sine_terms(i_f1_amp, i_f1_period, i_f1_phase)
+    call sine_terms(i_f2_amp, i_f2_period, i_f2_phase)
+    if (allocated(error)) return
+
+    ! The initial state must satisfy every constraint; a gap within rounding of zero is contact.
+    scale = max(abs(input%value(i_x1)), abs(input%value(i_x2)))
+    do k = 1, n_contacts
+      if (.not. input%given(limit_index(k))) cycle
+      gap = normal(1, k) * input%value(i_x1) + normal(2, k) * input%value(i_x2) + offset_of(k)
+      if (gap < -16.0_wp * eps_wp * max(scale, abs(offset_of(k)))) then
+        call raise(error, status_input, 'the initial state x1 = ' // fmt(input%value(i_x1)) // &
+          ', x2 = ' // fmt(input%value(i_x2)) // ' violates the ' // trim(contact_names(k)) // &
+          ' constraint (' // trim(real_names(limit_index(k))) // ' = ' // &
+          fmt(input%value(limit_index(k))) // ')')
+        return
+      end if
+    end do
+
+    if (input%given(i_t_end)) then
+      if (input%value(i_t_end) <= 0.0_wp) then
+        call raise(error, status_input, 't_end = ' // fmt(input%value(i_t_end)) // ' must be positive')
+        return
+      end if
+    end if
+    if (input%given(i_dt)) then
+      if (input%value(i_dt) <= 0.0_wp) then
+        call raise(error, status_input, 'dt = ' // fmt(input%value(i_dt)) // ' must be positive')
+        return
+      end if
+      if (input%given(i_dt_out)) then
+        if (input%value(i_dt_out) < input%value(i_dt)) then
+          call raise(error, status_input, 'dt_out = ' // fmt(input%value(i_dt_out)) // &
+            ' is less than dt = ' // fmt(input%value(i_dt)) // ': output cannot be finer than the step')
+          return
+        end if
+      end if
+    end if
+    if (input%given(i_t_end) .and. (input%given(i_dt) .or. input%given(i_dt_out))) then
+      if (input%value(i_t_end) / value_or(i_dt_out, input%value(i_dt)) > real(max_samples - 1, wp)) then
+        call raise(error, status_input, 't_end / dt_out = ' // &
+          fmt(input%value(i_t_end) / value_or(i_dt_out, input%value(i_dt))) // &
+          ' output rows is over the limit of ' // fmt(max_samples) // ': set a larger dt_out')
+        return
+      end if
+    end if
+    if (len_trim(input%text(i_method)) > 0) then
+      if (trim(input%text(i_method)) /= 'event') then
+        call raise(error, status_input, "method = '" // trim(input%text(i_method)) // &
+          "' is unknown: the method is 'event'")
+        return
+      end if
+    end if
+
+  contains
+
+    subroutine require(indices)
+      integer, intent(in) :: indices(:)
+      integer :: j
+      do j = 1, size(indices)
+        if (.not. input%given(indices(j))) then
+          call raise(error, status_input, trim(real_names(indices(j))) // ' is required but not given')
+          return
+        end if
+      end do
+    end subroutine require
+
+    subroutine positive(i)
+      integer, intent(in) :: i
+      if (allocated(error)) return
+      if (input%value(i) <= 0.0_wp) call raise(error, status_input, trim(real_names(i)) // ' = ' // &
+        fmt(input%value(i)) // ' must be positive')
+    end subroutine positive
+
+    subroutine nonnegative(i)
+      integer, intent(in) :: i
+      if (allocated(error) .or. .not. input%given(i)) return
+      if (input%value(i) < 0.0_wp) call raise(error, status_input, trim(real_names(i)) // ' = ' // &
+        fmt(input%value(i)) // ' must not be negative')
+    end subroutine nonnegative
+
+    subroutine restitution(i, owner)
+      integer, intent(in) :: i, owner
+      if (allocated(error) .or. .not. input%given(i)) return
+      if (input%value(i) < 0.0_wp .or. input%value(i) > 1.0_wp) then
+        call raise(error, status_input, trim(real_names(i)) // ' = ' // fmt(input%value(i)) // &
+          ' is outside [0, 1]')
+      else if (.not. input%given(owner)) then
+        call raise(error, status_input, trim(real_names(i)) // ' is given but ' // &
+          trim(real_names(owner)) // ' is not: a restitution needs its constraint')
+      end if
+    end subroutine restitution
+
+    subroutine sine_terms(i_amp, i_period, i_phase)
+      integer, intent(in) :: i_amp, i_period, i_phase
+      if (allocated(error)) return
+      if (input%given(i_amp) .neqv. input%given(i_period)) then
+        call raise(error, status_input, trim(real_names(i_amp)) // ' and ' // trim(real_names(i_period)) // &
+          ' go together: a sine force needs both')
+      else if (input%given(i_phase) .and. .not. input%given(i_amp)) then
+        call raise(error, status_input, trim(real_names(i_phase)) // ' is given but ' // &
+          trim(real_names(i_amp)) // ' is not')
+      else if (input%given(i_period)) then
+        if (input%value(i_period) <= 0.0_wp) call raise(error, status_input, trim(real_names(i_period)) // &
+          ' = ' // fmt(input%value(i_period)) // ' must be positive')
+      end if
+    end subroutine sine_terms
+
+    real(wp) function value_or(i, default)
+      integer, intent(in) :: i
+      real(wp), intent(in) :: default
+      value_or = default
+      if (input%given(i)) value_or = input%value(i)
+    end function value_or
+
+    real(wp) function offset_of(k)
+      integer, intent(in) :: k
+      offset_of = offset_sign(k) * input%value(limit_index(k))
+    end function offset_of
+  end subroutine validate
+
+  !> Validate and build the model. tables(i) holds f_i's table when the input names one.
+  subroutine build_scene(input, tables, scene, error)
+    type(scene_input), intent(in) :: input
+    type(table_type), intent(in) :: tables(2)
+    type(scene_type), intent(out) :: scene
+    type(error_type), allocatable, intent(out) :: error
+    integer :: i, k
+    real(wp) :: g, ratio
+
+    call validate(input, .true., error)
+    if (allocated(error)) return
+
+    scene%title = trim(input%text(i_title))
+    scene%method = 'event'
+    if (len_trim(input%text(i_method)) > 0) scene%method = trim(input%text(i_method))
+    scene%mass = input%value([i_m1, i_m2])
+    g = default_gravity
+    if (input%given(i_g)) g = input%value(i_g)
+    scene%friction = 0.0_wp
+    do i = 1, 2
+      if (input%given(i_mu1 + i - 1)) scene%friction(i) = input%value(i_mu1 + i - 1) * scene%mass(i) * g
+    end do
+    scene%friction = max(scene%friction, 0.0_wp)
+    do k = 1, n_contacts
+      scene%has_contact(k) = input%given(limit_index(k))
+      if (.not. scene%has_contact(k)) cycle
+      scene%offset(k) = offset_sign(k) * input%value(limit_index(k))
+      if (input%given(limit_index(k) + 1)) scene%restitution(k) = input%value(limit_index(k) + 1)
+    end do
+    scene%x0 = input%value([i_x1, i_x2])
+    scene%v0 = 0.0_wp
+    if (input%given(i_v1)) scene%v0(1) = input%value(i_v1)
+    if (input%given(i_v2)) scene%v0(2) = input%value(i_v2)
+
+    do i = 1, 2
+      if (input%given(i_f1 + i - 1)) scene%forcing%constant(i) = input%value(i_f1 + i - 1)
+      scene%forcing%has_table(i) = len_trim(input%text(i_f1_table + i - 1)) > 0
+      if (scene%forcing%has_table(i)) scene%forcing%table(i) = tables(i)
+      k = i_f1_amp + 3 * (i - 1)
+      scene%forcing%has_sine(i) = input%given(k)
+      if (scene%forcing%has_sine(i)) then
+        scene%forcing%amp(i) = input%value(k)
+        scene%forcing%omega(i) = 2.0_wp * acos(-1.0_wp) / input%value(k + 1)
+        if (input%given(k + 2)) scene%forcing%phase(i) = input%value(k + 2)
+      end if
+    end do
+
+    scene%t_end = input%value(i_t_end)
+    scene%dt = input%value(i_dt)
+    scene%dt_out = scene%dt
+    if (input%given(i_dt_out)) scene%dt_out = input%value(i_dt_out)
+    ! Samples at j*dt_out, and at t_end when it is off that grid.
+    ratio = scene%t_end / scene%dt_out
+    scene%n_samples = nint(ratio) + 1
+    if (abs(ratio - nint(ratio)) > 1.0e-9_wp * max(1.0_wp, ratio)) scene%n_samples = floor(ratio) + 2
+  end subroutine build_scene
+
+  !> Index of the variable that names constraint k (its limit); the restitution follows it.
+  pure integer function limit_index(k)
+    integer, intent(in) :: k
+    integer, parameter :: indices(n_contacts) = [i_x_left, i_x_right, i_d_min, i_d_max]
+    limit_index = indices(k)
+  end function limit_index
+
+  !> gap = normal . x + offset_sign * limit (left: x1 - x_left; right: x_right - x2; ...).
+  pure real(wp) function offset_sign(k)
+    integer, intent(in) :: k
+    real(wp), parameter :: signs(n_contacts) = [-1.0_wp, 1.0_wp, -1.0_wp, 1.0_wp]
+    offset_sign = signs(k)
+  end function offset_sign
+end module impact1d_scene

@@ -1,0 +1,550 @@
+!> The hybrid-system driver (METHOD.md sections 2-6): classical RK4 at the user's step
+!> within a mode, in-step location of the earliest event on the step's dense output, a
+!> re-step to the event time, then impacts, Zeno rest and a new mode at the event point.
+!> Nothing here allocates, formats or writes per step; output goes to a sink at sample times.
+module impact1d_solver
+  use impact1d_kinds, only: wp, eps_wp
+  use impact1d_error, only: error_type, raise, status_simulation, fmt
+  use impact1d_scene, only: scene_type, n_contacts, normal, contact_names
+  use impact1d_modes, only: mode_type, solve_mode, max_holds
+  use impact1d_events, only: hermite, earliest_crossing
+  use impact1d_impacts, only: normal_velocity, impulse, most_approaching, restitution_of, &
+    kinetic_energy
+  use impact1d_output, only: sink_type, n_columns, n_event_kinds, event_impact, event_rest, &
+    event_release, event_stick, event_slip
+  implicit none
+  private
+  public :: run, run_stats
+
+  !> What a run did, for the CLI's summary and Python's result.
+  type :: run_stats
+    integer :: steps = 0
+    integer :: events(n_event_kinds) = 0
+    real(wp) :: last_row(n_columns) = 0.0_wp
+    real(wp) :: max_residual = 0.0_wp
+  end type run_stats
+
+  !> Tolerances, each a multiple of the unit roundoff of the quantity it guards.
+  real(wp), parameter :: gap_rounding = 16.0_wp * eps_wp      !< a gap this small (x scale) is closed
+  real(wp), parameter :: zeno_height = 256.0_wp * eps_wp      !< flights lower than this are unresolvable
+  real(wp), parameter :: velocity_rounding = 64.0_wp * eps_wp !< a velocity this small is zero
+  real(wp), parameter :: time_rounding = 64.0_wp * eps_wp     !< instants closer than this coincide
+  integer, parameter :: max_impulses = 1000000   !< per event point; elastic chains need ~pi sqrt(M/m)
+  integer, parameter :: max_stalls = 10000       !< event points in a row without time advancing
+  integer, parameter :: max_halvings = 60        !< retries of a step whose end violated a constraint
+
+  !> Positions are kept as x + x_lo (compensated summation of the step increments), so a gap
+  !> near a wall far from the origin keeps its digits: a micrometre bounce at x = 10 m would
+  !> otherwise be rounded to 2e-15 m at every stored step, and its velocity with it.
+  type :: state_type
+    real(wp) :: t = 0.0_wp
+    real(wp) :: x(2) = 0.0_wp, x_lo(2) = 0.0_wp, v(2) = 0.0_wp
+    real(wp) :: work = 0.0_wp, friction_loss = 0.0_wp, impact_loss = 0.0_wp
+  end type state_type
+
+contains
+
+  !> Run a scene from t = 0 to t_end, sending every dt_out sample and every event to sink.
+  subroutine run(scene, sink, stats, error)
+    type(scene_type), intent(in) :: scene
+    class(sink_type), intent(inout) :: sink
+    type(run_stats), intent(out) :: stats
+    type(error_type), allocatable, intent(out) :: error
+
+    type(state_type) :: s, trial
+    type(mode_type) :: mode
+    real(wp) :: ke0, t_stop, t_break, h, h_event, pending_rest(n_contacts), sample_t
+    logical :: in_contact(n_contacts), at_rest(2), located, at_stop
+    integer :: j_sample, stalls, halvings, watched
+    real(wp) :: t_last_event
+
+    s%t = 0.0_wp
+    s%x = scene%x0
+    s%v = scene%v0
+    ke0 = kinetic_energy(scene, s%v)
+    pending_rest = huge(1.0_wp)
+    in_contact = .false.
+    at_rest = .false.
+    stalls = 0
+    t_last_event = -huge(1.0_wp)
+
+    call event_point(initial=.true., located_body=0)
+    if (allocated(error)) return
+    j_sample = 0
+    call emit_sample()
+
+    do while (j_sample < scene%n_samples)
+      sample_t = sample_time(j_sample)
+      t_break = scene%forcing%next_breakpoint(s%t)
+      t_stop = min(sample_t, t_break, minval(pending_rest))
+      h = min(scene%dt, t_stop - s%t)
+      ! No sliver steps: a step that would stop just short of a stop goes to it.
+      if (t_stop - s%t - h <= 1.0e-9_wp * scene%dt) h = t_stop - s%t
+
+      halvings = 0
+      do
+        call rk4_step(s, h, trial)
+        call locate(s, trial, h, h_event, watched)
+        located = h_event <= h
+        if (located) then
+          h = h_event
+          call refine(s, h, watched, trial)
+        end if
+        if (constraints_hold(trial)) exit
+        ! The location missed a root (only possible for non-polynomial forcing): retry shorter.
+        halvings = halvings + 1
+        if (halvings > max_halvings) then
+          call raise(error, status_simulation, 'at t = ' // fmt(s%t) // &
+            ': no step keeps the constraints (event location failed)')
+          return
+        end if
+        h = 0.5_wp * h
+      end do
+
+      at_stop = .not. located .and. h == t_stop - s%t
+      s = trial
+      if (at_stop) s%t = t_stop
+      stats%steps = stats%steps + 1
+      if (any(.not. ieee_finite_state(s))) then
+        call raise(error, status_simulation, 'at t = ' // fmt(s%t) // ': the state is no longer finite')
+        return
+      end if
+
+      ! Events, table corners (the force's slope changes) and accumulation times need an
+      ! event point; a sample time does not.
+      if (located .or. (at_stop .and. (t_stop == t_break .or. t_stop == minval(pending_rest)))) then
+        if (s%t - t_last_event <= time_rounding * max(abs(s%t), scene%dt)) then
+          stalls = stalls + 1
+          if (stalls > max_stalls) then
+            call raise(error, status_simulation, 'at t = ' // fmt(s%t) // ': ' // fmt(max_stalls) // &
+              ' events without time advancing (the contacts chatter)')
+            return
+          end if
+        else
+          stalls = 0
+        end if
+        t_last_event = s%t
+        call flush_pending_rest()
+        call event_point(initial=.false., located_body=merge(watched - 100, 0, watched > 100 .and. located))
+        if (allocated(error)) return
+      end if
+      if (at_stop .and. s%t == sample_t) call emit_sample()
+    end do
+
+  contains
+
+    pure real(wp) function sample_time(j)
+      integer, intent(in) :: j
+      if (j == scene%n_samples - 1) then
+        sample_time = scene%t_end
+      else
+        sample_time = j * scene%dt_out
+      end if
+    end function sample_time
+
+    subroutine emit_sample()
+      real(wp) :: row(n_columns), ke
+      ke = kinetic_energy(scene, s%v)
+      row = [s%t, s%x(1) + s%x_lo(1), s%v(1), s%x(2) + s%x_lo(2), s%v(2), ke, s%work, s%friction_loss, s%impact_loss, &
+        ke - ke0 - s%work + s%friction_loss + s%impact_loss]
+      stats%max_residual = max(stats%max_residual, abs(row(n_columns)))
+      stats%last_row = row
+      call sink%put_sample(row)
+      j_sample = j_sample + 1
+    end subroutine emit_sample
+
+    subroutine log_event(kind, v_before, v_after)
+      integer, intent(in) :: kind
+      real(wp), intent(in) :: v_before(2), v_after(2)
+      stats%events(kind) = stats%events(kind) + 1
+      call sink%put_event(s%t, kind, v_before, v_after)
+    end subroutine log_event
+
+    !> Rest after an accumulation of impacts is logged at the accumulation time.
+    subroutine flush_pending_rest()
+      integer :: k
+      do k = 1, n_contacts
+        if (pending_rest(k) <= s%t) then
+          call log_event(event_rest + k, s%v, s%v)
+          pending_rest(k) = huge(1.0_wp)
+        end if
+      end do
+    end subroutine flush_pending_rest
+
+    !> One classical RK4 step of the mode's equations from a to b; the energy ledger by
+    !> Simpson's rule on the step's Hermite velocity, exact where RK4 is (polynomial forcing).
+    subroutine rk4_step(a, step, b)
+      type(state_type), intent(in) :: a
+      real(wp), intent(in) :: step
+      type(state_type), intent(out) :: b
+      real(wp) :: f0(2), fm(2), f1(2), a0(2), am(2), a1(2)
+      real(wp) :: k1x(2), k2x(2), k3x(2), k4x(2), vm(2), dx(2)
+      f0 = scene%forcing%force(a%t)
+      fm = scene%forcing%force(a%t + 0.5_wp * step)
+      f1 = scene%forcing%force(a%t + step)
+      ! Within a mode the acceleration depends on time only, so stages 2 and 3 share it.
+      a0 = mode%acceleration(f0)
+      am = mode%acceleration(fm)
+      a1 = mode%acceleration(f1)
+      k1x = a%v
+      k2x = a%v + 0.5_wp * step * a0
+      k3x = a%v + 0.5_wp * step * am
+      k4x = a%v + step * am
+      b%t = a%t + step
+      dx = step / 6.0_wp * (k1x + 2.0_wp * k2x + 2.0_wp * k3x + k4x) + a%x_lo
+      b%x = a%x + dx
+      b%x_lo = dx - (b%x - a%x)
+      b%v = a%v + step / 6.0_wp * (a0 + 4.0_wp * am + a1)
+      vm = 0.5_wp * (a%v + b%v) + 0.125_wp * step * (a0 - a1)
+      b%work = a%work + step / 6.0_wp * (dot_product(f0, a%v) + 4.0_wp * dot_product(fm, vm) + &
+        dot_product(f1, b%v))
+      b%friction_loss = a%friction_loss + step / 6.0_wp * dot_product(scene%friction * mode%sgn, &
+        a%v + 4.0_wp * vm + b%v)
+      b%impact_loss = a%impact_loss
+    end subroutine rk4_step
+
+    !> Earliest event in (0, step]: a gap closing, a sliding body stopping, a mode condition
+    !> failing. watched = k for contact k, 100 + i for body i, -1 for a mode condition.
+    subroutine locate(a, b, step, theta, which)
+      type(state_type), intent(in) :: a, b
+      real(wp), intent(in) :: step
+      real(wp), intent(out) :: theta
+      integer, intent(out) :: which
+      real(wp) :: c(3, 2), p(0:3), candidate, scale
+      integer :: k, i
+
+      theta = huge(1.0_wp)
+      which = 0
+      c(:, 1) = hermite((b%x(1) - a%x(1)) + (b%x_lo(1) - a%x_lo(1)), a%v(1), b%v(1), step)
+      c(:, 2) = hermite((b%x(2) - a%x(2)) + (b%x_lo(2) - a%x_lo(2)), a%v(2), b%v(2), step)
+      do k = 1, n_contacts
+        if (.not. scene%has_contact(k) .or. mode%active(k)) cycle
+        p(0) = gap(k, a)
+        p(1:3) = normal(1, k) * c(:, 1) + normal(2, k) * c(:, 2)
+        candidate = earliest_crossing(p, step, gap_tolerance(k, a))
+        if (candidate < theta) then
+          theta = candidate
+          which = k
+        end if
+      end do
+      do i = 1, 2
+        if (scene%friction(i) == 0.0_wp .or. mode%sgn(i) == 0.0_wp) cycle
+        ! Sliding velocity in its own direction: the derivative of the Hermite cubic.
+        p = mode%sgn(i) * [c(1, i), 2.0_wp * c(2, i), 3.0_wp * c(3, i), 0.0_wp]
+        scale = max(abs(a%v(i)), abs(b%v(i)), abs(b%v(i) - a%v(i)))
+        candidate = earliest_crossing(p, step, velocity_rounding * scale)
+        if (candidate < theta) then
+          theta = candidate
+          which = 100 + i
+        end if
+      end do
+      if (mode%n_hold > 0) then
+        candidate = hold_crossing(a%t, step)
+        if (candidate < theta) then
+          theta = candidate
+          which = -1
+        end if
+      end if
+    end subroutine locate
+
+    !> Earliest time in (0, step] at which a condition of the mode (a contact force, a static
+    !> friction margin) turns negative. They depend on time only: linear within a step under
+    !> piecewise-linear forcing, so the ends decide; a sine is sampled finer before bisection.
+    real(wp) function hold_crossing(t0, step) result(theta)
+      real(wp), intent(in) :: t0, step
+      real(wp) :: lo, hi, mid, tol
+      integer :: n_sub, j
+      theta = huge(1.0_wp)
+      tol = hold_tolerance(t0)
+      n_sub = 1
+      do j = 1, 2
+        if (scene%forcing%has_sine(j)) n_sub = max(n_sub, &
+          ceiling(16.0_wp * step * scene%forcing%omega(j) / (2.0_wp * acos(-1.0_wp))))
+      end do
+      lo = 0.0_wp
+      do j = 1, n_sub
+        hi = step * real(j, wp) / real(n_sub, wp)
+        if (worst_hold(t0 + hi) < -tol) then
+          ! Bisection to the last instant at which every condition still holds.
+          do while (hi - lo > 2.0_wp * eps_wp * max(abs(t0 + hi), step))
+            mid = 0.5_wp * (lo + hi)
+            if (worst_hold(t0 + mid) < 0.0_wp) then
+              hi = mid
+            else
+              lo = mid
+            end if
+          end do
+          theta = lo
+          return
+        end if
+        lo = hi
+      end do
+    end function hold_crossing
+
+    real(wp) function worst_hold(t)
+      real(wp), intent(in) :: t
+      real(wp) :: values(max_holds)
+      values = mode%holds(scene%forcing%force(t))
+      worst_hold = minval(values(1:mode%n_hold))
+    end function worst_hold
+
+    real(wp) function hold_tolerance(t)
+      real(wp), intent(in) :: t
+      hold_tolerance = 1.0e3_wp * eps_wp * (sum(abs(scene%forcing%force(t))) + &
+        2.0_wp * sum(scene%friction)) + tiny(1.0_wp)
+    end function hold_tolerance
+
+    !> Re-take the step to the located time and polish it by Newton's method on the watched
+    !> function evaluated on the integrator's own state (needed only for non-polynomial forcing,
+    !> where the Hermite dense output is approximate).
+    subroutine refine(a, step, which, b)
+      type(state_type), intent(in) :: a
+      real(wp), intent(inout) :: step
+      integer, intent(in) :: which
+      type(state_type), intent(out) :: b
+      real(wp) :: value, slope, tol, acc(2)
+      integer :: iteration
+      call rk4_step(a, step, b)
+      if (which <= 0) return
+      do iteration = 1, 8
+        if (which > 100) then
+          value = b%v(which - 100)
+          acc = mode%acceleration(scene%forcing%force(b%t))
+          slope = acc(which - 100)
+          tol = velocity_rounding * max(abs(a%v(which - 100)), abs(value))
+        else
+          value = gap(which, b)
+          slope = normal_velocity(which, b%v)
+          tol = gap_tolerance(which, b)
+        end if
+        if (abs(value) <= tol .or. slope == 0.0_wp) exit
+        if (step - value / slope <= 0.0_wp) exit
+        step = step - value / slope
+        call rk4_step(a, step, b)
+      end do
+    end subroutine refine
+
+    !> No step may end with a gap below zero beyond rounding, nor a sliding body past zero.
+    logical function constraints_hold(b)
+      type(state_type), intent(in) :: b
+      integer :: k, i
+      constraints_hold = .true.
+      do k = 1, n_contacts
+        if (.not. scene%has_contact(k) .or. mode%active(k)) cycle
+        if (gap(k, b) < -gap_tolerance(k, b)) constraints_hold = .false.
+      end do
+      do i = 1, 2
+        if (scene%friction(i) == 0.0_wp .or. mode%sgn(i) == 0.0_wp) cycle
+        if (mode%sgn(i) * b%v(i) < -velocity_rounding * max(abs(s%v(i)), abs(b%v(i)), &
+            abs(b%v(i) - s%v(i)))) constraints_hold = .false.
+      end do
+    end function constraints_hold
+
+    pure real(wp) function gap(k, state)
+      integer, intent(in) :: k
+      type(state_type), intent(in) :: state
+      gap = (dot_product(normal(:, k), state%x) + scene%offset(k)) + dot_product(normal(:, k), state%x_lo)
+    end function gap
+
+    !> Rounding level of gap k: from the positions it involves only, so a body near the
+    !> origin is not judged by one far away.
+    pure real(wp) function gap_tolerance(k, state)
+      integer, intent(in) :: k
+      type(state_type), intent(in) :: state
+      gap_tolerance = gap_rounding * position_scale(k, state)
+    end function gap_tolerance
+
+    pure real(wp) function position_scale(k, state)
+      integer, intent(in) :: k
+      type(state_type), intent(in) :: state
+      position_scale = max(maxval(abs(normal(:, k) * state%x)), abs(scene%offset(k)))
+    end function position_scale
+
+    !> Put a closed contact exactly on its constraint (gap = 0, no roundoff penetration).
+    subroutine snap(k, closed)
+      integer, intent(in) :: k
+      logical, intent(in) :: closed(n_contacts)
+      select case (k)
+      case (1)
+        s%x(1) = -scene%offset(1)
+        s%x_lo(1) = 0.0_wp
+      case (2)
+        s%x(2) = scene%offset(2)
+        s%x_lo(2) = 0.0_wp
+      case (3, 4)
+        ! Move the body that no wall holds.
+        if (closed(2)) then
+          s%x(1) = s%x(2) - merge(-scene%offset(3), scene%offset(4), k == 3)
+          s%x_lo(1) = s%x_lo(2)
+        else
+          s%x(2) = s%x(1) + merge(-scene%offset(3), scene%offset(4), k == 3)
+          s%x_lo(2) = s%x_lo(1)
+        end if
+      end select
+    end subroutine snap
+
+    !> Everything that happens at one instant: closed contacts snapped, impacts resolved by
+    !> sequential impulses, unresolvable bounce series put to rest (Zeno), stopped bodies
+    !> zeroed, then the new mode from the complementarity problem, and the log of what changed.
+    subroutine event_point(initial, located_body)
+      logical, intent(in) :: initial
+      integer, intent(in) :: located_body
+      logical :: closed(n_contacts), candidate(n_contacts), resting(2), found, was_moving(2)
+      real(wp) :: f(2), df(2), v_before(2), v_after(2), moving_sign(2), acc(2), tol_a(2)
+      real(wp) :: u, a_gap, flight, remaining
+      integer :: k, i, n_impulses
+      type(mode_type) :: free_mode, new_mode
+
+      f = scene%forcing%force(s%t)
+      df = scene%forcing%rate(s%t)
+      was_moving = s%v /= 0.0_wp
+      do k = 1, n_contacts
+        closed(k) = scene%has_contact(k)
+        if (closed(k)) closed(k) = gap(k, s) <= gap_tolerance(k, s)
+      end do
+      do k = 1, n_contacts
+        if (closed(k)) call snap(k, closed)
+      end do
+      ! A sliding body whose stop was located, or that stopped within rounding (its velocity
+      ! change over a step is the scale), is at rest.
+      acc = mode%acceleration(f)
+      do i = 1, 2
+        if (scene%friction(i) == 0.0_wp) cycle
+        if (i == located_body .or. abs(s%v(i)) <= velocity_rounding * abs(acc(i)) * scene%dt) s%v(i) = 0.0_wp
+      end do
+
+      n_impulses = 0
+      do
+        k = most_approaching(closed, s%v, u_tolerances())
+        if (k == 0) exit
+        n_impulses = n_impulses + 1
+        if (n_impulses > max_impulses) then
+          call raise(error, status_simulation, 'at t = ' // fmt(s%t) // ': the impacts did not settle after ' &
+            // fmt(max_impulses) // ' impulses')
+          return
+        end if
+        v_before = s%v
+        v_after = impulse(scene, k, restitution_of(scene, k, closed), s%v)
+        call apply(v_after)
+        call log_event(event_impact + k, v_before, v_after)
+      end do
+
+      ! Contacts left with a rounding-level normal velocity are closed and still.
+      do k = 1, n_contacts
+        if (.not. closed(k)) cycle
+        if (abs(normal_velocity(k, s%v)) <= u_tolerance(k) .and. normal_velocity(k, s%v) /= 0.0_wp) &
+          call apply(impulse(scene, k, 0.0_wp, s%v))
+      end do
+
+      ! Zeno: a bounce whose next flight (or whole remaining series) is below what the state
+      ! can resolve ends in rest now; the rest is logged at the series' accumulation time.
+      do k = 1, n_contacts
+        if (.not. closed(k)) cycle
+        u = normal_velocity(k, s%v)
+        if (u <= u_tolerance(k)) cycle
+        call candidates(closed, candidate, resting, moving_sign)
+        candidate(k) = .false.
+        call solve_mode(scene, f, df, candidate, resting, moving_sign, free_mode, found)
+        if (.not. found) cycle
+        acc = free_mode%acceleration(f)
+        a_gap = dot_product(normal(:, k), acc)
+        if (a_gap >= 0.0_wp) cycle
+        flight = 2.0_wp * u / (-a_gap)
+        remaining = huge(1.0_wp)
+        if (restitution_of(scene, k, closed) < 1.0_wp) remaining = flight / (1.0_wp - restitution_of(scene, k, closed))
+        if (u**2 / (-2.0_wp * a_gap) > zeno_height * position_scale(k, s) &
+            .and. remaining > time_rounding * max(abs(s%t), scene%dt)) cycle
+        call apply(impulse(scene, k, 0.0_wp, s%v))
+        in_contact(k) = .true.
+        if (remaining < huge(1.0_wp)) then
+          pending_rest(k) = s%t + remaining
+        else
+          call log_event(event_rest + k, s%v, s%v)
+        end if
+      end do
+
+      call candidates(closed, candidate, resting, moving_sign)
+      call solve_mode(scene, f, df, candidate, resting, moving_sign, new_mode, found)
+      if (.not. found) then
+        call raise(error, status_simulation, 'at t = ' // fmt(s%t) // &
+          ': no consistent contact and friction state (complementarity problem has no solution)')
+        return
+      end if
+
+      ! Log what a user can see change: contacts that start or stop holding, bodies that
+      ! come to rest or break away.
+      acc = new_mode%acceleration(f)
+      tol_a = 1.0e3_wp * eps_wp * (sum(abs(f)) + 2.0_wp * sum(scene%friction)) / scene%mass
+      do k = 1, n_contacts
+        if (new_mode%active(k) .and. .not. in_contact(k)) then
+          in_contact(k) = .true.
+          if (pending_rest(k) == huge(1.0_wp)) call log_event(event_rest + k, s%v, s%v)
+        else if (in_contact(k) .and. .not. new_mode%active(k)) then
+          if (.not. candidate(k) .or. dot_product(normal(:, k), acc) > dot_product(abs(normal(:, k)), tol_a)) then
+            if (pending_rest(k) < huge(1.0_wp)) then
+              call log_event(event_rest + k, s%v, s%v)
+              pending_rest(k) = huge(1.0_wp)
+            end if
+            in_contact(k) = .false.
+            call log_event(event_release + k, s%v, s%v)
+          end if
+        end if
+      end do
+      do i = 1, 2
+        if (s%v(i) == 0.0_wp .and. abs(acc(i)) <= tol_a(i)) then
+          if (.not. at_rest(i) .and. .not. initial .and. was_moving(i) .and. scene%friction(i) > 0.0_wp) &
+            call log_event(event_stick + i, s%v, s%v)
+          at_rest(i) = .true.
+        else
+          if (at_rest(i) .and. s%v(i) == 0.0_wp .and. scene%friction(i) > 0.0_wp) &
+            call log_event(event_slip + i, s%v, s%v)
+          at_rest(i) = .false.
+        end if
+      end do
+      mode = new_mode
+    end subroutine event_point
+
+    !> Set new velocities at an instant, booking the kinetic energy they remove as impact loss.
+    subroutine apply(v_new)
+      real(wp), intent(in) :: v_new(2)
+      s%impact_loss = s%impact_loss + kinetic_energy(scene, s%v) - kinetic_energy(scene, v_new)
+      s%v = v_new
+    end subroutine apply
+
+    !> The complementarity problem's unknowns at this instant.
+    subroutine candidates(closed, candidate, resting, moving_sign)
+      logical, intent(in) :: closed(n_contacts)
+      logical, intent(out) :: candidate(n_contacts), resting(2)
+      real(wp), intent(out) :: moving_sign(2)
+      integer :: k
+      do k = 1, n_contacts
+        candidate(k) = closed(k)
+        if (candidate(k)) candidate(k) = abs(normal_velocity(k, s%v)) <= u_tolerance(k)
+      end do
+      resting = scene%friction > 0.0_wp .and. s%v == 0.0_wp
+      moving_sign = 0.0_wp
+      where (scene%friction > 0.0_wp .and. s%v /= 0.0_wp) moving_sign = sign(1.0_wp, s%v)
+    end subroutine candidates
+
+    !> Rounding level of contact k's normal velocity: from the speeds of the bodies it
+    !> involves and what a step changes them by, so a slow body is not judged by a fast one.
+    real(wp) function u_tolerance(k)
+      integer, intent(in) :: k
+      real(wp) :: acc(2)
+      acc = mode%acceleration(scene%forcing%force(s%t))
+      u_tolerance = velocity_rounding * dot_product(abs(normal(:, k)), abs(s%v) + abs(acc) * scene%dt)
+    end function u_tolerance
+
+    function u_tolerances() result(tol)
+      real(wp) :: tol(n_contacts)
+      integer :: k
+      tol = [(u_tolerance(k), k = 1, n_contacts)]
+    end function u_tolerances
+
+    pure function ieee_finite_state(state) result(finite)
+      type(state_type), intent(in) :: state
+      logical :: finite(5)
+      finite = abs([state%x, state%v, state%work]) <= huge(1.0_wp)
+    end function ieee_finite_state
+  end subroutine run
+end module impact1d_solver
