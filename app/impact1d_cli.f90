@@ -58,10 +58,12 @@ program impact1d_cli
         method = value
       case ('-o')
         out_path = value
-      case default
-        k = findloc(['--t-end ', '--dt    ', '--dt-out'], option, dim=1)
-        overrides(k) = number(option, value)
-        overridden(k) = .true.
+      case ('--t-end')
+        call override(1)
+      case ('--dt')
+        call override(2)
+      case ('--dt-out')
+        call override(3)
       end select
     case default
       if (option(1:1) == '-' .and. len(option) > 1) call fail(status_input, 'unknown option ' // option // '; ' // usage)
@@ -115,6 +117,13 @@ contains
       '  |residual| <=', stats%max_residual, ' J'
     write(output_unit, '(a)') '  steps     ' // fmt(stats%steps) // ' RK4 steps'
   end subroutine summary
+
+  !> Option k of --t-end, --dt, --dt-out takes the value just read.
+  subroutine override(k)
+    integer, intent(in) :: k
+    overrides(k) = number(option, value)
+    overridden(k) = .true.
+  end subroutine override
 
   real(wp) function number(name, text)
     character(len=*), intent(in) :: name, text

@@ -34,13 +34,66 @@ contains
     error%message = message
   end subroutine raise
 
+  !> Shortest decimal that reads back as x (1 to 17 digits), in plain notation for
+  !> moderate magnitudes: 0.001, 2.5, 1e-12, 6.02e+23.
   pure function fmt_real(x) result(text)
     real(wp), intent(in) :: x
     character(len=:), allocatable :: text
     character(len=40) :: buffer
-    write(buffer, '(g0)') x
-    text = trim(adjustl(buffer))
+    character(len=12) :: form
+    real(wp) :: back
+    integer :: digits, ios, e
+    if (x /= x .or. abs(x) > huge(x)) then
+      write(buffer, '(g0)') x
+      text = trim(adjustl(buffer))
+      return
+    end if
+    do digits = 1, 17
+      write(form, '(a, i0, a)') '(es40.', digits - 1, 'e3)'
+      write(buffer, form) x
+      read(buffer, *, iostat=ios) back
+      if (ios == 0 .and. back == x) exit
+    end do
+    e = 0
+    if (x /= 0.0_wp) e = floor(log10(abs(x)))
+    if (e >= -4 .and. e < 15) then
+      write(form, '(a, i0, a)') '(f40.', max(digits - 1 - e, 1), ')'
+      write(buffer, form) x
+      text = trim(adjustl(buffer))
+      ! 2.50 -> 2.5, 3.0 stays 3.0
+      do while (len(text) > 2 .and. text(len(text):len(text)) == '0' .and. text(len(text) - 1:len(text) - 1) /= '.')
+        text = text(:len(text) - 1)
+      end do
+      if (text(1:1) == '.') text = '0' // text
+      if (text(1:2) == '-.') text = '-0' // text(2:)
+    else
+      text = trim(adjustl(buffer))
+      e = index(text, 'E')
+      ! 1.0E-012 -> 1e-12
+      text = strip_mantissa(text(:e - 1)) // 'e' // exponent_text(text(e + 1:))
+    end if
   end function fmt_real
+
+  pure function strip_mantissa(m) result(out)
+    character(len=*), intent(in) :: m
+    character(len=:), allocatable :: out
+    out = m
+    if (index(out, '.') == 0) return
+    do while (out(len(out):len(out)) == '0')
+      out = out(:len(out) - 1)
+    end do
+    if (out(len(out):len(out)) == '.') out = out(:len(out) - 1)
+  end function strip_mantissa
+
+  pure function exponent_text(e) result(out)
+    character(len=*), intent(in) :: e
+    character(len=:), allocatable :: out
+    integer :: value, ios
+    character(len=8) :: buffer
+    read(e, *, iostat=ios) value
+    write(buffer, '(i0)') value
+    out = trim(buffer)
+  end function exponent_text
 
   pure function fmt_int(i) result(text)
     integer, intent(in) :: i

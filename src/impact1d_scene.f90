@@ -142,7 +142,8 @@ contains
       if (input%given(i_dt_out)) then
         if (input%value(i_dt_out) < input%value(i_dt)) then
           call raise(error, status_input, 'dt_out = ' // fmt(input%value(i_dt_out)) // &
-            ' is less than dt = ' // fmt(input%value(i_dt)) // ': output cannot be finer than the step')
+            ' is less than dt = ' // fmt(input%value(i_dt)) // &
+            ': output cannot be finer than the step (set dt_out too)')
           return
         end if
       end if

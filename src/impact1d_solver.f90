@@ -389,15 +389,14 @@ contains
     subroutine event_point(initial, located_body)
       logical, intent(in) :: initial
       integer, intent(in) :: located_body
-      logical :: closed(n_contacts), candidate(n_contacts), resting(2), found, was_moving(2)
-      real(wp) :: f(2), df(2), v_before(2), v_after(2), moving_sign(2), acc(2), tol_a(2)
+      logical :: closed(n_contacts), candidate(n_contacts), resting(2), found, leaving, resting_now
+      real(wp) :: f(2), df(2), v_before(2), v_after(2), moving_sign(2), acc(2), tol_a(2), acc_rate(2)
       real(wp) :: u, a_gap, flight, remaining
       integer :: k, i, n_impulses
       type(mode_type) :: free_mode, new_mode
 
       f = scene%forcing%force(s%t)
       df = scene%forcing%rate(s%t)
-      was_moving = s%v /= 0.0_wp
       do k = 1, n_contacts
         closed(k) = scene%has_contact(k)
         if (closed(k)) closed(k) = gap(k, s) <= gap_tolerance(k, s)
@@ -490,16 +489,17 @@ contains
           end if
         end if
       end do
+      ! A body at rest leaves it when its acceleration, or at a break-away instant (force
+      ! exactly at the bound) the acceleration's rate, points along its sliding direction.
+      acc_rate = matmul(new_mode%gain, df)
       do i = 1, 2
-        if (s%v(i) == 0.0_wp .and. abs(acc(i)) <= tol_a(i)) then
-          if (.not. at_rest(i) .and. .not. initial .and. was_moving(i) .and. scene%friction(i) > 0.0_wp) &
-            call log_event(event_stick + i, s%v, s%v)
-          at_rest(i) = .true.
-        else
-          if (at_rest(i) .and. s%v(i) == 0.0_wp .and. scene%friction(i) > 0.0_wp) &
-            call log_event(event_slip + i, s%v, s%v)
-          at_rest(i) = .false.
-        end if
+        if (scene%friction(i) == 0.0_wp) cycle
+        leaving = new_mode%sgn(i) * acc(i) > tol_a(i) .or. (new_mode%sgn(i) * acc(i) >= -tol_a(i) .and. &
+          new_mode%sgn(i) * acc_rate(i) > 1.0e3_wp * eps_wp * sum(abs(df)) / scene%mass(i))
+        resting_now = s%v(i) == 0.0_wp .and. .not. leaving
+        if (resting_now .and. .not. at_rest(i) .and. .not. initial) call log_event(event_stick + i, s%v, s%v)
+        if (.not. resting_now .and. at_rest(i) .and. s%v(i) == 0.0_wp) call log_event(event_slip + i, s%v, s%v)
+        at_rest(i) = resting_now
       end do
       mode = new_mode
     end subroutine event_point
