@@ -1,0 +1,90 @@
+# The README's commands. Every target sets itself up from a fresh Debian
+# machine: gfortran (apt, only when missing), a venv in .venv, the package.
+SHELL := /bin/bash
+.SHELLFLAGS := -euo pipefail -c
+.DEFAULT_GOAL := help
+.DELETE_ON_ERROR:
+
+PYTHON ?= python3
+VENV   := .venv
+BIN    := $(CURDIR)/$(VENV)/bin
+# meson-python runs `meson` from PATH: the venv's bin must come first.
+export PATH := $(BIN):$(PATH)
+export DEBIAN_FRONTEND := noninteractive
+# No display on CI or a server.
+export MPLBACKEND ?= Agg
+
+# Persistent meson build dir shared by `pip install` and `meson test`: one
+# compile serves the wheel and the Fortran unit tests, and re-runs are no-ops.
+BUILDDIR := $(CURDIR)/build/py
+CASES    := 1 2 3 4 5 6
+
+# What the installed package is made of: a change re-installs it (folders too,
+# so that a deleted file counts).
+PKG_SOURCES := $(shell find src app wrapper -not -path '*/__pycache__*' 2>/dev/null) \
+               meson.build pyproject.toml .f2py_f2cmap
+
+DEPS_STAMP    := $(VENV)/.build-deps
+INSTALL_STAMP := $(VENV)/.installed
+
+.PHONY: help setup demo test clean gfortran
+
+help:
+	@echo "make setup   gfortran (apt, if missing), .venv, pip install .[test]"
+	@echo "make demo    run input/case1..6.nml with the impact1d CLI and plot them"
+	@echo "make test    Fortran unit tests (meson test), then pytest"
+	@echo "make clean   remove .venv, build/ and output files"
+
+setup: gfortran $(INSTALL_STAMP)
+
+# apt-get only when gfortran is missing; sudo only when not root and present.
+gfortran:
+	@if ! command -v gfortran >/dev/null 2>&1; then \
+	  if [ "$$(id -u)" -eq 0 ]; then SUDO=""; \
+	  elif command -v sudo >/dev/null 2>&1; then SUDO="sudo -E"; \
+	  else echo "error: gfortran is missing and we are not root (no sudo): install gfortran" >&2; exit 1; fi; \
+	  echo "installing gfortran with apt-get"; \
+	  $$SUDO apt-get update -q; \
+	  $$SUDO apt-get install -y -q gfortran; \
+	fi
+	@gfortran --version | head -n 1
+
+$(BIN)/python:
+	@if ! $(PYTHON) -m venv $(VENV); then \
+	  echo "python3 -m venv failed: installing python3-venv with apt-get" >&2; \
+	  rm -rf $(VENV); \
+	  if [ "$$(id -u)" -eq 0 ]; then SUDO=""; else SUDO="sudo -E"; fi; \
+	  $$SUDO apt-get update -q && $$SUDO apt-get install -y -q python3-venv python3-dev; \
+	  $(PYTHON) -m venv $(VENV); \
+	fi
+
+# Build requirements for --no-build-isolation (meson-python needs them in the env).
+$(DEPS_STAMP): $(BIN)/python
+	$(BIN)/python -m pip install -q meson-python meson ninja numpy
+	@touch $@
+
+# Regular (not editable) install: it is what puts the `impact1d` executable
+# on PATH. A missing build dir also forces it (meson test runs there).
+$(INSTALL_STAMP): $(DEPS_STAMP) $(PKG_SOURCES) $(BUILDDIR)/build.ninja
+	$(BIN)/python -m pip install -q --no-build-isolation \
+	    -Cbuild-dir=$(BUILDDIR) '.[test]'
+	@touch $@
+
+$(BUILDDIR)/build.ninja: ;
+
+demo: setup
+	@mkdir -p output
+	@for n in $(CASES); do \
+	  echo "== case$$n"; \
+	  impact1d input/case$$n.nml; \
+	  impact1d-plot output/case$$n.dat; \
+	done
+
+test: setup
+	meson test -C $(BUILDDIR) --print-errorlogs
+	$(BIN)/python -m pytest -q tests
+
+clean:
+	rm -rf $(VENV) build .pytest_cache .hypothesis
+	find . -name __pycache__ -type d -prune -exec rm -rf {} +
+	find output -mindepth 1 ! -name README.md -delete 2>/dev/null || true
