@@ -1,0 +1,68 @@
+!> Event location: the earliest root of a cubic on a step, including two roots inside one
+!> step (a fast bounce) and a graze that must not count.
+program test_events
+  use impact1d_kinds, only: wp
+  use impact1d_events, only: earliest_crossing, hermite, poly_value
+  implicit none
+  ! Roots of these cubics are known to the last bit; bisection should land within a few ulps.
+  real(wp), parameter :: root_tol = 1.0e-14_wp
+  integer :: failures = 0
+  real(wp) :: theta, c(3)
+
+  ! g = (theta - 0.2)(theta - 0.6)(theta + 1): positive, dips below zero on (0.2, 0.6), back up.
+  theta = earliest_crossing(expand(0.2_wp, 0.6_wp, -1.0_wp), 1.0_wp, 1.0e-15_wp)
+  call check(abs(theta - 0.2_wp) < root_tol, 'two roots in one step: the first one is found')
+
+  ! The same dip entirely inside a step whose ends are both positive.
+  theta = earliest_crossing(expand(0.3_wp, 0.31_wp, -1.0_wp), 1.0_wp, 1.0e-15_wp)
+  call check(abs(theta - 0.3_wp) < root_tol, 'a dip between positive ends is not missed')
+
+  ! A graze: (theta - 0.5)^2 touches zero but never goes below: no event.
+  theta = earliest_crossing([0.25_wp, -1.0_wp, 1.0_wp, 0.0_wp], 1.0_wp, 1.0e-15_wp)
+  call check(theta > 1.0_wp, 'a graze with zero approach speed is not an event')
+
+  ! A gap at zero that opens (just after an impact): the root at 0 is not an event.
+  theta = earliest_crossing([0.0_wp, 1.0_wp, -0.5_wp, 0.0_wp], 1.0_wp, 1.0e-15_wp)
+  call check(theta > 1.0_wp, 'an opening gap at zero is not an event')
+  ! ... but it closes again at theta = 2 in a longer step.
+  theta = earliest_crossing([0.0_wp, 1.0_wp, -0.5_wp, 0.0_wp], 3.0_wp, 1.0e-15_wp)
+  call check(abs(theta - 2.0_wp) < root_tol, 'an opening gap closes again later in the step')
+
+  ! No root at all, far from zero: the cheap rejection.
+  theta = earliest_crossing([5.0_wp, -1.0_wp, 0.0_wp, 0.0_wp], 1.0_wp, 1.0e-15_wp)
+  call check(theta > 1.0_wp, 'no root when the gap stays positive')
+
+  ! Hermite dense output reproduces a cubic motion exactly: x = 2 t - 3 t^2 + 0.5 t^3 on [0, 0.7].
+  c = hermite(motion(0.7_wp), velocity(0.0_wp), velocity(0.7_wp), 0.7_wp)
+  call check(all(abs(c - [2.0_wp, -3.0_wp, 0.5_wp]) < 1.0e-13_wp), 'Hermite is exact for a cubic')
+
+  if (failures > 0) error stop 1
+  print '(a)', 'test_events: all passed'
+
+contains
+
+  !> Coefficients of (theta - r1)(theta - r2)(theta - r3), lowest order first.
+  function expand(r1, r2, r3) result(p)
+    real(wp), intent(in) :: r1, r2, r3
+    real(wp) :: p(0:3)
+    p = [-r1 * r2 * r3, r1 * r2 + r1 * r3 + r2 * r3, -(r1 + r2 + r3), 1.0_wp]
+  end function expand
+
+  real(wp) function motion(t)
+    real(wp), intent(in) :: t
+    motion = 2.0_wp * t - 3.0_wp * t**2 + 0.5_wp * t**3
+  end function motion
+
+  real(wp) function velocity(t)
+    real(wp), intent(in) :: t
+    velocity = 2.0_wp - 6.0_wp * t + 1.5_wp * t**2
+  end function velocity
+
+  subroutine check(condition, what)
+    logical, intent(in) :: condition
+    character(len=*), intent(in) :: what
+    if (condition) return
+    failures = failures + 1
+    print '(a)', 'FAILED: ' // what
+  end subroutine check
+end program test_events
