@@ -1,0 +1,236 @@
+"""The Python API: Scene, load_scene, simulate, Result, errors (DESIGN.md, API contract)."""
+
+import dataclasses
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import impact1d
+from impact1d import InputError, SimulationError
+
+ROOT = Path(__file__).resolve().parents[1]
+INPUT = ROOT / "input"
+
+# Free flight is exact to rounding (x = x0 + v t over 2000 steps of 0.01 s).
+FREE_FLIGHT_TOL = 1e-12
+
+CASE3_NML = """\
+&scene   title = 'api test scene' /
+&bodies  m1 = 1.0, m2 = 2.0, mu1 = 0.0, mu2 = 0.0, g = 10.0 /
+&walls   x_left = 0.0, r_left = 1.0, x_right = 10.0, r_right = 1.0 /
+&link    d_min = 1.0, r_min = 1.0, d_max = 2.0, r_max = 1.0 /
+&initial x1 = 1.0, v1 = -9.0, x2 = 2.5, v2 = 1.0 /
+&forces  f1 = 0.0, f2 = 0.0 /
+&run     t_end = 0.5, dt = 1.0e-3, dt_out = 1.0e-2 /
+"""
+
+
+def write_scene(tmp_path, text, name="scene.nml"):
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+# --- package surface -----------------------------------------------------------
+
+def test_public_names():
+    for name in ("Scene", "Result", "InputError", "SimulationError", "load_scene",
+                 "simulate", "read_output"):
+        assert name in impact1d.__all__
+        assert hasattr(impact1d, name)
+    assert issubclass(InputError, ValueError)
+    assert issubclass(SimulationError, RuntimeError)
+
+
+def test_import_does_not_load_matplotlib():
+    code = "import sys, impact1d; assert 'matplotlib' not in sys.modules, 'matplotlib loaded'"
+    subprocess.run([sys.executable, "-c", code], check=True, cwd=ROOT)
+
+
+def test_plot_is_reexported_lazily():
+    code = ("import sys, impact1d\n"
+            "assert 'impact1d.plot' not in sys.modules\n"
+            "from impact1d import plot\n"
+            "assert plot.__name__ == 'impact1d.plot'\n"
+            "assert impact1d.plot is plot\n")
+    subprocess.run([sys.executable, "-c", code], check=True, cwd=ROOT,
+                   env={**__import__("os").environ, "MPLBACKEND": "Agg"})
+
+
+def test_scene_fields_follow_the_core():
+    reals, texts = impact1d._scene._api.field_names()
+    names = [f.name for f in dataclasses.fields(impact1d.Scene)]
+    assert names == (impact1d._scene.decode(reals).split()
+                     + impact1d._scene.decode(texts).split() + ["source"])
+    assert len(impact1d._scene.REAL_FIELDS) == 28
+
+
+# --- load_scene ------------------------------------------------------------------
+
+def test_load_scene_case3():
+    path = INPUT / "case3.nml"
+    scene = impact1d.load_scene(path)
+    assert isinstance(scene, impact1d.Scene)
+    assert scene.title == "Test case 3: conservation of energy"
+    assert scene.source == str(path)
+    assert (scene.m1, scene.m2, scene.mu1, scene.mu2, scene.g) == (1.0, 2.0, 0.0, 0.0, 10.0)
+    assert (scene.x_left, scene.x_right, scene.d_min, scene.d_max) == (0.0, 10.0, 1.0, 2.0)
+    assert (scene.x1, scene.v1, scene.x2, scene.v2) == (1.0, -9.0, 2.5, 1.0)
+    assert (scene.t_end, scene.dt, scene.dt_out, scene.method) == (6.0, 1e-3, 1e-3, "event")
+    for absent in ("f1_amp", "f1_period", "f1_phase", "f2_amp", "f2_period", "f2_phase",
+                   "f1_table", "f2_table"):
+        assert getattr(scene, absent) is None, absent
+
+
+def test_load_scene_resolves_table_path():
+    scene = impact1d.load_scene(INPUT / "case6.nml")
+    assert scene.f1 == 0.0
+    assert Path(scene.f1_table).samefile(INPUT / "triangle.dat")
+    assert scene.f2_table is None
+
+
+def test_absent_variables_are_none(tmp_path):
+    path = write_scene(tmp_path, "&bodies m1 = 1.0, m2 = 2.0 /\n"
+                                 "&initial x1 = 1.0, x2 = 2.0 /\n"
+                                 "&run t_end = 1.0, dt = 0.01 /\n")
+    scene = impact1d.load_scene(path)
+    assert (scene.m1, scene.m2, scene.x1, scene.x2, scene.t_end, scene.dt) == \
+        (1.0, 2.0, 1.0, 2.0, 1.0, 0.01)
+    for name in ("mu1", "g", "x_left", "r_left", "x_right", "d_min", "d_max", "v1", "f1",
+                 "dt_out", "title", "method", "f1_table"):
+        assert getattr(scene, name) is None, name
+
+
+# --- simulate and Result -----------------------------------------------------------
+
+def test_result_arrays_and_scene():
+    scene = impact1d.load_scene(INPUT / "case3.nml")
+    res = impact1d.simulate(scene, t_end=0.5, dt_out=0.01)
+    n = 51
+    for name in impact1d.COLUMNS:
+        column = getattr(res, name)
+        assert isinstance(column, np.ndarray) and column.dtype == np.float64, name
+        assert column.shape == (n,), name
+    assert res.samples.shape == (n, 10)
+    assert res.events.dtype == np.dtype([("t", "f8"), ("kind", "U20"), ("v1_before", "f8"),
+                                         ("v2_before", "f8"), ("v1_after", "f8"),
+                                         ("v2_after", "f8")])
+    assert list(res.events["kind"][:4]) == ["slot_max", "slot_min", "slot_max", "slot_min"]
+    assert isinstance(res.steps, int) and res.steps >= 500
+    assert isinstance(res.energy_residual, float)
+    # The result carries the scene after the overrides; the caller's scene is untouched.
+    assert (res.scene.t_end, res.scene.dt_out, res.scene.dt) == (0.5, 0.01, 1e-3)
+    assert (scene.t_end, scene.dt_out) == (6.0, 1e-3)
+
+
+def test_results_do_not_share_storage():
+    """The core keeps one run in module storage: a Result must own copies."""
+    scene = impact1d.load_scene(INPUT / "case3.nml")
+    first = impact1d.simulate(scene, t_end=0.5)
+    x1, kinds = first.x1.copy(), first.events.copy()
+    impact1d.simulate(impact1d.load_scene(INPUT / "case5.nml"), t_end=0.5)
+    assert np.array_equal(first.x1, x1)
+    assert np.array_equal(first.events, kinds)
+
+
+def test_scene_built_in_python_free_flight():
+    """No constraints named: no walls and no slot; the bodies fly through each other."""
+    scene = impact1d.Scene(m1=1.0, m2=2.0, x1=0.0, v1=1.0, x2=5.0, v2=-0.5,
+                           t_end=20.0, dt=0.01, dt_out=0.5)
+    res = impact1d.simulate(scene)
+    assert res.t[-1] == pytest.approx(20.0, abs=FREE_FLIGHT_TOL)
+    np.testing.assert_allclose(res.x1, res.t, rtol=0, atol=FREE_FLIGHT_TOL)
+    np.testing.assert_allclose(res.x2, 5.0 - 0.5 * res.t, rtol=0, atol=FREE_FLIGHT_TOL)
+    assert len(res.events) == 0
+    np.testing.assert_allclose(res.ke, 0.5 + 0.25, rtol=0, atol=FREE_FLIGHT_TOL)
+
+
+def test_override_makes_field_absent():
+    """None as an override removes a component: without the left wall m1 flies on."""
+    scene = impact1d.load_scene(INPUT / "case5.nml")
+    res = impact1d.simulate(scene, x_left=None, r_left=None, t_end=1.5)
+    assert "left" not in set(res.events["kind"])
+    # x1 = 1 - t^2 with no wall.
+    np.testing.assert_allclose(res.x1, 1.0 - res.t**2, rtol=0, atol=1e-9)
+
+
+# --- errors ---------------------------------------------------------------------
+
+def test_unknown_override_names_it():
+    scene = impact1d.load_scene(INPUT / "case3.nml")
+    with pytest.raises(InputError, match="t_stop"):
+        impact1d.simulate(scene, t_stop=1.0)
+
+
+def test_override_of_wrong_type_names_it():
+    scene = impact1d.load_scene(INPUT / "case3.nml")
+    with pytest.raises(InputError, match="m1"):
+        impact1d.simulate(scene, m1="heavy")
+
+
+def test_simulate_needs_a_scene():
+    with pytest.raises(InputError):
+        impact1d.simulate({"m1": 1.0})
+
+
+def test_missing_file_names_it(tmp_path):
+    missing = tmp_path / "no_such_scene.nml"
+    with pytest.raises(InputError, match="no_such_scene.nml"):
+        impact1d.load_scene(missing)
+
+
+@pytest.mark.parametrize("m1", ["0.0", "-1.0"])
+def test_nonpositive_mass_in_file_names_it(tmp_path, m1):
+    path = write_scene(tmp_path, CASE3_NML.replace("m1 = 1.0", f"m1 = {m1}"))
+    with pytest.raises(InputError, match="m1"):
+        impact1d.simulate(impact1d.load_scene(path))
+
+
+@pytest.mark.parametrize("m1", [0.0, -1.0])
+def test_nonpositive_mass_override_names_it(m1):
+    scene = impact1d.load_scene(INPUT / "case3.nml")
+    with pytest.raises(InputError, match="m1"):
+        impact1d.simulate(scene, m1=m1)
+
+
+def test_unknown_namelist_variable_names_it(tmp_path):
+    path = write_scene(tmp_path, CASE3_NML.replace("m2 = 2.0,", "m2 = 2.0, mass3 = 4.0,"))
+    with pytest.raises(InputError, match="mass3"):
+        impact1d.simulate(impact1d.load_scene(path))
+
+
+def test_missing_t_end_in_file_names_it(tmp_path):
+    path = write_scene(tmp_path, CASE3_NML.replace("t_end = 0.5, ", ""))
+    with pytest.raises(InputError, match="t_end"):
+        impact1d.simulate(impact1d.load_scene(path))
+
+
+def test_dat_file_needs_t_end():
+    """A VisSim .dat file has no run settings: t_end must come as an override."""
+    scene = impact1d.load_scene(INPUT / "input3.dat")
+    with pytest.raises(InputError, match="t_end"):
+        impact1d.simulate(scene, dt=1e-3)
+
+
+@pytest.mark.parametrize("name", ["m1", "m2", "x1", "x2", "t_end", "dt"])
+def test_missing_required_field_names_it(name):
+    scene = impact1d.load_scene(INPUT / "case3.nml")
+    with pytest.raises(InputError, match=name):
+        impact1d.simulate(scene, **{name: None})
+
+
+def test_unknown_method_names_it():
+    scene = impact1d.load_scene(INPUT / "case3.nml")
+    with pytest.raises(InputError, match="method"):
+        impact1d.simulate(scene, method="leapfrog")
+
+
+def test_bad_dat_file(tmp_path):
+    lines = (INPUT / "input3.dat").read_text().splitlines()
+    short = [line for line in lines if not line.startswith("#")][:10]
+    path = write_scene(tmp_path, "\n".join(short) + "\n", name="short.dat")
+    with pytest.raises(InputError):
+        impact1d.simulate(impact1d.load_scene(path), t_end=1.0, dt=1e-3)

@@ -1,0 +1,84 @@
+"""read_output(): load a CLI output file (and its events file) back into a Result."""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+
+from ._scene import REAL_FIELDS, TEXT_FIELDS, Scene, InputError
+from ._simulate import COLUMNS, EVENT_DTYPE, Result, result_from_columns
+
+__all__ = ["read_output", "events_path"]
+
+
+def events_path(path) -> str:
+    """The events file that goes with an output file: OUT minus .dat plus .events.dat."""
+    path = os.fspath(path)
+    stem = path[:-4] if path.endswith(".dat") else path
+    return stem + ".events.dat"
+
+
+def _read_header(path):
+    """The '# name = value' lines before the data, and the last comment line."""
+    fields, last = {}, None
+    with open(path, encoding="utf-8") as handle:
+        for line in handle:
+            if not line.startswith("#"):
+                if line.strip():
+                    break
+                continue
+            text = line[1:].strip()
+            last = text
+            name, sep, value = text.partition("=")
+            if sep:
+                fields[name.strip()] = value.strip()
+    return fields, last
+
+
+def _read_events(path) -> np.ndarray:
+    rows = []
+    with open(path, encoding="utf-8") as handle:
+        for number, line in enumerate(handle, 1):
+            text = line.split("#", 1)[0].split()
+            if not text:
+                continue
+            if len(text) != 6:
+                raise InputError(f"{path}:{number}: expected 6 entries "
+                                 "(t kind v1_before v2_before v1_after v2_after)")
+            t, kind, *velocities = text
+            rows.append((float(t), kind, *map(float, velocities)))
+    return np.array(rows, dtype=EVENT_DTYPE)
+
+
+def read_output(path) -> Result:
+    """Load `impact1d` CLI output: the samples of OUT.dat, the events of OUT.events.dat
+    when it exists, and the scene recorded in the header (`source` = the scene file).
+    `steps` is None (the file does not record it); energy_residual is max |residual|."""
+    path = os.fspath(path)
+    if not os.path.isfile(path):
+        raise InputError(f"cannot open output file '{path}': no such file")
+    header, columns = _read_header(path)
+    if columns is None or tuple(columns.split()) != COLUMNS:
+        raise InputError(f"{path}: the last header line must name the columns "
+                         f"'{' '.join(COLUMNS)}', got {columns!r}")
+    samples = np.loadtxt(path, comments="#", ndmin=2)
+    if samples.size == 0:
+        samples = np.empty((0, len(COLUMNS)))
+
+    kwargs = {}
+    for name in REAL_FIELDS:
+        if name in header:
+            kwargs[name] = float(header[name])
+    for name in TEXT_FIELDS:
+        if name in header:
+            kwargs[name] = header[name]
+    scene = Scene(**kwargs, source=header.get("scene"))
+
+    events_file = events_path(path)
+    events = (_read_events(events_file) if os.path.isfile(events_file)
+              else np.empty(0, dtype=EVENT_DTYPE))
+    residual = samples[:, COLUMNS.index("residual")]
+    energy_residual = float(np.max(np.abs(residual))) if residual.size else 0.0
+    return result_from_columns(samples, events, energy_residual=energy_residual,
+                               steps=None, scene=scene)

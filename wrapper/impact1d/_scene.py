@@ -1,0 +1,172 @@
+"""The Scene dataclass, the package's exceptions and the glue to the Fortran reader.
+
+One parser and one validator, both in Fortran (impact1d._core): this module only
+moves values between a Scene and the flat arrays of the api layer.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+from dataclasses import dataclass
+from typing import Optional
+
+import numpy as np
+
+from . import _core
+
+# f2py wraps the routines of the Fortran module impact1d_api as _core.impact1d_api.
+_api = getattr(_core, "impact1d_api", _core)
+
+__all__ = ["Scene", "InputError", "SimulationError", "load_scene",
+           "REAL_FIELDS", "TEXT_FIELDS"]
+
+
+class InputError(ValueError):
+    """A scene or an argument is invalid (api status 1)."""
+
+
+class SimulationError(RuntimeError):
+    """A run could not go on (api status 2)."""
+
+
+# Length of the api's fixed text buffers (character(len=1024) in impact1d_api).
+TEXT_LEN = 1024
+
+# The api's field order, written out so that the dataclass below is static and
+# readable; checked against _api.field_names() at import (one source of truth).
+REAL_FIELDS = (
+    "m1", "m2", "mu1", "mu2", "g",
+    "x_left", "r_left", "x_right", "r_right",
+    "d_min", "r_min", "d_max", "r_max",
+    "x1", "v1", "x2", "v2",
+    "f1", "f2", "f1_amp", "f1_period", "f1_phase", "f2_amp", "f2_period", "f2_phase",
+    "t_end", "dt", "dt_out",
+)
+TEXT_FIELDS = ("title", "f1_table", "f2_table", "method")
+
+
+@dataclass
+class Scene:
+    """A scene: fields named as the namelist variables; None means absent.
+
+    Absent constraints do not exist; absent optional values take the engine's
+    defaults (DESIGN.md).  `source` is the file the scene came from (for titles).
+    Table paths from load_scene are already resolved against the scene's folder.
+    """
+
+    m1: Optional[float] = None
+    m2: Optional[float] = None
+    mu1: Optional[float] = None
+    mu2: Optional[float] = None
+    g: Optional[float] = None
+    x_left: Optional[float] = None
+    r_left: Optional[float] = None
+    x_right: Optional[float] = None
+    r_right: Optional[float] = None
+    d_min: Optional[float] = None
+    r_min: Optional[float] = None
+    d_max: Optional[float] = None
+    r_max: Optional[float] = None
+    x1: Optional[float] = None
+    v1: Optional[float] = None
+    x2: Optional[float] = None
+    v2: Optional[float] = None
+    f1: Optional[float] = None
+    f2: Optional[float] = None
+    f1_amp: Optional[float] = None
+    f1_period: Optional[float] = None
+    f1_phase: Optional[float] = None
+    f2_amp: Optional[float] = None
+    f2_period: Optional[float] = None
+    f2_phase: Optional[float] = None
+    t_end: Optional[float] = None
+    dt: Optional[float] = None
+    dt_out: Optional[float] = None
+    title: Optional[str] = None
+    f1_table: Optional[str] = None
+    f2_table: Optional[str] = None
+    method: Optional[str] = None
+    source: Optional[str] = None
+
+
+def decode(text) -> str:
+    """Fortran text from f2py (bytes, numpy bytes or a char array) -> stripped str."""
+    if isinstance(text, np.ndarray):
+        text = text.tobytes()
+    if isinstance(text, (bytes, np.bytes_)):
+        text = bytes(text).decode("utf-8", errors="replace")
+    return str(text).replace("\x00", " ").strip()
+
+
+def _words(text) -> tuple:
+    return tuple(decode(text).split())
+
+
+def _check_field_order() -> None:
+    reals, texts = _api.field_names()
+    if _words(reals) != REAL_FIELDS or _words(texts) != TEXT_FIELDS:
+        raise ImportError(
+            "impact1d._core field names do not match impact1d.Scene: "
+            f"core has {_words(reals)} / {_words(texts)}")
+
+
+_check_field_order()
+_SCENE_FIELDS = tuple(f.name for f in dataclasses.fields(Scene))
+assert _SCENE_FIELDS == REAL_FIELDS + TEXT_FIELDS + ("source",)
+
+
+def _fortran_text(value) -> str:
+    # Blank-padded to the buffer length: Fortran's len_trim ignores blanks, not NULs.
+    text = "" if value is None else str(value)
+    if len(text) > TEXT_LEN:
+        raise InputError(f"text longer than {TEXT_LEN} characters: {text[:60]}...")
+    return text.ljust(TEXT_LEN)
+
+
+def to_core(scene: Scene):
+    """Scene -> (values, given, title, f1_table, f2_table, method) for the api."""
+    values = np.zeros(len(REAL_FIELDS), dtype=np.float64)
+    given = np.zeros(len(REAL_FIELDS), dtype=np.int32)
+    for i, name in enumerate(REAL_FIELDS):
+        value = getattr(scene, name)
+        if value is None:
+            continue
+        try:
+            values[i] = float(value)
+        except (TypeError, ValueError):
+            raise InputError(f"{name} must be a number, got {value!r}") from None
+        given[i] = 1
+    texts = []
+    for name in TEXT_FIELDS:
+        value = getattr(scene, name)
+        if value is not None and not isinstance(value, (str, os.PathLike)):
+            raise InputError(f"{name} must be text, got {value!r}")
+        texts.append(_fortran_text(None if value is None else os.fspath(value)))
+    return (values, given, *texts)
+
+
+def raise_for_status(status, message) -> None:
+    """Turn an api status and message into the package's exceptions."""
+    status = int(status)
+    if status == 0:
+        return
+    text = decode(message) or f"impact1d core returned status {status}"
+    if status == 1:
+        raise InputError(text)
+    raise SimulationError(text)
+
+
+def load_scene(path) -> Scene:
+    """Read a scene file: a namelist (.nml, or any other name) or a VisSim .dat file."""
+    path = os.fspath(path)
+    if not os.path.isfile(path):
+        raise InputError(f"cannot open scene file '{path}': no such file")
+    (values, given, title, f1_table, f2_table, method,
+     status, message) = _api.read_scene(path, len(REAL_FIELDS))
+    raise_for_status(status, message)
+    kwargs = {name: (float(values[i]) if given[i] else None)
+              for i, name in enumerate(REAL_FIELDS)}
+    for name, text in zip(TEXT_FIELDS, (title, f1_table, f2_table, method)):
+        kwargs[name] = decode(text) or None
+    return Scene(**kwargs, source=path)

@@ -1,0 +1,111 @@
+"""simulate(): run a Scene in the Fortran engine and collect its output as numpy arrays."""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+from functools import lru_cache
+from typing import Optional
+
+import numpy as np
+
+from ._scene import Scene, InputError, raise_for_status, to_core, _words, _api
+
+__all__ = ["Result", "simulate", "COLUMNS", "EVENT_DTYPE"]
+
+# The sample columns of the api (and of the CLI output), checked against the core below.
+COLUMNS = ("t", "x1", "v1", "x2", "v2", "ke", "work", "friction_loss",
+           "impact_loss", "residual")
+
+# Longest event kind is "release_slot_min" (16 characters).
+EVENT_DTYPE = np.dtype([("t", "f8"), ("kind", "U20"), ("v1_before", "f8"),
+                        ("v2_before", "f8"), ("v1_after", "f8"), ("v2_after", "f8")])
+
+if _words(_api.column_names()) != COLUMNS:
+    raise ImportError("impact1d._core sample columns do not match impact1d.COLUMNS: "
+                      f"core has {_words(_api.column_names())}")
+
+_OVERRIDABLE = tuple(f.name for f in dataclasses.fields(Scene))
+
+
+@lru_cache(maxsize=None)
+def event_kinds() -> tuple:
+    """Event kind words; the core's code k is the k-th word (1-based)."""
+    return _words(_api.event_kind_names())
+
+
+def _empty():
+    return np.empty(0, dtype=np.float64)
+
+
+@dataclass
+class Result:
+    """One run: the samples as float64 arrays (one entry per output time), the event
+    log, the run's accuracy monitor and the scene actually run."""
+
+    t: np.ndarray = field(default_factory=_empty)
+    x1: np.ndarray = field(default_factory=_empty)
+    v1: np.ndarray = field(default_factory=_empty)
+    x2: np.ndarray = field(default_factory=_empty)
+    v2: np.ndarray = field(default_factory=_empty)
+    ke: np.ndarray = field(default_factory=_empty)
+    work: np.ndarray = field(default_factory=_empty)
+    friction_loss: np.ndarray = field(default_factory=_empty)
+    impact_loss: np.ndarray = field(default_factory=_empty)
+    residual: np.ndarray = field(default_factory=_empty)
+    events: np.ndarray = field(default_factory=lambda: np.empty(0, dtype=EVENT_DTYPE))
+    energy_residual: float = 0.0       # max |residual| over the samples
+    steps: Optional[int] = None        # integrator steps taken (None: read from a file)
+    scene: Optional[Scene] = None
+
+    @property
+    def samples(self) -> np.ndarray:
+        """All sample columns as one (n, 10) array, in COLUMNS order."""
+        return np.column_stack([getattr(self, name) for name in COLUMNS])
+
+    def __repr__(self) -> str:
+        title = self.scene.title if self.scene is not None else None
+        return (f"Result({title!r}: {len(self.t)} samples, {len(self.events)} events, "
+                f"steps={self.steps}, energy_residual={self.energy_residual:.3g})")
+
+
+def result_from_columns(samples: np.ndarray, events: np.ndarray, **extra) -> Result:
+    """Build a Result from an (n, 10) sample array in COLUMNS order."""
+    samples = np.asarray(samples, dtype=np.float64).reshape(-1, len(COLUMNS))
+    columns = {name: np.ascontiguousarray(samples[:, i]) for i, name in enumerate(COLUMNS)}
+    return Result(**columns, events=events, **extra)
+
+
+def simulate(scene: Scene, **overrides) -> Result:
+    """Run `scene` with keyword overrides of any Scene field (typically dt, t_end,
+    dt_out, method; None makes a field absent).  Raises InputError for a bad scene
+    and SimulationError for a run that cannot go on."""
+    if not isinstance(scene, Scene):
+        raise InputError(f"simulate() needs an impact1d.Scene, got {type(scene).__name__}")
+    unknown = [name for name in overrides if name not in _OVERRIDABLE]
+    if unknown:
+        raise InputError(f"unknown scene field(s) in overrides: {', '.join(unknown)} "
+                         f"(known: {', '.join(_OVERRIDABLE)})")
+    scene = dataclasses.replace(scene, **overrides)
+    values, given, title, f1_table, f2_table, method = to_core(scene)
+
+    (n_samples, n_events, steps, energy_residual,
+     status, message) = _api.simulate(values, given, title, f1_table, f2_table, method)
+    raise_for_status(status, message)
+
+    n_samples, n_events = int(n_samples), int(n_events)
+    if n_samples > 0:
+        samples = _api.get_samples(n_samples, len(COLUMNS))
+    else:
+        samples = np.empty((0, len(COLUMNS)))
+    events = np.empty(n_events, dtype=EVENT_DTYPE)
+    if n_events > 0:
+        t, kind, v1b, v2b, v1a, v2a = _api.get_events(n_events)
+        names = event_kinds()
+        events["t"] = t
+        events["kind"] = [names[k - 1] if 1 <= k <= len(names) else f"unknown_{k}"
+                          for k in np.asarray(kind).tolist()]
+        events["v1_before"], events["v2_before"] = v1b, v2b
+        events["v1_after"], events["v2_after"] = v1a, v2a
+    return result_from_columns(samples, events, energy_residual=float(energy_residual),
+                               steps=int(steps), scene=scene)

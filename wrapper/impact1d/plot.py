@@ -1,0 +1,475 @@
+"""Plots of one impact1d run: positions, velocities, kinetic energy, impacts, energy ledger.
+
+The panels follow the VisSim tutorial's result figures (positions: Figures 19
+and 21; kinetic energy: Figures 20 and 22; impact indicator: Figure 23) and add
+the energy ledger that every run reports.
+
+A *result* is anything with the attributes of :class:`impact1d.Result`:
+``t x1 v1 x2 v2 ke work friction_loss impact_loss residual`` (1-D arrays),
+``events`` (structured array with fields ``t kind v1_before v2_before v1_after
+v2_after``, or None) and ``scene`` (an object with the scene's fields, absent
+ones None or missing; may itself be None).  Both ``impact1d.simulate`` and
+``impact1d.read_output`` return such objects.
+
+Only the object API of matplotlib is used (``matplotlib.figure.Figure``), so
+this module never touches pyplot's global state or picks a backend:
+``save`` renders PNGs through Agg on any machine.
+
+Artists carry a ``gid`` so tests and scripts can find them: lines ``x1 x2 v1 v2
+ke work friction_loss impact_loss ke_change residual``, walls ``wall:left``,
+``wall:right``, the slot band ``slot_band`` (or ``slot:min``/``slot:max`` when
+only one limit exists), impact markers on the position panel
+``impact:<contact>``, impact ticks ``tick:<contact>`` and persistent-contact
+bars ``rest:<contact>`` on the impact panel, friction events ``stick1`` etc. on
+the velocity panel.  Axes are labelled (``Axes.get_label()``) ``positions
+velocities kinetic_energy impacts ledger residual``.
+"""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+from matplotlib.figure import Figure
+from matplotlib.ticker import ScalarFormatter
+
+__all__ = ["figure", "save", "PANELS", "CONTACTS"]
+
+#: Panel names, in drawing order; ``save(..., separate=True)`` appends them to the file stem.
+PANELS = ("positions", "velocities", "kinetic_energy", "impacts", "energy")
+
+#: The four unilateral constraints, in the order of the impact panel's rows (top to bottom).
+CONTACTS = ("left", "right", "slot_min", "slot_max")
+
+_CONTACT_LABEL = {
+    "left": "left wall",
+    "right": "right wall",
+    "slot_min": "slot min",
+    "slot_max": "slot max",
+}
+# Colours: bodies take the first two of the default cycle, contacts four others,
+# so a marker's colour says which constraint was hit, not which body.
+_BODY_COLOR = {1: "tab:blue", 2: "tab:orange"}
+_CONTACT_COLOR = {
+    "left": "tab:green",
+    "right": "tab:red",
+    "slot_min": "tab:purple",
+    "slot_max": "tab:brown",
+}
+# Which bodies a contact involves (the body whose position marks the impact).
+_CONTACT_BODIES = {"left": (1,), "right": (2,), "slot_min": (1, 2), "slot_max": (1, 2)}
+
+_HEIGHT = {  # relative panel heights in the combined figure
+    "positions": 3.0,
+    "velocities": 2.0,
+    "kinetic_energy": 1.8,
+    "impacts": 0.45,  # per row of the impact indicator, plus a base below
+    "ledger": 2.0,
+    "residual": 1.1,
+}
+_WIDTH = 11.0  # inches; with dpi 100 the PNG is 1100 px wide
+
+
+# ----------------------------------------------------------------------------
+# access to the result (only the documented attributes)
+
+
+def _scene_value(result, name):
+    """A scene field, or None when the scene or the field is absent."""
+    scene = getattr(result, "scene", None)
+    if scene is None:
+        return None
+    value = getattr(scene, name, None)
+    if value is None:
+        return None
+    if isinstance(value, (bytes, bytearray)):
+        value = value.decode(errors="replace")
+    if isinstance(value, str):
+        value = value.strip()
+        return value or None
+    return value
+
+
+def _float_or_none(value):
+    if value is None:
+        return None
+    try:
+        out = float(value)
+    except (TypeError, ValueError):
+        return None
+    return out if np.isfinite(out) else None
+
+
+def _kind_str(kind):
+    if isinstance(kind, (bytes, bytearray, np.bytes_)):
+        kind = bytes(kind).decode(errors="replace")
+    return str(kind).strip()
+
+
+def _events(result):
+    """List of (t, kind) pairs, in time order."""
+    ev = getattr(result, "events", None)
+    if ev is None or len(ev) == 0:
+        return []
+    times = np.asarray(ev["t"], dtype=float)
+    kinds = [_kind_str(k) for k in ev["kind"]]
+    order = np.argsort(times, kind="stable")
+    return [(float(times[i]), kinds[i]) for i in order]
+
+
+def _event_times(events, kind):
+    return np.array([t for t, k in events if k == kind], dtype=float)
+
+
+def _contacts_present(result, events):
+    """Contacts drawn in the impact panel: those the scene has, plus any that had events."""
+    limits = {
+        "left": "x_left",
+        "right": "x_right",
+        "slot_min": "d_min",
+        "slot_max": "d_max",
+    }
+    seen = set()
+    for _, kind in events:
+        for c in CONTACTS:
+            if kind in (c, "rest_" + c, "release_" + c):
+                seen.add(c)
+    return [c for c in CONTACTS if c in seen or _float_or_none(_scene_value(result, limits[c])) is not None]
+
+
+def _rest_intervals(events, contact, t_start, t_end):
+    """(start, end) of each persistent contact: rest_<c> to release_<c> or the end of the run.
+
+    A release with no rest before it means the run started in that contact.
+    """
+    out = []
+    start = None
+    for t, kind in events:
+        if kind == "rest_" + contact and start is None:
+            start = t
+        elif kind == "release_" + contact:
+            out.append((t_start if start is None else start, t))
+            start = None
+    if start is not None:
+        out.append((start, t_end))
+    return out
+
+
+def _title(result):
+    title = _scene_value(result, "title")
+    if title:
+        return str(title)
+    source = _scene_value(result, "source")
+    if source:
+        return os.path.basename(str(source))
+    return "impact1d run"
+
+
+def _subtitle(result, events):
+    parts = []
+    method = _scene_value(result, "method")
+    if method:
+        parts.append(f"method {method}")
+    dt = _float_or_none(_scene_value(result, "dt"))
+    if dt is not None:
+        parts.append(f"dt = {dt:g} s")
+    n_impacts = sum(1 for _, k in events if k in CONTACTS)
+    parts.append(f"{n_impacts} impact{'s' if n_impacts != 1 else ''}")
+    residual = np.asarray(result.residual, dtype=float)
+    if residual.size:
+        parts.append(f"max |energy residual| = {np.max(np.abs(residual)):.1e} J")
+    return "  \u00b7  ".join(parts)
+
+
+# ----------------------------------------------------------------------------
+# panels
+
+
+def _finish_time_axis(ax, t):
+    if len(t) > 1 and t[-1] > t[0]:
+        ax.set_xlim(t[0], t[-1])
+    ax.grid(True, alpha=0.3)
+
+
+def _legend(ax, **kw):
+    # Outside the plotting area, right: legends never hide the curves.
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0,
+              fontsize="small", frameon=False, **kw)
+
+
+def _draw_positions(ax, result, events):
+    t = np.asarray(result.t, dtype=float)
+    x1 = np.asarray(result.x1, dtype=float)
+    x2 = np.asarray(result.x2, dtype=float)
+    x_left = _float_or_none(_scene_value(result, "x_left"))
+    x_right = _float_or_none(_scene_value(result, "x_right"))
+    d_min = _float_or_none(_scene_value(result, "d_min"))
+    d_max = _float_or_none(_scene_value(result, "d_max"))
+
+    # Limits from the bodies and the walls only: a wide slot (case 5 has
+    # d_max = 50 m) must not squash the motion.
+    lo = [np.min(x1), np.min(x2)] if t.size else [0.0]
+    hi = [np.max(x1), np.max(x2)] if t.size else [1.0]
+    for w in (x_left, x_right):
+        if w is not None:
+            lo.append(w)
+            hi.append(w)
+    lo, hi = float(min(lo)), float(max(hi))
+    pad = 0.06 * (hi - lo) if hi > lo else 0.5
+    ylim = (lo - pad, hi + pad)
+
+    def inside_walls(y):
+        # x2 cannot pass a wall, so neither does the band that says where it may be.
+        return np.clip(y, -np.inf if x_left is None else x_left,
+                       np.inf if x_right is None else x_right)
+
+    if d_min is not None and d_max is not None:
+        ax.fill_between(t, inside_walls(x1 + d_min), inside_walls(x1 + d_max), color=_BODY_COLOR[2], alpha=0.10,
+                        linewidth=0, gid="slot_band",
+                        label=f"slot: x1 + [{d_min:g}, {d_max:g}] m")
+    else:
+        for name, d in (("min", d_min), ("max", d_max)):
+            if d is not None:
+                ax.plot(t, inside_walls(x1 + d), color=_BODY_COLOR[2], linestyle=":", linewidth=1.0,
+                        gid=f"slot:{name}", label=f"slot {name}: x1 + {d:g} m")
+
+    for name, w, beyond in (("left", x_left, ylim[0] - 1e3 * (pad + 1)),
+                            ("right", x_right, ylim[1] + 1e3 * (pad + 1))):
+        if w is None:
+            continue
+        ax.axhspan(min(w, beyond), max(w, beyond), color="0.85", zorder=0)
+        ax.axhline(w, color="0.25", linewidth=1.5, gid=f"wall:{name}",
+                   label=f"{name} wall x = {w:g} m")
+
+    ax.plot(t, x1, color=_BODY_COLOR[1], linewidth=1.4, gid="x1", label="x1 (body 1)")
+    ax.plot(t, x2, color=_BODY_COLOR[2], linewidth=1.4, gid="x2", label="x2 (body 2)")
+
+    # Smaller markers when impacts crowd (long runs), so the paths stay visible.
+    n_impacts = sum(1 for _, k in events if k in CONTACTS)
+    size = 5 if n_impacts <= 150 else 3
+    for contact in CONTACTS:
+        times = _event_times(events, contact)
+        if times.size == 0:
+            continue
+        xs, ys = [], []
+        for body in _CONTACT_BODIES[contact]:
+            pos = x1 if body == 1 else x2
+            xs.append(times)
+            ys.append(np.interp(times, t, pos))
+        ax.plot(np.concatenate(xs), np.concatenate(ys), linestyle="none", marker="o",
+                markersize=size, markerfacecolor="none", markeredgewidth=1.2,
+                color=_CONTACT_COLOR[contact], gid=f"impact:{contact}", zorder=5,
+                label=f"impact, {_CONTACT_LABEL[contact]}")
+
+    ax.set_ylim(*ylim)
+    ax.set_ylabel("position (m)")
+    _finish_time_axis(ax, t)
+    _legend(ax)
+
+
+def _draw_velocities(ax, result, events):
+    t = np.asarray(result.t, dtype=float)
+    ax.axhline(0.0, color="0.5", linewidth=0.8)
+    ax.plot(t, np.asarray(result.v1, dtype=float), color=_BODY_COLOR[1], linewidth=1.2,
+            gid="v1", label="v1 (body 1)")
+    ax.plot(t, np.asarray(result.v2, dtype=float), color=_BODY_COLOR[2], linewidth=1.2,
+            gid="v2", label="v2 (body 2)")
+    # Friction mode switches: the body's velocity is zero there.
+    styles = {"stick": ("s", "stuck (friction holds)"), "slip": ("D", "slips (breaks away)")}
+    for what, (marker, text) in styles.items():
+        for body in (1, 2):
+            times = _event_times(events, f"{what}{body}")
+            if times.size == 0:
+                continue
+            v = np.asarray(result.v1 if body == 1 else result.v2, dtype=float)
+            ax.plot(times, np.interp(times, t, v), linestyle="none", marker=marker,
+                    markersize=4, color=_BODY_COLOR[body], gid=f"{what}{body}",
+                    label=f"body {body} {text}")
+    ax.set_ylabel("velocity (m/s)")
+    _finish_time_axis(ax, t)
+    _legend(ax)
+
+
+def _draw_kinetic_energy(ax, result, events):
+    t = np.asarray(result.t, dtype=float)
+    ke = np.asarray(result.ke, dtype=float)
+    ax.plot(t, ke, color="black", linewidth=1.3, gid="ke", label="KE = m1 v1\u00b2/2 + m2 v2\u00b2/2")
+    # From zero up: a constant energy (case 3) then reads as a flat line, not as
+    # rounding noise blown up by autoscaling.
+    top = float(np.max(ke)) if ke.size else 1.0
+    ax.set_ylim(0.0, 1.1 * top if top > 0 else 1.0)
+    ax.set_ylabel("kinetic energy (J)")
+    _finish_time_axis(ax, t)
+    _legend(ax)
+
+
+def _draw_impacts(ax, result, events):
+    t = np.asarray(result.t, dtype=float)
+    t_start, t_end = (float(t[0]), float(t[-1])) if t.size else (0.0, 0.0)
+    contacts = _contacts_present(result, events)
+    n = len(contacts)
+    for row, contact in enumerate(contacts):
+        y = n - 1 - row  # first contact on top
+        color = _CONTACT_COLOR[contact]
+        bars = _rest_intervals(events, contact, t_start, t_end)
+        if bars:
+            ax.broken_barh([(a, b - a) for a, b in bars], (y - 0.3, 0.6), facecolors=color,
+                           alpha=0.45, gid=f"rest:{contact}")
+        times = _event_times(events, contact)
+        if times.size:
+            ax.plot(times, np.full(times.size, float(y)), linestyle="none", marker="|",
+                    markersize=14, markeredgewidth=1.3, color=color, gid=f"tick:{contact}")
+        if not bars and times.size == 0:
+            ax.text(0.5, y, "no contact", transform=ax.get_yaxis_transform(), ha="center",
+                    va="center", fontsize="small", color="0.5")
+    if n == 0:
+        ax.text(0.5, 0.5, "no walls, no slot", transform=ax.transAxes, ha="center",
+                va="center", fontsize="small", color="0.5")
+    ax.set_yticks(range(n))
+    ax.set_yticklabels([_CONTACT_LABEL[c] for c in reversed(contacts)])
+    ax.set_ylim(-0.6, n - 0.4 if n else 0.6)
+    ax.set_ylabel("impacts")
+    _finish_time_axis(ax, t)
+    ax.grid(False, axis="y")
+    from matplotlib.patches import Patch
+    from matplotlib.lines import Line2D
+    handles = [Line2D([], [], linestyle="none", marker="|", markersize=10, color="0.3",
+                      label="impact"),
+               Patch(facecolor="0.3", alpha=0.45, label="persistent contact")]
+    _legend(ax, handles=handles)
+
+
+def _draw_ledger(ax, result, events):
+    t = np.asarray(result.t, dtype=float)
+    ke = np.asarray(result.ke, dtype=float)
+    ax.axhline(0.0, color="0.5", linewidth=0.8)
+    ax.plot(t, np.asarray(result.work, dtype=float), color="tab:green", linewidth=1.3,
+            gid="work", label="work of forces W")
+    ax.plot(t, np.asarray(result.friction_loss, dtype=float), color="tab:olive",
+            linewidth=1.3, gid="friction_loss", label="friction loss D")
+    ax.plot(t, np.asarray(result.impact_loss, dtype=float), color="tab:red", linewidth=1.3,
+            gid="impact_loss", label="impact loss Q")
+    if ke.size:
+        ax.plot(t, ke - ke[0], color="black", linewidth=1.0, linestyle="--", gid="ke_change",
+                label="KE \u2212 KE(0) = W \u2212 D \u2212 Q")
+    # On the scale of the run's energy: a ledger that stays at rounding level
+    # (no forces, no losses: case 3) reads as flat zero lines, not as noise.
+    series = [np.asarray(getattr(result, n), dtype=float)
+              for n in ("work", "friction_loss", "impact_loss")] + [ke - ke[0] if ke.size else ke]
+    values = np.concatenate([s[np.isfinite(s)] for s in series] + [np.zeros(1)])
+    scale = max(float(np.max(np.abs(values))), float(np.max(ke)) if ke.size else 0.0)
+    lo, hi = float(values.min()), float(values.max())
+    if scale > 0 and hi - lo < 0.05 * scale:
+        mid = 0.5 * (lo + hi)
+        ax.set_ylim(mid - 0.1 * scale, mid + 0.1 * scale)
+    ax.set_ylabel("energy (J)")
+    _finish_time_axis(ax, t)
+    _legend(ax)
+
+
+def _draw_residual(ax, result, events):
+    t = np.asarray(result.t, dtype=float)
+    residual = np.asarray(result.residual, dtype=float)
+    ax.plot(t, residual, color="tab:gray", linewidth=1.0, gid="residual",
+            label="KE \u2212 KE(0) \u2212 W + D + Q")
+    amax = float(np.max(np.abs(residual))) if residual.size else 0.0
+    # Symmetric limits around zero: the reader sees the residual's size, not its shape.
+    ax.set_ylim(-1.15 * amax, 1.15 * amax) if amax > 0 else ax.set_ylim(-1.0, 1.0)
+    fmt = ScalarFormatter(useMathText=True)
+    fmt.set_powerlimits((-2, 3))
+    ax.yaxis.set_major_formatter(fmt)
+    ax.locator_params(axis="y", nbins=3)
+    ax.set_ylabel("residual (J)")
+    _finish_time_axis(ax, t)
+    _legend(ax)
+
+
+_DRAW = {
+    "positions": _draw_positions,
+    "velocities": _draw_velocities,
+    "kinetic_energy": _draw_kinetic_energy,
+    "impacts": _draw_impacts,
+    "ledger": _draw_ledger,
+    "residual": _draw_residual,
+}
+# A panel of the separate mode = one or more of the drawn axes.
+_PANEL_AXES = {
+    "positions": ("positions",),
+    "velocities": ("velocities",),
+    "kinetic_energy": ("kinetic_energy",),
+    "impacts": ("impacts",),
+    "energy": ("ledger", "residual"),
+}
+
+
+# ----------------------------------------------------------------------------
+# figures
+
+
+def _heights(names, n_contacts):
+    return [(_HEIGHT["impacts"] * max(n_contacts, 1) + 0.4) if n == "impacts" else _HEIGHT[n]
+            for n in names]
+
+
+def _build(result, names, events, factory, label):
+    n_contacts = len(_contacts_present(result, events))
+    heights = _heights(names, n_contacts)
+    # A lone panel gets some height of its own, so it does not read as a strip.
+    height = max(0.9 + 1.25 * sum(heights), 4.5)
+    fig = factory(figsize=(_WIDTH, height), layout="constrained")
+    fig.set_label(label)
+    axes = fig.subplots(len(names), 1, sharex=True, squeeze=False,
+                        gridspec_kw={"height_ratios": heights})[:, 0]
+    for ax, name in zip(axes, names):
+        ax.set_label(name)
+        _DRAW[name](ax, result, events)
+    for ax in axes[:-1]:
+        ax.tick_params(labelbottom=False)
+    axes[-1].set_xlabel("time t (s)")
+    fig.suptitle(_title(result), fontsize="large", fontweight="bold")
+    axes[0].set_title(_subtitle(result, events), fontsize="small", loc="left", color="0.3")
+    fig.align_ylabels(axes)
+    return fig
+
+
+def figure(result, separate=False, *, figure_factory=None):
+    """Draw a run.
+
+    Returns one :class:`matplotlib.figure.Figure` with all panels stacked on a
+    shared time axis, or with ``separate=True`` a list of figures, one per
+    panel of :data:`PANELS` (each figure's ``get_label()`` is the panel name).
+
+    ``figure_factory`` makes the figures (default ``matplotlib.figure.Figure``;
+    pass ``matplotlib.pyplot.figure`` to get figures that ``pyplot.show``
+    displays).  It is called with ``figsize=`` and ``layout=``.
+    """
+    factory = Figure if figure_factory is None else figure_factory
+    events = _events(result)
+    if not separate:
+        names = [n for p in PANELS for n in _PANEL_AXES[p]]
+        return _build(result, names, events, factory, "impact1d")
+    return [_build(result, _PANEL_AXES[p], events, factory, p) for p in PANELS]
+
+
+def save(result, path, separate=False, *, dpi=100, figure_factory=None):
+    """Write the run's plot as PNG; return the list of paths written.
+
+    With ``separate=True`` one file per panel: ``STEM_<panel>.png`` next to ``path``.
+    ``figure_factory`` is passed to :func:`figure`.
+    """
+    path = os.fspath(path)
+    stem, ext = os.path.splitext(path)
+    if not ext:
+        ext = ".png"
+        path = stem + ext
+    figs = figure(result, separate=separate, figure_factory=figure_factory)
+    if not separate:
+        figs = [figs]
+        paths = [path]
+    else:
+        paths = [f"{stem}_{fig.get_label()}{ext}" for fig in figs]
+    folder = os.path.dirname(os.path.abspath(path))
+    os.makedirs(folder, exist_ok=True)
+    for fig, p in zip(figs, paths):
+        fig.savefig(p, dpi=dpi)
+    return paths

@@ -1,0 +1,94 @@
+"""``impact1d-plot OUTPUT.dat [-o PNG] [--separate] [--show]``: plot a run written by the CLI.
+
+Reads OUTPUT.dat (and OUTPUT.events.dat next to it, if present) and writes
+OUTPUT.png next to it, or one PNG per panel with ``--separate``
+(OUTPUT_positions.png, ...).  ``--show`` also opens the figures in a window.
+Any error gives a one-line message on stderr and exit status 1.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+
+PROG = "impact1d-plot"
+
+
+def _parser():
+    p = argparse.ArgumentParser(
+        prog=PROG,
+        description="Plot an impact1d output file: positions with walls and slot, "
+        "velocities, kinetic energy, impacts per constraint, energy ledger.",
+    )
+    p.add_argument("output", metavar="OUTPUT.dat", help="output file written by impact1d "
+                   "(its OUTPUT.events.dat is read too when present)")
+    p.add_argument("-o", dest="png", metavar="PNG",
+                   help="image to write (default: OUTPUT with .png instead of .dat)")
+    p.add_argument("--separate", action="store_true",
+                   help="one PNG per panel: PNG stem + _positions, _velocities, ...")
+    p.add_argument("--show", action="store_true", help="also open the figures in a window")
+    return p
+
+
+def _default_png(output):
+    stem = output[:-4] if output.endswith(".dat") else output
+    return stem + ".png"
+
+
+def _read(path):
+    # Imported here so `impact1d-plot --help` works even if the package's
+    # compiled core cannot load.
+    from impact1d import read_output
+
+    return read_output(path)
+
+
+def _fail(message):
+    print(f"{PROG}: error: {message}", file=sys.stderr)
+    return 1
+
+
+def _one_line(exc):
+    text = " ".join(str(exc).split())
+    return text or type(exc).__name__
+
+
+def main(argv=None):
+    args = _parser().parse_args(argv)
+    output = args.output
+    if not os.path.isfile(output):
+        return _fail(f"no such file: {output}")
+    try:
+        result = _read(output)
+    except Exception as exc:  # noqa: BLE001 - any read failure is reported the same way
+        text = _one_line(exc)
+        return _fail(text if output in text else f"cannot read {output}: {text}")
+    if len(getattr(result, "t", ())) == 0:
+        return _fail(f"no samples in {output}")
+
+    import matplotlib
+
+    if not args.show:
+        matplotlib.use("Agg")
+    from impact1d import plot
+
+    factory = None
+    if args.show:
+        import matplotlib.pyplot as plt
+
+        factory = plt.figure
+    png = args.png or _default_png(output)
+    try:
+        paths = plot.save(result, png, separate=args.separate, figure_factory=factory)
+    except Exception as exc:  # noqa: BLE001
+        return _fail(f"cannot write {png}: {_one_line(exc)}")
+    for p in paths:
+        print(f"wrote {p}")
+    if args.show:
+        plt.show()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
