@@ -77,7 +77,7 @@ contains
     type(error_type), allocatable, intent(out) :: error
     real(wp) :: m1, m2, mu1, mu2, g, x_left, r_left, x_right, r_right, d_min, r_min, d_max, r_max
     real(wp) :: x1, v1, x2, v2, f1, f2, f1_amp, f1_period, f1_phase, f2_amp, f2_period, f2_phase
-    real(wp) :: t_end, dt, dt_out
+    real(wp) :: t_end, dt, dt_out, zero_vel
     character(len=1024) :: title, f1_table, f2_table, method
     namelist /scene/ title
     namelist /bodies/ m1, m2, mu1, mu2, g
@@ -85,7 +85,7 @@ contains
     namelist /link/ d_min, r_min, d_max, r_max
     namelist /initial/ x1, v1, x2, v2
     namelist /forces/ f1, f2, f1_table, f2_table, f1_amp, f1_period, f1_phase, f2_amp, f2_period, f2_phase
-    namelist /run/ t_end, dt, dt_out, method
+    namelist /run/ t_end, dt, dt_out, method, zero_vel
     logical :: present(size(known_groups))
     integer :: unit, ios, j
     character(len=512) :: message
@@ -107,7 +107,7 @@ contains
     x1 = absent; v1 = absent; x2 = absent; v2 = absent; f1 = absent; f2 = absent
     f1_amp = absent; f1_period = absent; f1_phase = absent
     f2_amp = absent; f2_period = absent; f2_phase = absent
-    t_end = absent; dt = absent; dt_out = absent
+    t_end = absent; dt = absent; dt_out = absent; zero_vel = absent
     title = absent_text; f1_table = absent_text; f2_table = absent_text; method = absent_text
 
     open(newunit=unit, file=path, status='old', action='read', iostat=ios, iomsg=message)
@@ -136,7 +136,8 @@ contains
     close(unit)
 
     values = [m1, m2, mu1, mu2, g, x_left, r_left, x_right, r_right, d_min, r_min, d_max, r_max, &
-      x1, v1, x2, v2, f1, f2, f1_amp, f1_period, f1_phase, f2_amp, f2_period, f2_phase, t_end, dt, dt_out]
+      x1, v1, x2, v2, f1, f2, f1_amp, f1_period, f1_phase, f2_amp, f2_period, f2_phase, t_end, dt, dt_out, &
+      zero_vel]
     input%given = values /= absent
     input%value = merge(values, 0.0_wp, input%given)
     input%text(i_title) = given_text(title)

@@ -9,7 +9,7 @@ module impact1d_output
   implicit none
   private
   public :: sink_type, memory_sink, file_sink, n_columns, column_names, n_event_kinds, event_names
-  public :: event_impact, event_rest, event_release, event_stick, event_slip, make_folder
+  public :: event_impact, event_rest, event_release, event_stick, event_slip, make_folder, run_stats
 
   integer, parameter :: n_columns = 10
   character(len=*), parameter :: column_names = &
@@ -24,6 +24,14 @@ module impact1d_output
     'left', 'right', 'slot_min', 'slot_max', 'rest_left', 'rest_right', 'rest_slot_min', &
     'rest_slot_max', 'release_left', 'release_right', 'release_slot_min', 'release_slot_max', &
     'stick1', 'stick2', 'slip1', 'slip2']
+
+  !> What a run did, for the CLI's summary and Python's result.
+  type :: run_stats
+    integer :: steps = 0
+    integer :: events(n_event_kinds) = 0
+    real(wp) :: last_row(n_columns) = 0.0_wp
+    real(wp) :: max_residual = 0.0_wp
+  end type run_stats
 
   type, abstract :: sink_type
   contains

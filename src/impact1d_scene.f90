@@ -11,22 +11,23 @@ module impact1d_scene
   public :: n_contacts, contact_names, normal, i_left, i_right, i_slot_min, i_slot_max
   public :: i_m1, i_m2, i_mu1, i_mu2, i_g, i_x_left, i_r_left, i_x_right, i_r_right, i_d_min, &
     i_r_min, i_d_max, i_r_max, i_x1, i_v1, i_x2, i_v2, i_f1, i_f2, i_f1_amp, i_f1_period, &
-    i_f1_phase, i_f2_amp, i_f2_period, i_f2_phase, i_t_end, i_dt, i_dt_out
+    i_f1_phase, i_f2_amp, i_f2_period, i_f2_phase, i_t_end, i_dt, i_dt_out, i_zero_vel
   public :: i_title, i_f1_table, i_f2_table, i_method, max_samples, default_gravity
 
-  integer, parameter :: n_real = 28, n_text = 4
+  integer, parameter :: n_real = 29, n_text = 4
   !> Names of the real inputs, as in the namelist and in Python's Scene, in this order.
   character(len=*), parameter :: real_names(n_real) = [character(len=9) :: &
     'm1', 'm2', 'mu1', 'mu2', 'g', 'x_left', 'r_left', 'x_right', 'r_right', &
     'd_min', 'r_min', 'd_max', 'r_max', 'x1', 'v1', 'x2', 'v2', 'f1', 'f2', &
-    'f1_amp', 'f1_period', 'f1_phase', 'f2_amp', 'f2_period', 'f2_phase', 't_end', 'dt', 'dt_out']
+    'f1_amp', 'f1_period', 'f1_phase', 'f2_amp', 'f2_period', 'f2_phase', 't_end', 'dt', 'dt_out', &
+    'zero_vel']
   character(len=*), parameter :: text_names(n_text) = [character(len=8) :: &
     'title', 'f1_table', 'f2_table', 'method']
   integer, parameter :: i_m1 = 1, i_m2 = 2, i_mu1 = 3, i_mu2 = 4, i_g = 5, i_x_left = 6, &
     i_r_left = 7, i_x_right = 8, i_r_right = 9, i_d_min = 10, i_r_min = 11, i_d_max = 12, &
     i_r_max = 13, i_x1 = 14, i_v1 = 15, i_x2 = 16, i_v2 = 17, i_f1 = 18, i_f2 = 19, &
     i_f1_amp = 20, i_f1_period = 21, i_f1_phase = 22, i_f2_amp = 23, i_f2_period = 24, &
-    i_f2_phase = 25, i_t_end = 26, i_dt = 27, i_dt_out = 28
+    i_f2_phase = 25, i_t_end = 26, i_dt = 27, i_dt_out = 28, i_zero_vel = 29
   integer, parameter :: i_title = 1, i_f1_table = 2, i_f2_table = 3, i_method = 4
 
   !> The four optional unilateral constraints: gap_k = normal(:,k) . x + offset_k >= 0.
@@ -37,6 +38,8 @@ module impact1d_scene
     [1.0_wp, 0.0_wp, 0.0_wp, -1.0_wp, -1.0_wp, 1.0_wp, 1.0_wp, -1.0_wp], [2, n_contacts])
 
   real(wp), parameter :: default_gravity = 9.80665_wp
+  !> The tutorial's zero-velocity threshold, used by the vissim method only.
+  real(wp), parameter :: default_zero_velocity = 0.005_wp
   !> Output rows a run may produce: beyond this the user almost surely meant a larger dt_out.
   integer, parameter :: max_samples = 10000000
 
@@ -57,6 +60,7 @@ module impact1d_scene
     real(wp) :: x0(2), v0(2)
     type(forcing_type) :: forcing
     real(wp) :: t_end, dt, dt_out
+    real(wp) :: zero_velocity = default_zero_velocity
     integer :: n_samples
   end type scene_type
 
@@ -85,7 +89,7 @@ contains
 
     call positive(i_m1); call positive(i_m2)
     if (allocated(error)) return
-    call nonnegative(i_mu1); call nonnegative(i_mu2)
+    call nonnegative(i_mu1); call nonnegative(i_mu2); call nonnegative(i_zero_vel)
     if (allocated(error)) return
     if (input%given(i_g) .and. input%value(i_g) < 0.0_wp .and. (value_or(i_mu1, 0.0_wp) > 0.0_wp &
         .or. value_or(i_mu2, 0.0_wp) > 0.0_wp)) then
@@ -157,9 +161,9 @@ contains
       end if
     end if
     if (len_trim(input%text(i_method)) > 0) then
-      if (trim(input%text(i_method)) /= 'event') then
+      if (trim(input%text(i_method)) /= 'event' .and. trim(input%text(i_method)) /= 'vissim') then
         call raise(error, status_input, "method = '" // trim(input%text(i_method)) // &
-          "' is unknown: the method is 'event'")
+          "' is unknown: the methods are 'event' and 'vissim'")
         return
       end if
     end if
@@ -282,6 +286,7 @@ contains
     scene%dt = input%value(i_dt)
     scene%dt_out = scene%dt
     if (input%given(i_dt_out)) scene%dt_out = input%value(i_dt_out)
+    if (input%given(i_zero_vel)) scene%zero_velocity = input%value(i_zero_vel)
     ! Samples at j*dt_out, and at t_end when it is off that grid.
     ratio = scene%t_end / scene%dt_out
     scene%n_samples = nint(ratio) + 1

@@ -10,19 +10,12 @@ module impact1d_solver
   use impact1d_events, only: hermite, earliest_crossing
   use impact1d_impacts, only: normal_velocity, impulse, most_approaching, restitution_of, &
     kinetic_energy
-  use impact1d_output, only: sink_type, n_columns, n_event_kinds, event_impact, event_rest, &
+  use impact1d_output, only: sink_type, run_stats, n_columns, event_impact, event_rest, &
     event_release, event_stick, event_slip
+  use impact1d_vissim, only: run_vissim
   implicit none
   private
   public :: run, run_stats
-
-  !> What a run did, for the CLI's summary and Python's result.
-  type :: run_stats
-    integer :: steps = 0
-    integer :: events(n_event_kinds) = 0
-    real(wp) :: last_row(n_columns) = 0.0_wp
-    real(wp) :: max_residual = 0.0_wp
-  end type run_stats
 
   !> Tolerances, each a multiple of the unit roundoff of the quantity it guards.
   real(wp), parameter :: gap_rounding = 16.0_wp * eps_wp      !< a gap this small (x scale) is closed
@@ -44,7 +37,8 @@ module impact1d_solver
 
 contains
 
-  !> Run a scene from t = 0 to t_end, sending every dt_out sample and every event to sink.
+  !> Run a scene from t = 0 to t_end, sending every dt_out sample and every event to sink
+  !> (with method 'vissim', the tutorial's fixed-step scheme instead).
   subroutine run(scene, sink, stats, error)
     type(scene_type), intent(in) :: scene
     class(sink_type), intent(inout) :: sink
@@ -58,6 +52,10 @@ contains
     integer :: j_sample, stalls, halvings, watched
     real(wp) :: t_last_event
 
+    if (scene%method == 'vissim') then
+      call run_vissim(scene, sink, stats, error)
+      return
+    end if
     s%t = 0.0_wp
     s%x = scene%x0
     s%v = scene%v0

@@ -41,7 +41,7 @@ REAL_FIELDS = (
     "d_min", "r_min", "d_max", "r_max",
     "x1", "v1", "x2", "v2",
     "f1", "f2", "f1_amp", "f1_period", "f1_phase", "f2_amp", "f2_period", "f2_phase",
-    "t_end", "dt", "dt_out",
+    "t_end", "dt", "dt_out", "zero_vel",
 )
 TEXT_FIELDS = ("title", "f1_table", "f2_table", "method")
 
@@ -83,6 +83,7 @@ class Scene:
     t_end: Optional[float] = None
     dt: Optional[float] = None
     dt_out: Optional[float] = None
+    zero_vel: Optional[float] = None
     title: Optional[str] = None
     f1_table: Optional[str] = None
     f2_table: Optional[str] = None

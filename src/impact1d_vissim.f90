@@ -1,0 +1,152 @@
+!> The `vissim` method (METHOD.md section 7): an imitation of the tutorial's block diagram,
+!> kept so that the speed/accuracy trade against the event method can be measured on the
+!> same scenes. Fixed-step RK4 with no event location; collisions are seen as sign changes
+!> of a gap at step ends and applied with the velocities of the step before (the diagram's
+!> one-step delay); walls are limited integrators (positions clamped); friction follows the
+!> diagram's rules with a zero-velocity threshold. Its errors are O(dt) by design.
+module impact1d_vissim
+  use impact1d_kinds, only: wp
+  use impact1d_error, only: error_type, raise, status_simulation, fmt
+  use impact1d_scene, only: scene_type, n_contacts, normal, i_left, i_right, i_slot_min, i_slot_max
+  use impact1d_impacts, only: impulse, kinetic_energy
+  use impact1d_output, only: sink_type, run_stats, n_columns, event_impact
+  implicit none
+  private
+  public :: run_vissim
+
+contains
+
+  subroutine run_vissim(scene, sink, stats, error)
+    type(scene_type), intent(in) :: scene
+    class(sink_type), intent(inout) :: sink
+    type(run_stats), intent(out) :: stats
+    type(error_type), allocatable, intent(out) :: error
+    real(wp) :: t, x(2), v(2), v_prev(2), x_new(2), v_new(2), work, friction_loss, impact_loss
+    real(wp) :: ke0, h, t_sample, gap_before(n_contacts), v_hit(2), dwork, dfriction
+    integer :: j_sample, k
+    integer, parameter :: slot_first(n_contacts) = [i_slot_min, i_slot_max, i_left, i_right]
+
+    ! v is the velocity integrator's state; the diagram passes it through the zero-velocity
+    ! threshold before anything uses it (Figure 13), so what moves the bodies is threshold(v).
+    t = 0.0_wp
+    x = scene%x0
+    v = scene%v0
+    work = 0.0_wp
+    friction_loss = 0.0_wp
+    impact_loss = 0.0_wp
+    ke0 = kinetic_energy(scene, threshold(v))
+    j_sample = 0
+    call emit()
+    do while (j_sample < scene%n_samples)
+      t_sample = sample_time(j_sample)
+      h = min(scene%dt, t_sample - t)
+      if (t_sample - t - h <= 1.0e-9_wp * scene%dt) h = t_sample - t
+      v_prev = v
+      gap_before = [(gap(k, x), k = 1, n_contacts)]
+      call rk4(t, x, v, h, x_new, v_new, dwork, dfriction)
+      t = t + h
+      if (t_sample - t <= 1.0e-9_wp * scene%dt) t = t_sample
+      x = x_new
+      v = v_new
+      work = work + dwork
+      friction_loss = friction_loss + dfriction
+      stats%steps = stats%steps + 1
+      if (.not. all(abs([x, v]) <= huge(1.0_wp))) then
+        call raise(error, status_simulation, 'at t = ' // fmt(t) // ': the state is no longer finite')
+        return
+      end if
+      ! Collisions seen at the step's end: the slot's first, then the walls on what it left.
+      v_hit = threshold(v)
+      do k = 1, n_contacts
+        associate (c => slot_first(k))
+          if (.not. scene%has_contact(c)) cycle
+          if (.not. (gap_before(c) >= 0.0_wp .and. gap(c, x) < 0.0_wp)) cycle
+          if (c == i_left) x(1) = -scene%offset(i_left)
+          if (c == i_right) x(2) = scene%offset(i_right)
+          v_new = impulse(scene, c, scene%restitution(c), threshold(v_prev))
+          where (normal(:, c) == 0.0_wp) v_new = v
+          impact_loss = impact_loss + kinetic_energy(scene, threshold(v)) - kinetic_energy(scene, threshold(v_new))
+          v = v_new
+          v_prev = v
+          stats%events(event_impact + c) = stats%events(event_impact + c) + 1
+          call sink%put_event(t, event_impact + c, v_hit, threshold(v))
+        end associate
+      end do
+      if (t == t_sample) call emit()
+    end do
+
+  contains
+
+    pure real(wp) function sample_time(j)
+      integer, intent(in) :: j
+      if (j == scene%n_samples - 1) then
+        sample_time = scene%t_end
+      else
+        sample_time = j * scene%dt_out
+      end if
+    end function sample_time
+
+    subroutine emit()
+      real(wp) :: row(n_columns), ke, v_out(2)
+      v_out = threshold(v)
+      ke = kinetic_energy(scene, v_out)
+      row = [t, x(1), v_out(1), x(2), v_out(2), ke, work, friction_loss, impact_loss, &
+        ke - ke0 - work + friction_loss + impact_loss]
+      stats%max_residual = max(stats%max_residual, abs(row(n_columns)))
+      stats%last_row = row
+      call sink%put_sample(row)
+      j_sample = j_sample + 1
+    end subroutine emit
+
+    pure real(wp) function gap(k, positions)
+      integer, intent(in) :: k
+      real(wp), intent(in) :: positions(2)
+      gap = dot_product(normal(:, k), positions) + scene%offset(k)
+    end function gap
+
+    !> The diagram's "no movement on zero velocity": |v| <= threshold reads as zero.
+    pure function threshold(velocity) result(thresholded)
+      real(wp), intent(in) :: velocity(2)
+      real(wp) :: thresholded(2)
+      thresholded = merge(0.0_wp, velocity, abs(velocity) <= scene%zero_velocity)
+    end function threshold
+
+    !> The diagram's friction block: sliding friction when moving, otherwise the smaller of
+    !> the static bound and the applied force, opposing the applied force.
+    pure function friction(velocity, f) result(force)
+      real(wp), intent(in) :: velocity(2), f(2)
+      real(wp) :: force(2)
+      where (abs(velocity) > scene%zero_velocity)
+        force = -scene%friction * sign(1.0_wp, velocity)
+      elsewhere
+        force = -sign(min(scene%friction, abs(f)), f)
+      end where
+    end function friction
+
+    !> Classical RK4 on x' = thr(v), v' = (f + friction(thr(v), f)) / m, with the work and friction
+    !> dissipation integrated by the same stages.
+    subroutine rk4(t0, x0, v0, step, x1, v1, dw, dd)
+      real(wp), intent(in) :: t0, x0(2), v0(2), step
+      real(wp), intent(out) :: x1(2), v1(2), dw, dd
+      real(wp) :: kx(2, 4), kv(2, 4), kw(4), kd(4), f(2), fr(2), vs(2), ts
+      integer :: stage
+      real(wp), parameter :: c(4) = [0.0_wp, 0.5_wp, 0.5_wp, 1.0_wp], b(4) = [1.0_wp, 2.0_wp, 2.0_wp, 1.0_wp]
+      do stage = 1, 4
+        ts = t0 + c(stage) * step
+        vs = v0
+        if (stage > 1) vs = v0 + c(stage) * step * kv(:, stage - 1)
+        vs = threshold(vs)
+        f = scene%forcing%force(ts)
+        fr = friction(vs, f)
+        kx(:, stage) = vs
+        kv(:, stage) = (f + fr) / scene%mass
+        kw(stage) = dot_product(f, vs)
+        kd(stage) = -dot_product(fr, vs)
+      end do
+      x1 = x0 + step / 6.0_wp * matmul(kx, b)
+      v1 = v0 + step / 6.0_wp * matmul(kv, b)
+      dw = step / 6.0_wp * dot_product(kw, b)
+      dd = step / 6.0_wp * dot_product(kd, b)
+    end subroutine rk4
+  end subroutine run_vissim
+end module impact1d_vissim
