@@ -17,6 +17,10 @@ program impact1d_cli
       import :: c_int
       integer(c_int), value :: status
     end subroutine c_exit
+    integer(c_int) function c_isatty(fd) bind(C, name='isatty')
+      import :: c_int
+      integer(c_int), value :: fd
+    end function c_isatty
   end interface
 
   character(len=*), parameter :: usage = &
@@ -88,6 +92,8 @@ program impact1d_cli
   end if
   call sink%open(out_path, input, error)
   if (allocated(error)) call fail(error%status, error%message)
+  ! Progress only where a person watches: stderr a terminal (file descriptor 2).
+  sink%show_progress = c_isatty(2_c_int) == 1
   call run(scene, sink, stats, error)
   call sink%close(.not. allocated(error), close_error)
   if (allocated(error)) call fail(error%status, scene_path // ': ' // error%message)

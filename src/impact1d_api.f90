@@ -82,12 +82,13 @@ contains
   end subroutine read_scene
 
   !> Check and run a scene given as flat fields; keep its samples and events for get_*.
-  subroutine simulate(n, values, given, title, f1_table, f2_table, method, n_samples, n_events, &
-      steps, energy_residual, status, message)
+  subroutine simulate(n, values, given, title, f1_table, f2_table, method, progress, n_samples, &
+      n_events, steps, energy_residual, status, message)
     integer(c_int), intent(in) :: n
     real(c_double), intent(in) :: values(n)
     integer(c_int), intent(in) :: given(n)
     character(len=*), intent(in) :: title, f1_table, f2_table, method
+    integer(c_int), intent(in) :: progress    !< non-zero: show progress on stderr after 1 s
     integer(c_int), intent(out) :: n_samples, n_events, steps
     real(c_double), intent(out) :: energy_residual
     integer(c_int), intent(out) :: status
@@ -111,7 +112,10 @@ contains
     call prepare_scene(input, scene, error)
     if (failed(error, status, message)) return
     call last_run%reserve(scene%n_samples)
+    last_run%show_progress = progress /= 0
+    last_run%clock_start = -1
     call run(scene, last_run, stats, error)
+    call last_run%end_progress()
     if (failed(error, status, message)) return
     n_samples = last_run%n_samples
     n_events = last_run%n_events

@@ -2,6 +2,7 @@
 !> streams to files (memory constant in run length) while Python collects arrays.
 module impact1d_output
   use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char
+  use, intrinsic :: iso_fortran_env, only: error_unit, int64
   use impact1d_kinds, only: wp
   use impact1d_error, only: error_type, raise, status_input, fmt
   use impact1d_scene, only: scene_input, real_names, n_real, i_title, i_method, i_g, i_dt_out, &
@@ -33,10 +34,17 @@ module impact1d_output
     real(wp) :: max_residual = 0.0_wp
   end type run_stats
 
+  !> Every sink can show progress on stderr for long runs: once a run has taken a second,
+  !> a one-line '47% (t = 2.8 of 6 s)' refreshed four times a second, cleared at the end.
   type, abstract :: sink_type
+    logical :: show_progress = .false.
+    integer(int64) :: clock_start = -1, clock_shown = 0
+    logical :: progress_shown = .false.
   contains
     procedure(put_sample_interface), deferred :: put_sample
     procedure(put_event_interface), deferred :: put_event
+    procedure :: progress
+    procedure :: end_progress
   end type sink_type
 
   abstract interface
@@ -96,6 +104,38 @@ module impact1d_output
   character(len=*), parameter :: row_format = '(*(es25.16e3))'
 
 contains
+
+  !> Called by the stepping loop every few thousand steps: cheap unless a line is due.
+  subroutine progress(self, t, t_end)
+    class(sink_type), intent(inout) :: self
+    real(wp), intent(in) :: t, t_end
+    integer(int64) :: count, rate
+    character(len=8) :: percent
+    character(len=16) :: now
+    if (.not. self%show_progress) return
+    call system_clock(count, rate)
+    if (self%clock_start < 0) then
+      self%clock_start = count
+      self%clock_shown = count
+    end if
+    if (count - self%clock_start < rate .or. 4 * (count - self%clock_shown) < rate) return
+    self%clock_shown = count
+    write(percent, '(i3, a)') int(100.0_wp * t / t_end), '%'
+    write(now, '(f16.2)') t
+    write(error_unit, '(a)', advance='no') achar(13) // 'impact1d: ' // trim(adjustl(percent)) // &
+      ' (t = ' // trim(adjustl(now)) // ' of ' // fmt(t_end) // ' s)   '
+    flush(error_unit)
+    self%progress_shown = .true.
+  end subroutine progress
+
+  !> Clear the progress line, if one was shown.
+  subroutine end_progress(self)
+    class(sink_type), intent(inout) :: self
+    if (.not. self%progress_shown) return
+    write(error_unit, '(a)', advance='no') achar(13) // repeat(' ', 60) // achar(13)
+    flush(error_unit)
+    self%progress_shown = .false.
+  end subroutine end_progress
 
   subroutine memory_reserve(self, n_samples)
     class(memory_sink), intent(inout) :: self
@@ -206,6 +246,7 @@ contains
     logical, intent(in) :: keep
     type(error_type), allocatable, intent(out) :: error
     integer(c_int) :: status
+    call self%end_progress()
     if (.not. self%is_open) return
     self%is_open = .false.
     if (.not. keep) then

@@ -103,6 +103,7 @@ contains
       s = trial
       if (at_stop) s%t = t_stop
       stats%steps = stats%steps + 1
+      if (iand(stats%steps, 4095) == 0) call sink%progress(s%t, scene%t_end)
       if (any(.not. ieee_finite_state(s))) then
         call raise(error, status_simulation, 'at t = ' // fmt(s%t) // ': the state is no longer finite')
         return
@@ -128,6 +129,7 @@ contains
       end if
       if (at_stop .and. s%t == sample_t) call emit_sample()
     end do
+    call sink%end_progress()
 
   contains
 

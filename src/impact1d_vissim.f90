@@ -51,6 +51,7 @@ contains
       work = work + dwork
       friction_loss = friction_loss + dfriction
       stats%steps = stats%steps + 1
+      if (iand(stats%steps, 4095) == 0) call sink%progress(t, scene%t_end)
       if (.not. all(abs([x, v]) <= huge(1.0_wp))) then
         call raise(error, status_simulation, 'at t = ' // fmt(t) // ': the state is no longer finite')
         return
@@ -74,6 +75,7 @@ contains
       end do
       if (t == t_sample) call emit()
     end do
+    call sink%end_progress()
 
   contains
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import sys
 from dataclasses import dataclass, field
 from functools import lru_cache
 from typing import Optional
@@ -11,7 +12,7 @@ import numpy as np
 
 from ._scene import Scene, InputError, raise_for_status, to_core, _words, _api
 
-__all__ = ["Result", "simulate", "COLUMNS", "EVENT_DTYPE"]
+__all__ = ["Result", "simulate", "sweep", "COLUMNS", "EVENT_DTYPE"]
 
 # The sample columns of the api (and of the CLI output), checked against the core below.
 COLUMNS = ("t", "x1", "v1", "x2", "v2", "ke", "work", "friction_loss",
@@ -76,10 +77,11 @@ def result_from_columns(samples: np.ndarray, events: np.ndarray, **extra) -> Res
     return Result(**columns, events=events, **extra)
 
 
-def simulate(scene: Scene, **overrides) -> Result:
+def simulate(scene: Scene, *, progress: bool = False, **overrides) -> Result:
     """Run `scene` with keyword overrides of any Scene field (typically dt, t_end,
     dt_out, method; None makes a field absent).  Raises InputError for a bad scene
-    and SimulationError for a run that cannot go on."""
+    and SimulationError for a run that cannot go on.  With progress=True a run that
+    takes more than a second shows a progress line on stderr, as the CLI does."""
     if not isinstance(scene, Scene):
         raise InputError(f"simulate() needs an impact1d.Scene, got {type(scene).__name__}")
     unknown = [name for name in overrides if name not in _OVERRIDABLE]
@@ -90,7 +92,8 @@ def simulate(scene: Scene, **overrides) -> Result:
     values, given, title, f1_table, f2_table, method = to_core(scene)
 
     (n_samples, n_events, steps, energy_residual,
-     status, message) = _api.simulate(values, given, title, f1_table, f2_table, method)
+     status, message) = _api.simulate(values, given, title, f1_table, f2_table, method,
+                                      1 if progress else 0)
     raise_for_status(status, message)
 
     n_samples, n_events = int(n_samples), int(n_events)
@@ -109,3 +112,19 @@ def simulate(scene: Scene, **overrides) -> Result:
         events["v1_after"], events["v2_after"] = v1a, v2a
     return result_from_columns(samples, events, energy_residual=float(energy_residual),
                                steps=int(steps), scene=scene)
+
+
+def sweep(scene: Scene, runs, *, progress: bool = False) -> list:
+    """Run `scene` once per entry of `runs` (each a dict of overrides, as for simulate)
+    and return the Results in order.  With progress=True, stderr shows how many runs
+    are done (and each long run its own progress)."""
+    runs = list(runs)
+    results = []
+    for done, overrides in enumerate(runs, start=1):
+        results.append(simulate(scene, progress=progress, **overrides))
+        if progress:
+            sys.stderr.write(f"\rimpact1d sweep: {done}/{len(runs)} runs")
+            sys.stderr.flush()
+    if progress and runs:
+        sys.stderr.write("\n")
+    return results
