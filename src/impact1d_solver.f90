@@ -81,6 +81,12 @@ contains
 
       halvings = 0
       do
+        ! An event that landed exactly on the stop leaves nothing to step.
+        if (h <= 0.0_wp) then
+          trial = s
+          located = .false.
+          exit
+        end if
         call rk4_step(s, h, trial)
         call locate(s, trial, h, h_event, watched)
         located = h_event <= h
@@ -111,7 +117,8 @@ contains
 
       ! Events, table corners (the force's slope changes) and accumulation times need an
       ! event point; a sample time does not.
-      if (located .or. (at_stop .and. (t_stop == t_break .or. t_stop == minval(pending_rest)))) then
+      if (located .or. (at_stop .and. (t_stop == t_break .or. t_stop == minval(pending_rest) &
+          .or. impact_due()))) then
         if (s%t - t_last_event <= time_rounding * max(abs(s%t), scene%dt)) then
           stalls = stalls + 1
           if (stalls > max_stalls) then
@@ -323,6 +330,17 @@ contains
         call rk4_step(a, step, b)
       end do
     end subroutine refine
+
+    !> A gap that closed exactly at a stop (its root at the step's very end) with the bodies
+    !> still approaching: the impact belongs to this instant, so the sample shows its result.
+    logical function impact_due()
+      integer :: k
+      impact_due = .false.
+      do k = 1, n_contacts
+        if (.not. scene%has_contact(k) .or. mode%active(k)) cycle
+        if (gap(k, s) <= gap_tolerance(k, s) .and. normal_velocity(k, s%v) < -u_tolerance(k)) impact_due = .true.
+      end do
+    end function impact_due
 
     !> No step may end with a gap below zero beyond rounding, nor a sliding body past zero.
     logical function constraints_hold(b)
