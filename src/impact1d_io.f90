@@ -203,25 +203,18 @@ contains
     character(len=*), intent(in) :: path
     type(scene_input), intent(inout) :: input
     type(error_type), allocatable, intent(out) :: error
-    integer :: unit, ios, n_read, line_number, hash
+    integer :: unit, ios, n_read, line_number
     character(len=4096) :: line
-    character(len=512) :: message
     real(wp) :: value
+    logical :: found
 
-    open(newunit=unit, file=path, status='old', action='read', iostat=ios, iomsg=message)
-    if (ios /= 0) then
-      call raise(error, status_input, path // ': ' // trim(message))
-      return
-    end if
+    call open_data_file(path, unit, error)
+    if (allocated(error)) return
     n_read = 0
     line_number = 0
     do
-      read(unit, '(a)', iostat=ios) line
-      if (ios /= 0) exit
-      line_number = line_number + 1
-      hash = index(line, '#')
-      if (hash > 0) line(hash:) = ' '
-      if (len_trim(line) == 0) cycle
+      call next_data_line(unit, line, line_number, found)
+      if (.not. found) exit
       n_read = n_read + 1
       if (n_read <= size(dat_order)) then
         read(line, *, iostat=ios) value
@@ -264,27 +257,20 @@ contains
     character(len=*), intent(in) :: path
     type(table_type), intent(out) :: table
     type(error_type), allocatable, intent(out) :: error
-    integer :: unit, ios, line_number, hash, n
+    integer :: unit, ios, line_number, n
     character(len=4096) :: line
-    character(len=512) :: message
     real(wp) :: row(2)
     real(wp), allocatable :: t(:), f(:)
+    logical :: found
 
-    open(newunit=unit, file=path, status='old', action='read', iostat=ios, iomsg=message)
-    if (ios /= 0) then
-      call raise(error, status_input, path // ': ' // trim(message))
-      return
-    end if
+    call open_data_file(path, unit, error)
+    if (allocated(error)) return
     allocate(t(16), f(16))
     n = 0
     line_number = 0
     do
-      read(unit, '(a)', iostat=ios) line
-      if (ios /= 0) exit
-      line_number = line_number + 1
-      hash = index(line, '#')
-      if (hash > 0) line(hash:) = ' '
-      if (len_trim(line) == 0) cycle
+      call next_data_line(unit, line, line_number, found)
+      if (.not. found) exit
       read(line, *, iostat=ios) row
       if (ios /= 0) then
         call fail(': expected two numbers "t f", got ''' // trim(adjustl(line)) // '''')
@@ -322,6 +308,37 @@ contains
       call raise(error, status_input, path // ':' // fmt(line_number) // what)
     end subroutine fail
   end subroutine read_table
+
+  !> Open a data file for reading; a missing or unreadable one is an input error naming it.
+  subroutine open_data_file(path, unit, error)
+    character(len=*), intent(in) :: path
+    integer, intent(out) :: unit
+    type(error_type), allocatable, intent(out) :: error
+    integer :: ios
+    character(len=512) :: message
+    open(newunit=unit, file=path, status='old', action='read', iostat=ios, iomsg=message)
+    if (ios /= 0) call raise(error, status_input, path // ': ' // trim(message))
+  end subroutine open_data_file
+
+  !> The next line that holds data: '#' starts a comment, blank lines are skipped.
+  !> line_number counts every line read; found is false at the end of the file.
+  subroutine next_data_line(unit, line, line_number, found)
+    integer, intent(in) :: unit
+    character(len=*), intent(out) :: line
+    integer, intent(inout) :: line_number
+    logical, intent(out) :: found
+    integer :: ios, hash
+    found = .false.
+    do
+      read(unit, '(a)', iostat=ios) line
+      if (ios /= 0) return
+      line_number = line_number + 1
+      hash = index(line, '#')
+      if (hash > 0) line(hash:) = ' '
+      if (len_trim(line) > 0) exit
+    end do
+    found = .true.
+  end subroutine next_data_line
 
   !> A path written in a scene file is relative to that file's folder.
   function beside(scene_path, path) result(resolved)

@@ -11,6 +11,7 @@ module impact1d_output
   private
   public :: sink_type, memory_sink, file_sink, n_columns, column_names, n_event_kinds, event_names
   public :: event_impact, event_rest, event_release, event_stick, event_slip, make_folder, run_stats
+  public :: emit_sample
 
   integer, parameter :: n_columns = 10
   character(len=*), parameter :: column_names = &
@@ -104,6 +105,21 @@ module impact1d_output
   character(len=*), parameter :: row_format = '(*(es25.16e3))'
 
 contains
+
+  !> Send one sample (t, x, v and the energy ledger) to a sink, keeping the run's statistics:
+  !> both methods report through here, so their columns cannot drift apart.
+  subroutine emit_sample(sink, stats, t, x, v, mass, ke0, work, friction_loss, impact_loss)
+    class(sink_type), intent(inout) :: sink
+    type(run_stats), intent(inout) :: stats
+    real(wp), intent(in) :: t, x(2), v(2), mass(2), ke0, work, friction_loss, impact_loss
+    real(wp) :: row(n_columns), ke
+    ke = 0.5_wp * dot_product(mass, v**2)
+    row = [t, x(1), v(1), x(2), v(2), ke, work, friction_loss, impact_loss, &
+      ke - ke0 - work + friction_loss + impact_loss]
+    stats%max_residual = max(stats%max_residual, abs(row(n_columns)))
+    stats%last_row = row
+    call sink%put_sample(row)
+  end subroutine emit_sample
 
   !> Called by the stepping loop every few thousand steps: cheap unless a line is due.
   subroutine progress(self, t, t_end)

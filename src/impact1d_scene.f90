@@ -12,6 +12,7 @@ module impact1d_scene
   public :: i_m1, i_m2, i_mu1, i_mu2, i_g, i_x_left, i_r_left, i_x_right, i_r_right, i_d_min, &
     i_r_min, i_d_max, i_r_max, i_x1, i_v1, i_x2, i_v2, i_f1, i_f2, i_f1_amp, i_f1_period, &
     i_f1_phase, i_f2_amp, i_f2_period, i_f2_phase, i_t_end, i_dt, i_dt_out, i_zero_vel
+  public :: sample_time
   public :: i_title, i_f1_table, i_f2_table, i_method, max_samples, default_gravity
 
   integer, parameter :: n_real = 29, n_text = 4
@@ -292,6 +293,17 @@ contains
     scene%n_samples = nint(ratio) + 1
     if (abs(ratio - nint(ratio)) > 1.0e-9_wp * max(1.0_wp, ratio)) scene%n_samples = floor(ratio) + 2
   end subroutine build_scene
+
+  !> Time of output sample j (0-based): j dt_out, and t_end for the last one.
+  pure real(wp) function sample_time(scene, j)
+    type(scene_type), intent(in) :: scene
+    integer, intent(in) :: j
+    if (j == scene%n_samples - 1) then
+      sample_time = scene%t_end
+    else
+      sample_time = j * scene%dt_out
+    end if
+  end function sample_time
 
   !> Index of the variable that names constraint k (its limit); the restitution follows it.
   pure integer function limit_index(k)

@@ -5,12 +5,12 @@
 module impact1d_solver
   use impact1d_kinds, only: wp, eps_wp
   use impact1d_error, only: error_type, raise, status_simulation, fmt
-  use impact1d_scene, only: scene_type, n_contacts, normal, contact_names
+  use impact1d_scene, only: scene_type, n_contacts, normal, sample_time
   use impact1d_modes, only: mode_type, solve_mode, max_holds
   use impact1d_events, only: hermite, earliest_crossing
   use impact1d_impacts, only: normal_velocity, impulse, most_approaching, restitution_of, &
     kinetic_energy
-  use impact1d_output, only: sink_type, run_stats, n_columns, event_impact, event_rest, &
+  use impact1d_output, only: sink_type, run_stats, emit_sample, event_impact, event_rest, &
     event_release, event_stick, event_slip
   use impact1d_vissim, only: run_vissim
   implicit none
@@ -69,10 +69,10 @@ contains
     call event_point(initial=.true., located_body=0)
     if (allocated(error)) return
     j_sample = 0
-    call emit_sample()
+    call emit()
 
     do while (j_sample < scene%n_samples)
-      sample_t = sample_time(j_sample)
+      sample_t = sample_time(scene, j_sample)
       t_break = scene%forcing%next_breakpoint(s%t)
       t_stop = min(sample_t, t_break, minval(pending_rest))
       h = min(scene%dt, t_stop - s%t)
@@ -134,31 +134,17 @@ contains
         call event_point(initial=.false., located_body=merge(watched - 100, 0, watched > 100 .and. located))
         if (allocated(error)) return
       end if
-      if (at_stop .and. s%t == sample_t) call emit_sample()
+      if (at_stop .and. s%t == sample_t) call emit()
     end do
     call sink%end_progress()
 
   contains
 
-    pure real(wp) function sample_time(j)
-      integer, intent(in) :: j
-      if (j == scene%n_samples - 1) then
-        sample_time = scene%t_end
-      else
-        sample_time = j * scene%dt_out
-      end if
-    end function sample_time
-
-    subroutine emit_sample()
-      real(wp) :: row(n_columns), ke
-      ke = kinetic_energy(scene, s%v)
-      row = [s%t, s%x(1) + s%x_lo(1), s%v(1), s%x(2) + s%x_lo(2), s%v(2), ke, s%work, s%friction_loss, s%impact_loss, &
-        ke - ke0 - s%work + s%friction_loss + s%impact_loss]
-      stats%max_residual = max(stats%max_residual, abs(row(n_columns)))
-      stats%last_row = row
-      call sink%put_sample(row)
+    subroutine emit()
+      call emit_sample(sink, stats, s%t, s%x + s%x_lo, s%v, scene%mass, ke0, s%work, s%friction_loss, &
+        s%impact_loss)
       j_sample = j_sample + 1
-    end subroutine emit_sample
+    end subroutine emit
 
     subroutine log_event(kind, v_before, v_after)
       integer, intent(in) :: kind

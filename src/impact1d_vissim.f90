@@ -7,9 +7,10 @@
 module impact1d_vissim
   use impact1d_kinds, only: wp
   use impact1d_error, only: error_type, raise, status_simulation, fmt
-  use impact1d_scene, only: scene_type, n_contacts, normal, i_left, i_right, i_slot_min, i_slot_max
+  use impact1d_scene, only: scene_type, n_contacts, normal, i_left, i_right, i_slot_min, i_slot_max, &
+    sample_time
   use impact1d_impacts, only: impulse, kinetic_energy
-  use impact1d_output, only: sink_type, run_stats, n_columns, event_impact
+  use impact1d_output, only: sink_type, run_stats, emit_sample, event_impact
   implicit none
   private
   public :: run_vissim
@@ -38,7 +39,7 @@ contains
     j_sample = 0
     call emit()
     do while (j_sample < scene%n_samples)
-      t_sample = sample_time(j_sample)
+      t_sample = sample_time(scene, j_sample)
       h = min(scene%dt, t_sample - t)
       if (t_sample - t - h <= 1.0e-9_wp * scene%dt) h = t_sample - t
       v_prev = v
@@ -79,24 +80,8 @@ contains
 
   contains
 
-    pure real(wp) function sample_time(j)
-      integer, intent(in) :: j
-      if (j == scene%n_samples - 1) then
-        sample_time = scene%t_end
-      else
-        sample_time = j * scene%dt_out
-      end if
-    end function sample_time
-
     subroutine emit()
-      real(wp) :: row(n_columns), ke, v_out(2)
-      v_out = threshold(v)
-      ke = kinetic_energy(scene, v_out)
-      row = [t, x(1), v_out(1), x(2), v_out(2), ke, work, friction_loss, impact_loss, &
-        ke - ke0 - work + friction_loss + impact_loss]
-      stats%max_residual = max(stats%max_residual, abs(row(n_columns)))
-      stats%last_row = row
-      call sink%put_sample(row)
+      call emit_sample(sink, stats, t, x, threshold(v), scene%mass, ke0, work, friction_loss, impact_loss)
       j_sample = j_sample + 1
     end subroutine emit
 

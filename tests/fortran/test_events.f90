@@ -3,10 +3,10 @@
 program test_events
   use impact1d_kinds, only: wp
   use impact1d_events, only: earliest_crossing, hermite, poly_value
+  use testing, only: check, finish
   implicit none
   ! Roots of these cubics are known to the last bit; bisection should land within a few ulps.
   real(wp), parameter :: root_tol = 1.0e-14_wp
-  integer :: failures = 0
   real(wp) :: theta, c(3)
 
   ! g = (theta - 0.2)(theta - 0.6)(theta + 1): positive, dips below zero on (0.2, 0.6), back up.
@@ -36,8 +36,7 @@ program test_events
   c = hermite(motion(0.7_wp), velocity(0.0_wp), velocity(0.7_wp), 0.7_wp)
   call check(all(abs(c - [2.0_wp, -3.0_wp, 0.5_wp]) < 1.0e-13_wp), 'Hermite is exact for a cubic')
 
-  if (failures > 0) error stop 1
-  print '(a)', 'test_events: all passed'
+  call finish('test_events')
 
 contains
 
@@ -58,11 +57,4 @@ contains
     velocity = 2.0_wp - 6.0_wp * t + 1.5_wp * t**2
   end function velocity
 
-  subroutine check(condition, what)
-    logical, intent(in) :: condition
-    character(len=*), intent(in) :: what
-    if (condition) return
-    failures = failures + 1
-    print '(a)', 'FAILED: ' // what
-  end subroutine check
 end program test_events

@@ -4,10 +4,10 @@ program test_impacts
   use impact1d_kinds, only: wp
   use impact1d_scene, only: scene_type, i_left, i_right, i_slot_min, i_slot_max
   use impact1d_impacts, only: impulse, normal_velocity, most_approaching, restitution_of
+  use testing, only: check, finish
   implicit none
   ! One impulse is a handful of flops on O(10) numbers: a few ulps of them.
   real(wp), parameter :: tol = 1.0e-13_wp
-  integer :: failures = 0
   type(scene_type) :: scene
   real(wp) :: v(2), v_after(2), r, expected(2)
   logical :: closed(4)
@@ -41,16 +41,6 @@ program test_impacts
   closed = [.false., .false., .true., .true.]
   call check(restitution_of(scene, i_slot_min, closed) == 0.0_wp, 'a rigid link (both slot limits closed) does not rebound')
 
-  if (failures > 0) error stop 1
-  print '(a)', 'test_impacts: all passed'
+  call finish('test_impacts')
 
-contains
-
-  subroutine check(condition, what)
-    logical, intent(in) :: condition
-    character(len=*), intent(in) :: what
-    if (condition) return
-    failures = failures + 1
-    print '(a)', 'FAILED: ' // what
-  end subroutine check
 end program test_impacts

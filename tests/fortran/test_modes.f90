@@ -4,10 +4,10 @@ program test_modes
   use impact1d_kinds, only: wp
   use impact1d_scene, only: scene_type, i_left, i_slot_min
   use impact1d_modes, only: mode_type, solve_mode
+  use testing, only: check, finish
   implicit none
   ! Accelerations here are ratios of small integers: exact to a few ulps.
   real(wp), parameter :: tol = 1.0e-13_wp
-  integer :: failures = 0
   type(scene_type) :: scene
   type(mode_type) :: mode
   logical :: found
@@ -63,16 +63,6 @@ program test_modes
   call check(abs(h(1) - 5.0_wp) < tol .and. mode%n_hold == 1, &
     'the slot contact force is 5 N (body 1: 6 - 5 = 1 * a)')
 
-  if (failures > 0) error stop 1
-  print '(a)', 'test_modes: all passed'
+  call finish('test_modes')
 
-contains
-
-  subroutine check(condition, what)
-    logical, intent(in) :: condition
-    character(len=*), intent(in) :: what
-    if (condition) return
-    failures = failures + 1
-    print '(a)', 'FAILED: ' // what
-  end subroutine check
 end program test_modes
