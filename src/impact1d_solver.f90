@@ -50,7 +50,8 @@ contains
     type(state_type) :: s, trial
     type(mode_type) :: mode
     real(wp) :: ke0, t_stop, t_break, h, h_event, pending_rest(n_contacts), sample_t
-    logical :: in_contact(n_contacts), at_rest(2), located, at_stop
+    logical :: in_contact(n_contacts), at_rest(2), located, at_stop, constant_forcing, watching
+    real(wp) :: constant_acceleration(2)
     integer :: j_sample, stalls, halvings, watched
     real(wp) :: t_last_event
 
@@ -58,6 +59,8 @@ contains
       call run_vissim(scene, sink, stats, error)
       return
     end if
+    constant_forcing = .not. (any(scene%forcing%has_table) .or. any(scene%forcing%has_sine))
+    watching = .true.
     s%t = 0.0_wp
     s%x = scene%x0
     s%v = scene%v0
@@ -83,14 +86,15 @@ contains
 
       halvings = 0
       do
+        located = .false.
+        watched = 0
         ! An event that landed exactly on the stop leaves nothing to step.
         if (h <= 0.0_wp) then
           trial = s
-          located = .false.
-          watched = 0
           exit
         end if
         call rk4_step(s, h, trial)
+        if (.not. watching) exit      ! nothing in this mode can end it: no location needed
         call locate(s, trial, h, h_event, watched)
         located = h_event <= h
         if (located) then
@@ -183,13 +187,23 @@ contains
       type(state_type), intent(out) :: b
       real(wp) :: f0(2), fm(2), f1(2), a0(2), am(2), a1(2)
       real(wp) :: k1x(2), k2x(2), k3x(2), k4x(2), vm(2), dx(2)
-      f0 = scene%forcing%force(a%t)
-      fm = scene%forcing%force(a%t + 0.5_wp * step)
-      f1 = scene%forcing%force(a%t + step)
-      ! Within a mode the acceleration depends on time only, so stages 2 and 3 share it.
-      a0 = mode%acceleration(f0)
-      am = mode%acceleration(fm)
-      a1 = mode%acceleration(f1)
+      if (constant_forcing) then
+        ! Constant forces: the mode's acceleration was worked out once, at the event point.
+        f0 = scene%forcing%constant
+        fm = f0
+        f1 = f0
+        a0 = constant_acceleration
+        am = a0
+        a1 = a0
+      else
+        f0 = scene%forcing%force(a%t)
+        fm = scene%forcing%force(a%t + 0.5_wp * step)
+        f1 = scene%forcing%force(a%t + step)
+        ! Within a mode the acceleration depends on time only, so stages 2 and 3 share it.
+        a0 = mode%acceleration(f0)
+        am = mode%acceleration(fm)
+        a1 = mode%acceleration(f1)
+      end if
       k1x = a%v
       k2x = a%v + 0.5_wp * step * a0
       k3x = a%v + 0.5_wp * step * am
@@ -519,6 +533,9 @@ contains
         at_rest(i) = resting_now
       end do
       mode = new_mode
+      if (constant_forcing) constant_acceleration = mode%acceleration(scene%forcing%constant)
+      watching = mode%n_hold > 0 .or. any(scene%has_contact .and. .not. mode%active) .or. &
+        any(scene%friction > 0.0_wp .and. mode%sgn /= 0.0_wp)
     end subroutine event_point
 
     !> Set new velocities at an instant, booking the kinetic energy they remove as impact loss.
