@@ -5,7 +5,7 @@
 module impact1d_solver
   use impact1d_kinds, only: wp, eps_wp
   use impact1d_error, only: error_type, raise, status_simulation, fmt
-  use impact1d_scene, only: scene_type, n_contacts, normal, sample_time
+  use impact1d_scene, only: scene_type, n_contacts, normal, sample_time, i_slot_min, i_slot_max
   use impact1d_modes, only: mode_type, solve_mode, max_holds
   use impact1d_events, only: hermite, earliest_crossing
   use impact1d_impacts, only: normal_velocity, impulse, most_approaching, restitution_of, &
@@ -71,7 +71,7 @@ contains
     stalls = 0
     t_last_event = -huge(1.0_wp)
 
-    call event_point(initial=.true., located_body=0)
+    call event_point(initial=.true., which=0)
     if (allocated(error)) return
     j_sample = 0
     call emit()
@@ -106,7 +106,7 @@ contains
             exit
           end if
         end if
-        if (constraints_hold(trial)) exit
+        if (constraints_hold(trial, merge(watched, 0, located))) exit
         ! The location missed a root (only possible for non-polynomial forcing): retry shorter.
         halvings = halvings + 1
         if (halvings > max_halvings) then
@@ -146,7 +146,7 @@ contains
         end if
         t_last_event = s%t
         call flush_pending_rest()
-        call event_point(initial=.false., located_body=merge(watched - 100, 0, watched > 100 .and. located))
+        call event_point(initial=.false., which=merge(watched, 0, located))
         if (allocated(error)) return
       end if
       if (at_stop .and. s%t == sample_t) call emit()
@@ -238,7 +238,7 @@ contains
         if (.not. scene%has_contact(k) .or. mode%active(k)) cycle
         p(0) = gap(k, a)
         p(1:3) = normal(1, k) * c(:, 1) + normal(2, k) * c(:, 2)
-        candidate = earliest_crossing(p, step, gap_tolerance(k, a))
+        candidate = earliest_crossing(p, step, gap_tolerance(k, a, displacement(k, a, b)))
         if (candidate < theta) then
           theta = candidate
           which = k
@@ -332,7 +332,7 @@ contains
         else
           value = gap(which, b)
           slope = normal_velocity(which, b%v)
-          tol = gap_tolerance(which, b)
+          tol = gap_tolerance(which, b, displacement(which, a, b))
         end if
         if (abs(value) <= tol .or. slope == 0.0_wp) exit
         if (step - value / slope <= 0.0_wp) exit
@@ -348,18 +348,22 @@ contains
       impact_due = .false.
       do k = 1, n_contacts
         if (.not. scene%has_contact(k) .or. mode%active(k)) cycle
-        if (gap(k, s) <= gap_tolerance(k, s) .and. normal_velocity(k, s%v) < -u_tolerance(k)) impact_due = .true.
+        if (gap(k, s) <= gap_tolerance(k, s, 0.0_wp) .and. normal_velocity(k, s%v) < -u_tolerance(k)) &
+          impact_due = .true.
       end do
     end function impact_due
 
     !> No step may end with a gap below zero beyond rounding, nor a sliding body past zero.
-    logical function constraints_hold(b)
+    !> The contact whose closing ended the step (located_contact) is put on its constraint at
+    !> the event point, so its own rounding does not count.
+    logical function constraints_hold(b, located_contact)
       type(state_type), intent(in) :: b
+      integer, intent(in) :: located_contact
       integer :: k, i
       constraints_hold = .true.
       do k = 1, n_contacts
-        if (.not. scene%has_contact(k) .or. mode%active(k)) cycle
-        if (gap(k, b) < -gap_tolerance(k, b)) constraints_hold = .false.
+        if (.not. scene%has_contact(k) .or. mode%active(k) .or. k == located_contact) cycle
+        if (gap(k, b) < -gap_tolerance(k, b, displacement(k, s, b))) constraints_hold = .false.
       end do
       do i = 1, 2
         if (scene%friction(i) == 0.0_wp .or. mode%sgn(i) == 0.0_wp) cycle
@@ -374,13 +378,26 @@ contains
       gap = (dot_product(normal(:, k), state%x) + scene%offset(k)) + dot_product(normal(:, k), state%x_lo)
     end function gap
 
-    !> Rounding level of gap k: from the positions it involves only, so a body near the
-    !> origin is not judged by one far away.
-    pure real(wp) function gap_tolerance(k, state)
+    !> Rounding level of gap k. A wall gap is exact to its own size (compensated positions),
+    !> so only what a step moved it by counts; a slot gap is also rounded to its limit. A gap
+    !> closing within the clock's resolution is closed now: this is what makes contacts hit
+    !> at the same instant one event, while a tiny flight elsewhere keeps its own time.
+    pure real(wp) function gap_tolerance(k, state, moved)
       integer, intent(in) :: k
       type(state_type), intent(in) :: state
-      gap_tolerance = gap_rounding * position_scale(k, state)
+      real(wp), intent(in) :: moved
+      gap_tolerance = gap_rounding * moved + time_rounding * max(abs(state%t), scene%dt) * &
+        max(0.0_wp, -normal_velocity(k, state%v))
+      if (k == i_slot_min .or. k == i_slot_max) gap_tolerance = gap_tolerance + &
+        gap_rounding * position_scale(k, state)
     end function gap_tolerance
+
+    !> How far a step from a to b moved gap k (through either body).
+    pure real(wp) function displacement(k, a, b)
+      integer, intent(in) :: k
+      type(state_type), intent(in) :: a, b
+      displacement = dot_product(abs(normal(:, k)), abs((b%x - a%x) + (b%x_lo - a%x_lo)))
+    end function displacement
 
     pure real(wp) function position_scale(k, state)
       integer, intent(in) :: k
@@ -414,20 +431,20 @@ contains
     !> Everything that happens at one instant: closed contacts snapped, impacts resolved by
     !> sequential impulses, unresolvable bounce series put to rest (Zeno), stopped bodies
     !> zeroed, then the new mode from the complementarity problem, and the log of what changed.
-    subroutine event_point(initial, located_body)
+    !> which: what the location found (contact k, 100 + body i) or 0.
+    subroutine event_point(initial, which)
       logical, intent(in) :: initial
-      integer, intent(in) :: located_body
+      integer, intent(in) :: which
       logical :: closed(n_contacts), candidate(n_contacts), resting(2), found, leaving, resting_now
       real(wp) :: f(2), df(2), v_before(2), v_after(2), moving_sign(2), acc(2), tol_a(2), acc_rate(2)
-      real(wp) :: u, a_gap, flight, remaining
       integer :: k, i, n_impulses
-      type(mode_type) :: free_mode, new_mode
+      type(mode_type) :: new_mode
 
       f = scene%forcing%force(s%t)
       df = scene%forcing%rate(s%t)
       do k = 1, n_contacts
         closed(k) = scene%has_contact(k)
-        if (closed(k)) closed(k) = gap(k, s) <= gap_tolerance(k, s)
+        if (closed(k)) closed(k) = k == which .or. gap(k, s) <= gap_tolerance(k, s, 0.0_wp)
       end do
       do k = 1, n_contacts
         if (closed(k)) call snap(k, closed)
@@ -437,7 +454,7 @@ contains
       acc = mode%acceleration(f)
       do i = 1, 2
         if (scene%friction(i) == 0.0_wp) cycle
-        if (i == located_body .or. abs(s%v(i)) <= velocity_rounding * abs(acc(i)) * scene%dt) then
+        if (i == which - 100 .or. abs(s%v(i)) <= velocity_rounding * abs(acc(i)) * scene%dt) then
           s%v(i) = 0.0_wp
           s%v_lo(i) = 0.0_wp
         end if
@@ -466,32 +483,17 @@ contains
           call apply(impulse(scene, k, 0.0_wp, s%v))
       end do
 
-      ! Zeno: a bounce whose next flight (or whole remaining series) is below what the state
-      ! can resolve ends in rest now; the rest is logged at the series' accumulation time.
+      ! Zeno: a bounce series whose remaining time is below the clock's resolution, or (on the
+      ! slot, whose gap is resolved only to rounding of the limit) whose next flight is below
+      ! what a gap can resolve, ends in rest now; the rest is logged at the accumulation time.
       do k = 1, n_contacts
         if (.not. closed(k)) cycle
-        u = normal_velocity(k, s%v)
-        if (u <= u_tolerance(k)) cycle
-        call candidates(closed, candidate, resting, moving_sign)
-        candidate(k) = .false.
-        call solve_mode(scene, f, df, candidate, resting, moving_sign, free_mode, found)
-        if (.not. found) cycle
-        acc = free_mode%acceleration(f)
-        a_gap = dot_product(normal(:, k), acc)
-        if (a_gap >= 0.0_wp) cycle
-        flight = 2.0_wp * u / (-a_gap)
-        remaining = huge(1.0_wp)
-        if (restitution_of(scene, k, closed) < 1.0_wp) remaining = flight / (1.0_wp - restitution_of(scene, k, closed))
-        if (u**2 / (-2.0_wp * a_gap) > zeno_height * position_scale(k, s) &
-            .and. remaining > time_rounding * max(abs(s%t), scene%dt)) cycle
-        call apply(impulse(scene, k, 0.0_wp, s%v))
-        in_contact(k) = .true.
-        if (remaining < huge(1.0_wp)) then
-          pending_rest(k) = s%t + remaining
-        else
-          call log_event(event_rest + k, s%v, s%v)
-        end if
+        call bounce_series(k, f, df, closed)
+        if (allocated(error)) return
       end do
+
+      ! Impulses can leave a rounding-level velocity on a body that had stopped; it is zero.
+      call zero_stopped(acc)
 
       call candidates(closed, candidate, resting, moving_sign)
       call solve_mode(scene, f, df, candidate, resting, moving_sign, new_mode, found)
@@ -537,6 +539,75 @@ contains
       watching = mode%n_hold > 0 .or. any(scene%has_contact .and. .not. mode%active) .or. &
         any(scene%friction > 0.0_wp .and. mode%sgn /= 0.0_wp)
     end subroutine event_point
+
+    !> The bounce series on closed contact k, if its bodies separate slowly: gap acceleration
+    !> while rising (a_up) and falling back (a_down) come from the mode with k left free, for
+    !> the velocities now and with the normal velocity reversed (friction may change sides).
+    !> Under constant forces each arc takes u/|a_up| + u/sqrt(a_up a_down) and the next impact
+    !> speed is r u sqrt(a_down/a_up): the series is geometric and its sum is closed form.
+    subroutine bounce_series(k, f, df, closed)
+      integer, intent(in) :: k
+      real(wp), intent(in) :: f(2), df(2)
+      logical, intent(in) :: closed(n_contacts)
+      real(wp) :: u, a_up, a_down, ratio, first_arc, remaining, height_resolution
+      real(wp) :: r
+      u = normal_velocity(k, s%v)
+      if (u <= u_tolerance(k)) return
+      a_up = free_gap_acceleration(k, s%v, f, df, closed)
+      if (a_up >= 0.0_wp) return
+      a_down = free_gap_acceleration(k, impulse(scene, k, 1.0_wp, s%v), f, df, closed)
+      r = restitution_of(scene, k, closed)
+      remaining = huge(1.0_wp)
+      if (a_down < 0.0_wp) then
+        first_arc = u / (-a_up) + u / sqrt(a_up * a_down)
+        ratio = r * sqrt(a_down / a_up)
+        if (ratio < 1.0_wp) remaining = first_arc / (1.0_wp - ratio)
+      end if
+      ! Wall gaps are exact to their own size (compensated positions); a slot gap only to the
+      ! rounding of its limit, so a slot flight lower than that cannot be followed.
+      height_resolution = 0.0_wp
+      if (k == i_slot_min .or. k == i_slot_max) height_resolution = zeno_height * position_scale(k, s)
+      if (u**2 / (-2.0_wp * a_up) > height_resolution .and. &
+          remaining > time_rounding * max(abs(s%t), scene%dt)) return
+      call apply(impulse(scene, k, 0.0_wp, s%v))
+      in_contact(k) = .true.
+      if (remaining < huge(1.0_wp)) then
+        pending_rest(k) = s%t + remaining
+      else
+        call log_event(event_rest + k, s%v, s%v)
+      end if
+    end subroutine bounce_series
+
+    !> Normal acceleration of contact k with k left free and the others as they are.
+    real(wp) function free_gap_acceleration(k, v, f, df, closed) result(a_gap)
+      integer, intent(in) :: k
+      real(wp), intent(in) :: v(2), f(2), df(2)
+      logical, intent(in) :: closed(n_contacts)
+      type(mode_type) :: free_mode
+      logical :: candidate(n_contacts), resting(2), found
+      real(wp) :: moving_sign(2), v_saved(2)
+      v_saved = s%v
+      s%v = v
+      call candidates(closed, candidate, resting, moving_sign)
+      s%v = v_saved
+      candidate(k) = .false.
+      call solve_mode(scene, f, df, candidate, resting, moving_sign, free_mode, found)
+      a_gap = 0.0_wp
+      if (found) a_gap = dot_product(normal(:, k), free_mode%acceleration(f))
+    end function free_gap_acceleration
+
+    !> Bodies whose velocity is below the rounding of what a step changes it by are at rest.
+    subroutine zero_stopped(acc)
+      real(wp), intent(in) :: acc(2)
+      integer :: i
+      do i = 1, 2
+        if (s%v(i) /= 0.0_wp .and. abs(s%v(i)) <= velocity_rounding * abs(acc(i)) * scene%dt) then
+          s%impact_loss = s%impact_loss + 0.5_wp * scene%mass(i) * s%v(i)**2
+          s%v(i) = 0.0_wp
+          s%v_lo(i) = 0.0_wp
+        end if
+      end do
+    end subroutine zero_stopped
 
     !> Set new velocities at an instant, booking the kinetic energy they remove as impact loss.
     subroutine apply(v_new)
