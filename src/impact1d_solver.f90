@@ -51,6 +51,9 @@ contains
     type(mode_type) :: mode
     real(wp) :: ke0, t_stop, t_break, h, h_event, pending_rest(n_contacts), sample_t
     logical :: in_contact(n_contacts), at_rest(2), located, at_stop, constant_forcing, watching
+    ! Velocity scale of each body entering the current event point: impulses redistribute
+    ! velocity but cannot create precision, so what is below its rounding is zero.
+    real(wp) :: entry_scale(2)
     real(wp) :: constant_acceleration(2)
     integer :: j_sample, stalls, halvings, watched
     real(wp) :: t_last_event
@@ -60,6 +63,7 @@ contains
       return
     end if
     constant_forcing = .not. (any(scene%forcing%has_table) .or. any(scene%forcing%has_sine))
+    entry_scale = 0.0_wp
     watching = .true.
     s%t = 0.0_wp
     s%x = scene%x0
@@ -452,6 +456,7 @@ contains
       ! A sliding body whose stop was located, or that stopped within rounding (its velocity
       ! change over a step is the scale), is at rest.
       acc = mode%acceleration(f)
+      entry_scale = abs(s%v) + abs(acc) * scene%dt
       do i = 1, 2
         if (scene%friction(i) == 0.0_wp) cycle
         if (i == which - 100 .or. abs(s%v(i)) <= velocity_rounding * abs(acc(i)) * scene%dt) then
@@ -473,10 +478,12 @@ contains
         v_before = s%v
         v_after = impulse(scene, k, restitution_of(scene, k, closed), s%v)
         call apply(v_after)
+        if (all(normal(:, k) /= 0.0_wp)) entry_scale = maxval(entry_scale)
         call log_event(event_impact + k, v_before, v_after)
       end do
 
       ! Contacts left with a rounding-level normal velocity are closed and still.
+      call zero_stopped(acc)
       do k = 1, n_contacts
         if (.not. closed(k)) cycle
         if (abs(normal_velocity(k, s%v)) <= u_tolerance(k) .and. normal_velocity(k, s%v) /= 0.0_wp) &
@@ -535,6 +542,7 @@ contains
         at_rest(i) = resting_now
       end do
       mode = new_mode
+      entry_scale = 0.0_wp
       if (constant_forcing) constant_acceleration = mode%acceleration(scene%forcing%constant)
       watching = mode%n_hold > 0 .or. any(scene%has_contact .and. .not. mode%active) .or. &
         any(scene%friction > 0.0_wp .and. mode%sgn /= 0.0_wp)
@@ -596,12 +604,14 @@ contains
       if (found) a_gap = dot_product(normal(:, k), free_mode%acceleration(f))
     end function free_gap_acceleration
 
-    !> Bodies whose velocity is below the rounding of what a step changes it by are at rest.
+    !> Bodies whose velocity is below the rounding of what a step changes it by, or of the
+    !> velocities this event point started from, are at rest.
     subroutine zero_stopped(acc)
       real(wp), intent(in) :: acc(2)
       integer :: i
       do i = 1, 2
-        if (s%v(i) /= 0.0_wp .and. abs(s%v(i)) <= velocity_rounding * abs(acc(i)) * scene%dt) then
+        if (s%v(i) /= 0.0_wp .and. abs(s%v(i)) <= velocity_rounding * max(abs(acc(i)) * scene%dt, &
+            entry_scale(i))) then
           s%impact_loss = s%impact_loss + 0.5_wp * scene%mass(i) * s%v(i)**2
           s%v(i) = 0.0_wp
           s%v_lo(i) = 0.0_wp
@@ -638,7 +648,8 @@ contains
       integer, intent(in) :: k
       real(wp) :: acc(2)
       acc = mode%acceleration(scene%forcing%force(s%t))
-      u_tolerance = velocity_rounding * dot_product(abs(normal(:, k)), abs(s%v) + abs(acc) * scene%dt)
+      u_tolerance = velocity_rounding * dot_product(abs(normal(:, k)), &
+        max(abs(s%v) + abs(acc) * scene%dt, entry_scale))
     end function u_tolerance
 
     function u_tolerances() result(tol)
