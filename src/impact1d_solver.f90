@@ -19,7 +19,6 @@ module impact1d_solver
 
   !> Tolerances, each a multiple of the unit roundoff of the quantity it guards.
   real(wp), parameter :: gap_rounding = 16.0_wp * eps_wp      !< a gap this small (x scale) is closed
-  real(wp), parameter :: zeno_height = 256.0_wp * eps_wp      !< flights lower than this are unresolvable
   real(wp), parameter :: velocity_rounding = 64.0_wp * eps_wp !< a velocity this small is zero
   real(wp), parameter :: time_rounding = 64.0_wp * eps_wp     !< instants closer than this coincide
   integer, parameter :: max_impulses = 1000000   !< per event point; elastic chains need ~pi sqrt(M/m)
@@ -376,24 +375,30 @@ contains
       end do
     end function constraints_hold
 
+    !> Gap k of a state, exact to its own size: x2 - x1 is formed without rounding (two-sum),
+    !> and subtracting a limit it is close to is exact, so the slot is resolved like a wall.
     pure real(wp) function gap(k, state)
       integer, intent(in) :: k
       type(state_type), intent(in) :: state
-      gap = (dot_product(normal(:, k), state%x) + scene%offset(k)) + dot_product(normal(:, k), state%x_lo)
+      real(wp) :: a, b, total, rounded
+      a = normal(1, k) * state%x(1)
+      b = normal(2, k) * state%x(2)
+      total = a + b
+      rounded = total - a
+      gap = (total + scene%offset(k)) + (((a - (total - rounded)) + (b - rounded)) + &
+        dot_product(normal(:, k), state%x_lo))
     end function gap
 
-    !> Rounding level of gap k. A wall gap is exact to its own size (compensated positions),
-    !> so only what a step moved it by counts; a slot gap is also rounded to its limit. A gap
-    !> closing within the clock's resolution is closed now: this is what makes contacts hit
-    !> at the same instant one event, while a tiny flight elsewhere keeps its own time.
+    !> Rounding level of gap k. A gap is exact to its own size (compensated positions, exact
+    !> differences), so only what a step moved it by counts. A gap closing within the clock's
+    !> resolution is closed now: this is what makes contacts hit at the same instant one
+    !> event, while a tiny flight elsewhere keeps its own time.
     pure real(wp) function gap_tolerance(k, state, moved)
       integer, intent(in) :: k
       type(state_type), intent(in) :: state
       real(wp), intent(in) :: moved
       gap_tolerance = gap_rounding * moved + time_rounding * max(abs(state%t), scene%dt) * &
         max(0.0_wp, -normal_velocity(k, state%v))
-      if (k == i_slot_min .or. k == i_slot_max) gap_tolerance = gap_tolerance + &
-        gap_rounding * position_scale(k, state)
     end function gap_tolerance
 
     !> How far a step from a to b moved gap k (through either body).
@@ -403,16 +408,12 @@ contains
       displacement = dot_product(abs(normal(:, k)), abs((b%x - a%x) + (b%x_lo - a%x_lo)))
     end function displacement
 
-    pure real(wp) function position_scale(k, state)
-      integer, intent(in) :: k
-      type(state_type), intent(in) :: state
-      position_scale = max(maxval(abs(normal(:, k) * state%x)), abs(scene%offset(k)))
-    end function position_scale
 
     !> Put a closed contact exactly on its constraint (gap = 0, no roundoff penetration).
     subroutine snap(k, closed)
       integer, intent(in) :: k
       logical, intent(in) :: closed(n_contacts)
+      real(wp) :: limit
       select case (k)
       case (1)
         s%x(1) = -scene%offset(1)
@@ -422,12 +423,16 @@ contains
         s%x_lo(2) = 0.0_wp
       case (3, 4)
         ! Move the body that no wall holds.
+        ! x2 = x1 + d exactly, the sum's rounding kept in the low part.
+        limit = merge(-scene%offset(3), scene%offset(4), k == 3)
         if (closed(2)) then
-          s%x(1) = s%x(2) - merge(-scene%offset(3), scene%offset(4), k == 3)
+          s%x(1) = s%x(2)
           s%x_lo(1) = s%x_lo(2)
+          call add_compensated(s%x(1), s%x_lo(1), -limit)
         else
-          s%x(2) = s%x(1) + merge(-scene%offset(3), scene%offset(4), k == 3)
+          s%x(2) = s%x(1)
           s%x_lo(2) = s%x_lo(1)
+          call add_compensated(s%x(2), s%x_lo(2), limit)
         end if
       end select
     end subroutine snap
@@ -449,7 +454,18 @@ contains
       do k = 1, n_contacts
         closed(k) = scene%has_contact(k)
         if (closed(k)) closed(k) = k == which .or. gap(k, s) <= gap_tolerance(k, s, 0.0_wp)
+        ! The user's numbers carry their decimal rounding (7.553 - 7.122 is not 0.431): at the
+        ! start, a gap within it is contact, as the validator accepted it.
+        if (initial .and. scene%has_contact(k)) closed(k) = closed(k) .or. gap(k, s) <= &
+          gap_rounding * max(maxval(abs(normal(:, k) * s%x)), abs(scene%offset(k)))
       end do
+      ! A rigid link (d_min = d_max) is one constraint seen from both sides.
+      if (scene%has_contact(i_slot_min) .and. scene%has_contact(i_slot_max)) then
+        if (scene%offset(i_slot_min) == -scene%offset(i_slot_max)) then
+          closed(i_slot_min) = closed(i_slot_min) .or. closed(i_slot_max)
+          closed(i_slot_max) = closed(i_slot_min)
+        end if
+      end if
       do k = 1, n_contacts
         if (closed(k)) call snap(k, closed)
       end do
@@ -490,9 +506,8 @@ contains
           call apply(impulse(scene, k, 0.0_wp, s%v))
       end do
 
-      ! Zeno: a bounce series whose remaining time is below the clock's resolution, or (on the
-      ! slot, whose gap is resolved only to rounding of the limit) whose next flight is below
-      ! what a gap can resolve, ends in rest now; the rest is logged at the accumulation time.
+      ! Zeno: a bounce series whose remaining time is below the clock's resolution ends in
+      ! rest now; the rest is logged at the series' accumulation time.
       do k = 1, n_contacts
         if (.not. closed(k)) cycle
         call bounce_series(k, f, df, closed)
@@ -557,7 +572,7 @@ contains
       integer, intent(in) :: k
       real(wp), intent(in) :: f(2), df(2)
       logical, intent(in) :: closed(n_contacts)
-      real(wp) :: u, a_up, a_down, ratio, first_arc, remaining, height_resolution
+      real(wp) :: u, a_up, a_down, ratio, first_arc, remaining
       real(wp) :: r
       u = normal_velocity(k, s%v)
       if (u <= u_tolerance(k)) return
@@ -571,12 +586,9 @@ contains
         ratio = r * sqrt(a_down / a_up)
         if (ratio < 1.0_wp) remaining = first_arc / (1.0_wp - ratio)
       end if
-      ! Wall gaps are exact to their own size (compensated positions); a slot gap only to the
-      ! rounding of its limit, so a slot flight lower than that cannot be followed.
-      height_resolution = 0.0_wp
-      if (k == i_slot_min .or. k == i_slot_max) height_resolution = zeno_height * position_scale(k, s)
-      if (u**2 / (-2.0_wp * a_up) > height_resolution .and. &
-          remaining > time_rounding * max(abs(s%t), scene%dt)) return
+      ! Gaps are exact to their own size, so the series is followed until what remains of it
+      ! is below the clock's resolution.
+      if (remaining > time_rounding * max(abs(s%t), scene%dt)) return
       call apply(impulse(scene, k, 0.0_wp, s%v))
       in_contact(k) = .true.
       if (remaining < huge(1.0_wp)) then
@@ -658,16 +670,15 @@ contains
       tol = [(u_tolerance(k), k = 1, n_contacts)]
     end function u_tolerances
 
-    !> hi + lo += increment, keeping the rounding error of the sum in lo (Neumaier's two-sum,
-    !> valid whichever of hi and the increment is larger).
+    !> hi + lo += increment: the exact rounding error of hi + increment (Knuth's two-sum, valid
+    !> whichever is larger) goes into lo, which is never itself added to a large number.
     elemental subroutine add_compensated(hi, lo, increment)
       real(wp), intent(inout) :: hi, lo
       real(wp), intent(in) :: increment
-      real(wp) :: addend, total, rounded
-      addend = increment + lo
-      total = hi + addend
+      real(wp) :: total, rounded
+      total = hi + increment
       rounded = total - hi
-      lo = (hi - (total - rounded)) + (addend - rounded)
+      lo = lo + ((hi - (total - rounded)) + (increment - rounded))
       hi = total
     end subroutine add_compensated
 
