@@ -57,18 +57,24 @@ contains
   !> Preference: more bodies stuck, then more contacts held. Only combinations whose locked
   !> rows are independent are tried; that loses no solution (a vertex of the feasible
   !> reaction set has independent rows, the other reactions sitting at a bound).
-  subroutine solve_mode(scene, f, df, candidate, resting, moving_sign, mode, found)
+  !> force_scale: the size of the forces around this instant (what a step can change them
+  !> by included), the yardstick of rounding; without it, the forces now.
+  subroutine solve_mode(scene, f, df, candidate, resting, moving_sign, mode, found, force_scale)
     type(scene_type), intent(in) :: scene
     real(wp), intent(in) :: f(2), df(2)
     logical, intent(in) :: candidate(n_contacts), resting(2)
     real(wp), intent(in) :: moving_sign(2)
     type(mode_type), intent(out) :: mode
     logical, intent(out) :: found
+    real(wp), intent(in), optional :: force_scale
+    real(wp) :: scale
     integer :: target_stuck, o1, o2, mask, n_active, target_active, k
     integer :: option(2)
     logical :: active(n_contacts)
 
     found = .false.
+    scale = sum(abs(f)) + 2.0_wp * sum(scene%friction)
+    if (present(force_scale)) scale = max(scale, force_scale)
     do target_stuck = 2, 0, -1
       do o1 = 0, 2
         do o2 = 0, 2
@@ -82,7 +88,7 @@ contains
               if (any(active .and. .not. candidate)) cycle
               n_active = count(active)
               if (n_active /= target_active) cycle
-              call try_mode(scene, f, df, candidate, resting, moving_sign, option, active, mode, found)
+              call try_mode(scene, f, df, scale, candidate, resting, moving_sign, option, active, mode, found)
               if (found) return
             end do
           end do
@@ -91,9 +97,9 @@ contains
     end do
   end subroutine solve_mode
 
-  subroutine try_mode(scene, f, df, candidate, resting, moving_sign, option, active, mode, found)
+  subroutine try_mode(scene, f, df, scale, candidate, resting, moving_sign, option, active, mode, found)
     type(scene_type), intent(in) :: scene
-    real(wp), intent(in) :: f(2), df(2), moving_sign(2)
+    real(wp), intent(in) :: f(2), df(2), scale, moving_sign(2)
     logical, intent(in) :: candidate(n_contacts), resting(2), active(n_contacts)
     integer, intent(in) :: option(2)
     type(mode_type), intent(inout) :: mode
@@ -170,7 +176,7 @@ contains
     end if
 
     load = f + mode%f_slide
-    tol = 1.0e3_wp * eps_wp * (sum(abs(f)) + 2.0_wp * sum(scene%friction)) + tiny(1.0_wp)
+    tol = 1.0e3_wp * eps_wp * scale + tiny(1.0_wp)
     tol_rate = 1.0e3_wp * eps_wp * sum(abs(df))
 
     mode%n_hold = 0

@@ -310,9 +310,16 @@ contains
 
     real(wp) function hold_tolerance(t)
       real(wp), intent(in) :: t
-      hold_tolerance = 1.0e3_wp * eps_wp * (sum(abs(scene%forcing%force(t))) + &
-        2.0_wp * sum(scene%friction)) + tiny(1.0_wp)
+      hold_tolerance = 1.0e3_wp * eps_wp * force_scale(scene%forcing%force(t), scene%forcing%rate(t)) &
+        + tiny(1.0_wp)
     end function hold_tolerance
+
+    !> Size of the forces around an instant, for rounding tolerances: a force crossing zero
+    !> is still as large as what a step changes it by.
+    pure real(wp) function force_scale(f, df)
+      real(wp), intent(in) :: f(2), df(2)
+      force_scale = sum(abs(f)) + 2.0_wp * sum(scene%friction) + sum(abs(df)) * scene%dt
+    end function force_scale
 
     !> Re-take the step to the located time and polish it by Newton's method on the watched
     !> function evaluated on the integrator's own state (needed only for non-polynomial forcing,
@@ -518,7 +525,7 @@ contains
       call zero_stopped(acc)
 
       call candidates(closed, candidate, resting, moving_sign)
-      call solve_mode(scene, f, df, candidate, resting, moving_sign, new_mode, found)
+      call solve_mode(scene, f, df, candidate, resting, moving_sign, new_mode, found, force_scale(f, df))
       if (.not. found) then
         call raise(error, status_simulation, 'at t = ' // fmt(s%t) // &
           ': no consistent contact and friction state (complementarity problem has no solution)')
@@ -528,7 +535,7 @@ contains
       ! Log what a user can see change: contacts that start or stop holding, bodies that
       ! come to rest or break away.
       acc = new_mode%acceleration(f)
-      tol_a = 1.0e3_wp * eps_wp * (sum(abs(f)) + 2.0_wp * sum(scene%friction)) / scene%mass
+      tol_a = 1.0e3_wp * eps_wp * force_scale(f, df) / scene%mass
       do k = 1, n_contacts
         if (new_mode%active(k) .and. .not. in_contact(k)) then
           in_contact(k) = .true.
@@ -611,7 +618,7 @@ contains
       call candidates(closed, candidate, resting, moving_sign)
       s%v = v_saved
       candidate(k) = .false.
-      call solve_mode(scene, f, df, candidate, resting, moving_sign, free_mode, found)
+      call solve_mode(scene, f, df, candidate, resting, moving_sign, free_mode, found, force_scale(f, df))
       a_gap = 0.0_wp
       if (found) a_gap = dot_product(normal(:, k), free_mode%acceleration(f))
     end function free_gap_acceleration
