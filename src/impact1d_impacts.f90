@@ -2,7 +2,7 @@
 !> that momentum is kept by slot impacts and a wall only reverses its body's velocity.
 module impact1d_impacts
   use impact1d_kinds, only: wp
-  use impact1d_scene, only: scene_type, n_contacts, normal, i_slot_min, i_slot_max
+  use impact1d_scene, only: scene_type, n_contacts, normal, i_left, i_right, i_slot_min, i_slot_max
   implicit none
   private
   public :: normal_velocity, impulse, most_approaching, restitution_of, kinetic_energy
@@ -18,11 +18,20 @@ contains
 
   !> Velocities after an impulse on contact k that leaves the normal velocity at -r times
   !> its value before. For the slot this is the tutorial's two-body formula; for a wall v' = -r v.
-  pure function impulse(scene, k, r, v) result(v_after)
+  !> With rigid (the bodies locked by a rigid link) a wall stops or throws back both as one
+  !> body: v' = v - (1 + r) u n_i for both, the link carrying the impulse.
+  pure function impulse(scene, k, r, v, rigid) result(v_after)
     type(scene_type), intent(in) :: scene
     integer, intent(in) :: k
     real(wp), intent(in) :: r, v(2)
+    logical, intent(in), optional :: rigid
     real(wp) :: v_after(2), p
+    if (present(rigid)) then
+      if (rigid .and. (k == i_left .or. k == i_right)) then
+        v_after = v - (1.0_wp + r) * normal_velocity(k, v) * sum(normal(:, k))
+        return
+      end if
+    end if
     p = -(1.0_wp + r) * normal_velocity(k, v) / dot_product(normal(:, k)**2, 1.0_wp / scene%mass)
     v_after = v + normal(:, k) * p / scene%mass
     ! A wall acts on its own body only: keep the other velocity bit for bit.

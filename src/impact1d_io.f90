@@ -203,9 +203,9 @@ contains
     character(len=*), intent(in) :: path
     type(scene_input), intent(inout) :: input
     type(error_type), allocatable, intent(out) :: error
-    integer :: unit, ios, n_read, line_number
+    integer :: unit, ios, n_read, line_number, extra
     character(len=4096) :: line
-    real(wp) :: value
+    real(wp) :: value, surplus
     logical :: found
 
     call open_data_file(path, unit, error)
@@ -218,10 +218,11 @@ contains
       n_read = n_read + 1
       if (n_read <= size(dat_order)) then
         read(line, *, iostat=ios) value
-        if (ios /= 0) then
+        if (ios == 0) read(line, *, iostat=extra) value, surplus
+        if (ios /= 0 .or. extra == 0) then
           close(unit)
           call raise(error, status_input, path // ':' // fmt(line_number) // ': ''' // trim(adjustl(line)) // &
-            ''' is not a number (expected ' // trim(real_names(dat_order(n_read))) // ')')
+            ''' is not one number (expected ' // trim(real_names(dat_order(n_read))) // ')')
           return
         end if
         input%value(dat_order(n_read)) = value
@@ -257,9 +258,9 @@ contains
     character(len=*), intent(in) :: path
     type(table_type), intent(out) :: table
     type(error_type), allocatable, intent(out) :: error
-    integer :: unit, ios, line_number, n
+    integer :: unit, ios, line_number, n, extra
     character(len=4096) :: line
-    real(wp) :: row(2)
+    real(wp) :: row(2), surplus
     real(wp), allocatable :: t(:), f(:)
     logical :: found
 
@@ -272,7 +273,8 @@ contains
       call next_data_line(unit, line, line_number, found)
       if (.not. found) exit
       read(line, *, iostat=ios) row
-      if (ios /= 0) then
+      if (ios == 0) read(line, *, iostat=extra) row, surplus
+      if (ios /= 0 .or. extra == 0) then
         call fail(': expected two numbers "t f", got ''' // trim(adjustl(line)) // '''')
         return
       end if

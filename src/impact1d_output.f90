@@ -204,9 +204,15 @@ contains
     type(error_type), allocatable, intent(out) :: error
     integer :: ios, k
     character(len=512) :: message
+    logical :: folder
 
     self%path = path
     self%event_path = events_path(path)
+    folder = is_folder(path)
+    if (path(len(path):) == '/' .or. folder) then
+      call raise(error, status_input, 'cannot write output ' // path // ': it is a folder (give a file name)')
+      return
+    end if
     open(newunit=self%unit, file=self%path // '.part', status='replace', action='write', &
       iostat=ios, iomsg=message)
     if (ios /= 0) then
@@ -291,6 +297,12 @@ contains
     end if
     events = path // '.events.dat'
   end function events_path
+
+  !> True when path names an existing folder (opening path/. succeeds only then).
+  logical function is_folder(path)
+    character(len=*), intent(in) :: path
+    inquire(file=path // '/.', exist=is_folder)
+  end function is_folder
 
   !> Create a folder if it is missing (an existing one is fine).
   subroutine make_folder(path)

@@ -23,6 +23,8 @@ module impact1d_solver
   real(wp), parameter :: time_rounding = 64.0_wp * eps_wp     !< instants closer than this coincide
   integer, parameter :: max_impulses = 1000000   !< per event point; elastic chains need ~pi sqrt(M/m)
   integer, parameter :: max_stalls = 10000       !< event points in a row without time advancing
+  !> Work is bounded: elastic micro-bounces can make millions of genuine events a second.
+  integer, parameter :: max_event_points = 2000000
   integer, parameter :: max_halvings = 60        !< retries of a step whose end violated a constraint
 
   !> Time, positions, velocities and the ledger integrals are sums of many step increments,
@@ -54,7 +56,7 @@ contains
     ! velocity but cannot create precision, so what is below its rounding is zero.
     real(wp) :: entry_scale(2)
     real(wp) :: constant_acceleration(2)
-    integer :: j_sample, stalls, halvings, watched
+    integer :: j_sample, stalls, halvings, watched, event_points
     real(wp) :: t_last_event
 
     if (scene%method == 'vissim') then
@@ -63,6 +65,7 @@ contains
     end if
     constant_forcing = .not. (any(scene%forcing%has_table) .or. any(scene%forcing%has_sine))
     entry_scale = 0.0_wp
+    event_points = 0
     watching = .true.
     s%t = 0.0_wp
     s%x = scene%x0
@@ -148,6 +151,12 @@ contains
           stalls = 0
         end if
         t_last_event = s%t
+        event_points = event_points + 1
+        if (event_points > max_event_points) then
+          call raise(error, status_simulation, 'at t = ' // fmt(s%t) // ': more than ' // fmt(max_event_points) // &
+            ' events (a bounce that never settles, such as r = 1 under a pressing force, makes them without end)')
+          return
+        end if
         call flush_pending_rest()
         call event_point(initial=.false., which=merge(watched, 0, located))
         if (allocated(error)) return
@@ -499,7 +508,7 @@ contains
           return
         end if
         v_before = s%v
-        v_after = impulse(scene, k, restitution_of(scene, k, closed), s%v)
+        v_after = impulse(scene, k, restitution_of(scene, k, closed), s%v, rigid_pair(closed))
         call apply(v_after)
         if (all(normal(:, k) /= 0.0_wp)) entry_scale = maxval(entry_scale)
         call log_event(event_impact + k, v_before, v_after)
@@ -541,7 +550,10 @@ contains
           in_contact(k) = .true.
           if (pending_rest(k) == huge(1.0_wp)) call log_event(event_rest + k, s%v, s%v)
         else if (in_contact(k) .and. .not. new_mode%active(k)) then
-          if (.not. candidate(k) .or. dot_product(normal(:, k), acc) > dot_product(abs(normal(:, k)), tol_a)) then
+          if (.not. candidate(k) .or. dot_product(normal(:, k), acc) > dot_product(abs(normal(:, k)), tol_a) .or. &
+              (dot_product(normal(:, k), acc) >= -dot_product(abs(normal(:, k)), tol_a) .and. &
+              dot_product(normal(:, k), matmul(new_mode%gain, df)) > 1.0e3_wp * eps_wp * sum(abs(df)) / &
+              minval(scene%mass))) then
             if (pending_rest(k) < huge(1.0_wp)) then
               call log_event(event_rest + k, s%v, s%v)
               pending_rest(k) = huge(1.0_wp)
@@ -604,6 +616,12 @@ contains
         call log_event(event_rest + k, s%v, s%v)
       end if
     end subroutine bounce_series
+
+    !> Both slot limits closed on a rigid link (d_min = d_max): the bodies are one.
+    pure logical function rigid_pair(closed)
+      logical, intent(in) :: closed(n_contacts)
+      rigid_pair = closed(i_slot_min) .and. closed(i_slot_max)
+    end function rigid_pair
 
     !> Normal acceleration of contact k with k left free and the others as they are.
     real(wp) function free_gap_acceleration(k, v, f, df, closed) result(a_gap)
