@@ -33,6 +33,7 @@ help:
 	@echo "make setup   gfortran (apt, if missing), .venv, pip install .[test]"
 	@echo "make demo    run input/case1..6.nml with the impact1d CLI and plot them"
 	@echo "make test    Fortran unit tests (meson test), then pytest"
+	@echo "make bench   accuracy and speed studies -> docs/accuracy.md, docs/performance.md"
 	@echo "make clean   remove .venv, build/ and output files"
 
 setup: gfortran $(INSTALL_STAMP)
@@ -88,3 +89,9 @@ clean:
 	rm -rf $(VENV) build .pytest_cache .hypothesis
 	find . -name __pycache__ -type d -prune -exec rm -rf {} +
 	find output -mindepth 1 ! -name README.md -delete 2>/dev/null || true
+
+# Accuracy and speed studies (bench/): a few minutes; writes docs/accuracy.md,
+# docs/performance.md and their figures (docs/*.png). Numbers are measured, not asserted.
+.PHONY: bench
+bench: setup
+	$(BIN)/python bench/run_all.py

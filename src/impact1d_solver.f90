@@ -52,6 +52,7 @@ contains
     type(mode_type) :: mode
     real(wp) :: ke0, t_stop, t_break, h, h_event, pending_rest(n_contacts), sample_t
     logical :: in_contact(n_contacts), at_rest(2), located, at_stop, constant_forcing, watching
+    logical :: polynomial_forcing
     ! Velocity scale of each body entering the current event point: impulses redistribute
     ! velocity but cannot create precision, so what is below its rounding is zero.
     real(wp) :: entry_scale(2)
@@ -64,6 +65,7 @@ contains
       return
     end if
     constant_forcing = .not. (any(scene%forcing%has_table) .or. any(scene%forcing%has_sine))
+    polynomial_forcing = scene%forcing%is_polynomial()
     entry_scale = 0.0_wp
     event_points = 0
     watching = .true.
@@ -82,9 +84,10 @@ contains
     j_sample = 0
     call emit()
 
+    t_break = scene%forcing%next_breakpoint(s%t)
     do while (j_sample < scene%n_samples)
       sample_t = sample_time(scene, j_sample)
-      t_break = scene%forcing%next_breakpoint(s%t)
+      if (t_break <= s%t) t_break = scene%forcing%next_breakpoint(s%t)
       t_stop = min(sample_t, t_break, minval(pending_rest))
       h = min(scene%dt, (t_stop - s%t) - s%t_lo)
       ! No sliver steps: a step that would stop just short of a stop goes to it.
@@ -112,6 +115,9 @@ contains
             exit
           end if
         end if
+        ! Under polynomial forcing the dense output is exact and nothing can be missed; only
+        ! a sine's approximate dense output needs the step's end checked.
+        if (polynomial_forcing) exit
         if (constraints_hold(trial, merge(watched, 0, located))) exit
         ! The location missed a root (only possible for non-polynomial forcing): retry shorter.
         halvings = halvings + 1
@@ -250,6 +256,8 @@ contains
         if (.not. scene%has_contact(k) .or. mode%active(k)) cycle
         p(0) = gap(k, a)
         p(1:3) = normal(1, k) * c(:, 1) + normal(2, k) * c(:, 2)
+        ! The common case first: the gap cannot reach zero within the step.
+        if (p(0) - step * (abs(p(1)) + step * (abs(p(2)) + step * abs(p(3)))) > 0.0_wp) cycle
         candidate = earliest_crossing(p, step, gap_tolerance(k, a, displacement(k, a, b)))
         if (candidate < theta) then
           theta = candidate
