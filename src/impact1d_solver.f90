@@ -414,15 +414,16 @@ contains
     end function gap
 
     !> Rounding level of gap k. A gap is exact to its own size (compensated positions, exact
-    !> differences), so only what a step moved it by counts. A gap closing within the clock's
+    !> differences) up to the rounding of the low parts, so only that and what a step moved
+    !> it by count. A gap closing within the clock's
     !> resolution is closed now: this is what makes contacts hit at the same instant one
     !> event, while a tiny flight elsewhere keeps its own time.
     pure real(wp) function gap_tolerance(k, state, moved)
       integer, intent(in) :: k
       type(state_type), intent(in) :: state
       real(wp), intent(in) :: moved
-      gap_tolerance = gap_rounding * moved + time_rounding * max(abs(state%t), scene%dt) * &
-        max(0.0_wp, -normal_velocity(k, state%v))
+      gap_tolerance = gap_rounding * (moved + dot_product(abs(normal(:, k)), abs(state%x_lo))) + &
+        time_rounding * max(abs(state%t), scene%dt) * max(0.0_wp, -normal_velocity(k, state%v))
     end function gap_tolerance
 
     !> How far a step from a to b moved gap k (through either body).
