@@ -705,7 +705,9 @@ contains
     end function u_tolerances
 
     !> hi + lo += increment: the exact rounding error of hi + increment (Knuth's two-sum, valid
-    !> whichever is larger) goes into lo, which is never itself added to a large number.
+    !> whichever is larger) goes into lo, which is never itself added to a large number; then
+    !> hi takes what of lo it can hold (Fast2Sum), so hi alone is the sum correctly rounded
+    !> (event times and samples read hi) and lo stays below half an ulp of it.
     elemental subroutine add_compensated(hi, lo, increment)
       real(wp), intent(inout) :: hi, lo
       real(wp), intent(in) :: increment
@@ -713,7 +715,8 @@ contains
       total = hi + increment
       rounded = total - hi
       lo = lo + ((hi - (total - rounded)) + (increment - rounded))
-      hi = total
+      hi = total + lo
+      lo = lo - (hi - total)
     end subroutine add_compensated
 
     pure function ieee_finite_state(state) result(finite)
