@@ -1,0 +1,49 @@
+!> The limit for the engine's stepping loop (bench/performance.py): a plain classical RK4
+!> loop on the free-flight scene's force law (constant forces, no contacts, no friction),
+!> y = (x1, v1, x2, v2), y' = (v1, f1/m1, v2, f2/m2). No events, no ledger, no output but
+!> the final state. Everything comes from the command line so that nothing folds at compile
+!> time; the bench compiles it with the release build's flags (-O3) and times it the same
+!> way as the impact1d CLI (wall time of the process).
+!> usage: bare_rk4 N_STEPS DT M1 M2 F1 F2 X1 V1 X2 V2
+program bare_rk4
+  use, intrinsic :: iso_fortran_env, only: dp => real64, int64
+  implicit none
+  integer(int64) :: n, i
+  real(dp) :: dt, m(2), f(2), y(4), t, k1(4), k2(4), k3(4), k4(4)
+  character(len=64) :: arg
+  integer :: j
+
+  call get_command_argument(1, arg)
+  read(arg, *) n
+  call get_command_argument(2, arg)
+  read(arg, *) dt
+  do j = 1, 2
+    call get_command_argument(2 + j, arg)
+    read(arg, *) m(j)
+    call get_command_argument(4 + j, arg)
+    read(arg, *) f(j)
+  end do
+  do j = 1, 4
+    call get_command_argument(6 + j, arg)
+    read(arg, *) y(j)
+  end do
+  t = 0.0_dp
+  do i = 1, n
+    k1 = rhs(t, y)
+    k2 = rhs(t + 0.5_dp * dt, y + 0.5_dp * dt * k1)
+    k3 = rhs(t + 0.5_dp * dt, y + 0.5_dp * dt * k2)
+    k4 = rhs(t + dt, y + dt * k3)
+    y = y + dt / 6.0_dp * (k1 + 2.0_dp * k2 + 2.0_dp * k3 + k4)
+    t = t + dt
+  end do
+  print '(5es25.16)', t, y
+
+contains
+
+  pure function rhs(time, state) result(dydt)
+    real(dp), intent(in) :: time, state(4)
+    real(dp) :: dydt(4)
+    dydt = [state(2), f(1) / m(1), state(4), f(2) / m(2)]
+    if (time < 0.0_dp) dydt = 0.0_dp   ! keeps the time argument of a general rhs
+  end function rhs
+end program bare_rk4
