@@ -57,6 +57,8 @@ contains
     ! velocity but cannot create precision, so what is below its rounding is zero.
     real(wp) :: entry_scale(2)
     real(wp) :: constant_acceleration(2)
+    ! Until when each open gap (1..4) and each sliding body (5, 6) needs no location.
+    real(wp) :: quiet_until(n_contacts + 2)
     integer :: j_sample, stalls, halvings, watched, event_points
     real(wp) :: t_last_event
 
@@ -65,6 +67,7 @@ contains
       return
     end if
     constant_forcing = .not. (any(scene%forcing%has_table) .or. any(scene%forcing%has_sine))
+    quiet_until = -huge(1.0_wp)
     polynomial_forcing = scene%forcing%is_polynomial()
     entry_scale = 0.0_wp
     event_points = 0
@@ -247,13 +250,16 @@ contains
       integer, intent(out) :: which
       real(wp) :: c(3, 2), p(0:3), candidate, scale
       integer :: k, i
+      logical :: have_dense
 
       theta = huge(1.0_wp)
       which = 0
-      c(:, 1) = hermite((b%x(1) - a%x(1)) + (b%x_lo(1) - a%x_lo(1)), a%v(1), b%v(1), step)
-      c(:, 2) = hermite((b%x(2) - a%x(2)) + (b%x_lo(2) - a%x_lo(2)), a%v(2), b%v(2), step)
+      have_dense = .false.
       do k = 1, n_contacts
         if (.not. scene%has_contact(k) .or. mode%active(k)) cycle
+        if (a%t + step < quiet_until(k)) cycle
+        if (.not. have_dense) c = dense_output(a, b, step)
+        have_dense = .true.
         p(0) = gap(k, a)
         p(1:3) = normal(1, k) * c(:, 1) + normal(2, k) * c(:, 2)
         ! The common case first: the gap cannot reach zero within the step.
@@ -266,6 +272,9 @@ contains
       end do
       do i = 1, 2
         if (scene%friction(i) == 0.0_wp .or. mode%sgn(i) == 0.0_wp) cycle
+        if (a%t + step < quiet_until(n_contacts + i)) cycle
+        if (.not. have_dense) c = dense_output(a, b, step)
+        have_dense = .true.
         ! Sliding velocity in its own direction: the derivative of the Hermite cubic.
         p = mode%sgn(i) * [c(1, i), 2.0_wp * c(2, i), 3.0_wp * c(3, i), 0.0_wp]
         scale = max(abs(a%v(i)), abs(b%v(i)), abs(b%v(i) - a%v(i)))
@@ -275,7 +284,8 @@ contains
           which = 100 + i
         end if
       end do
-      if (mode%n_hold > 0) then
+      ! Under constant forces the mode's conditions are constant: they held when it began.
+      if (mode%n_hold > 0 .and. .not. constant_forcing) then
         candidate = hold_crossing(a%t, step)
         if (candidate < theta) then
           theta = candidate
@@ -283,6 +293,15 @@ contains
         end if
       end if
     end subroutine locate
+
+    !> The step's dense output: Hermite coefficients of both bodies' displacements.
+    pure function dense_output(a, b, step) result(c)
+      type(state_type), intent(in) :: a, b
+      real(wp), intent(in) :: step
+      real(wp) :: c(3, 2)
+      c(:, 1) = hermite((b%x(1) - a%x(1)) + (b%x_lo(1) - a%x_lo(1)), a%v(1), b%v(1), step)
+      c(:, 2) = hermite((b%x(2) - a%x(2)) + (b%x_lo(2) - a%x_lo(2)), a%v(2), b%v(2), step)
+    end function dense_output
 
     !> Earliest time in (0, step] at which a condition of the mode (a contact force, a static
     !> friction margin) turns negative. They depend on time only: linear within a step under
@@ -586,7 +605,11 @@ contains
       end do
       mode = new_mode
       entry_scale = 0.0_wp
-      if (constant_forcing) constant_acceleration = mode%acceleration(scene%forcing%constant)
+      quiet_until = -huge(1.0_wp)
+      if (constant_forcing) then
+        constant_acceleration = mode%acceleration(scene%forcing%constant)
+        call find_quiet_times()
+      end if
       watching = mode%n_hold > 0 .or. any(scene%has_contact .and. .not. mode%active) .or. &
         any(scene%friction > 0.0_wp .and. mode%sgn /= 0.0_wp)
     end subroutine event_point
@@ -625,6 +648,48 @@ contains
         call log_event(event_rest + k, s%v, s%v)
       end if
     end subroutine bounce_series
+
+    !> Under constant forces a mode's motion is an exact quadratic, so the first instant an
+    !> open gap can close, or a sliding body can stop, is known in closed form; steps that end
+    !> well before it (1% of the way, far beyond rounding) need no location for it. Only a
+    !> shortcut: the location itself still finds the event.
+    subroutine find_quiet_times()
+      integer :: k, i
+      do k = 1, n_contacts
+        if (.not. scene%has_contact(k) .or. mode%active(k)) cycle
+        quiet_until(k) = s%t + 0.99_wp * first_negative(gap(k, s), normal_velocity(k, s%v), &
+          dot_product(normal(:, k), constant_acceleration))
+      end do
+      do i = 1, 2
+        if (scene%friction(i) == 0.0_wp .or. mode%sgn(i) == 0.0_wp) cycle
+        quiet_until(n_contacts + i) = s%t + 0.99_wp * first_negative(mode%sgn(i) * s%v(i), &
+          mode%sgn(i) * constant_acceleration(i), 0.0_wp)
+      end do
+    end subroutine find_quiet_times
+
+    !> First tau > 0 with g0 + u tau + a tau^2 / 2 < 0, for g0 >= 0 (0 if g0 < 0, huge if never).
+    pure real(wp) function first_negative(g0, u, a) result(tau)
+      real(wp), intent(in) :: g0, u, a
+      real(wp) :: disc, q
+      tau = huge(1.0_wp)
+      if (g0 < 0.0_wp) then
+        tau = 0.0_wp
+      else if (a == 0.0_wp) then
+        if (u < 0.0_wp) tau = g0 / (-u)
+      else
+        disc = u**2 - 2.0_wp * a * g0
+        if (disc < 0.0_wp) return
+        ! Roots of a/2 tau^2 + u tau + g0 by the stable pair q/(a/2) and g0/q.
+        q = -0.5_wp * (u + sign(sqrt(disc), u))
+        if (a > 0.0_wp) then
+          if (u < 0.0_wp .and. q /= 0.0_wp) tau = g0 / q        ! the smaller positive root
+        else
+          tau = max(q / (0.5_wp * a), merge(g0 / q, 0.0_wp, q /= 0.0_wp))   ! the positive root
+        end if
+        tau = max(tau, 0.0_wp)
+      end if
+      if (tau /= tau) tau = 0.0_wp
+    end function first_negative
 
     !> Both slot limits closed on a rigid link (d_min = d_max): the bodies are one.
     pure logical function rigid_pair(closed)
