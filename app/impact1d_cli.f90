@@ -5,7 +5,7 @@ program impact1d_cli
   use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
   use, intrinsic :: iso_c_binding, only: c_int
   use impact1d_kinds, only: wp
-  use impact1d_error, only: error_type, raise, status_input, fmt
+  use impact1d_error, only: error_type, status_input, fmt
   use impact1d_scene, only: scene_input, scene_type, i_t_end, i_dt, i_dt_out, i_method, i_title
   use impact1d_io, only: read_scene_file, prepare_scene
   use impact1d_output, only: file_sink, make_folder, event_names, n_event_kinds
@@ -70,7 +70,10 @@ program impact1d_cli
         call override(3)
       end select
     case default
-      if (option(1:1) == '-' .and. len(option) > 1) call fail(status_input, 'unknown option ' // option // '; ' // usage)
+      if (len(option) > 1) then
+        if (option(1:1) == '-') call fail(status_input, 'unknown option ' // option // '; ' // usage)
+      end if
+      if (len(option) == 0) call fail(status_input, 'an empty argument is not a scene; ' // usage)
       if (len(scene_path) > 0) call fail(status_input, 'one scene at a time; ' // usage)
       scene_path = option
       i = i + 1

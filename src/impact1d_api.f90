@@ -119,7 +119,7 @@ contains
     if (failed(error, status, message)) return
     n_samples = last_run%n_samples
     n_events = last_run%n_events
-    steps = stats%steps
+    steps = int(min(stats%steps, int(huge(1_c_int), kind(stats%steps))), c_int)
     energy_residual = stats%max_residual
   end subroutine simulate
 

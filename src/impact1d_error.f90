@@ -1,6 +1,7 @@
 !> Errors travel back to the caller as values: the library never stops the program,
 !> because inside the f2py extension a `stop` would kill the user's Python session.
 module impact1d_error
+  use, intrinsic :: iso_fortran_env, only: int64
   use impact1d_kinds, only: wp
   implicit none
   private
@@ -18,7 +19,7 @@ module impact1d_error
 
   !> Shortest text of a number for messages (g0 keeps every digit the user wrote).
   interface fmt
-    module procedure fmt_real, fmt_int
+    module procedure fmt_real, fmt_int, fmt_int64
   end interface fmt
 
 contains
@@ -94,6 +95,14 @@ contains
     write(buffer, '(i0)') value
     out = trim(buffer)
   end function exponent_text
+
+  pure function fmt_int64(i) result(text)
+    integer(int64), intent(in) :: i
+    character(len=:), allocatable :: text
+    character(len=24) :: buffer
+    write(buffer, '(i0)') i
+    text = trim(buffer)
+  end function fmt_int64
 
   pure function fmt_int(i) result(text)
     integer, intent(in) :: i

@@ -3,10 +3,10 @@
 !> its roots are isolated between the extrema and none is missed: two crossings inside one
 !> step (a fast bounce, a graze) are found as surely as one.
 module impact1d_events
-  use impact1d_kinds, only: wp, eps_wp
+  use impact1d_kinds, only: wp
   implicit none
   private
-  public :: hermite, earliest_crossing, poly_value, poly_slope
+  public :: hermite, earliest_crossing, poly_value
 
 contains
 
@@ -27,18 +27,13 @@ contains
     poly_value = p(0) + theta * (p(1) + theta * (p(2) + theta * p(3)))
   end function poly_value
 
-  pure real(wp) function poly_slope(p, theta)
-    real(wp), intent(in) :: p(0:3), theta
-    poly_slope = p(1) + theta * (2.0_wp * p(2) + theta * 3.0_wp * p(3))
-  end function poly_slope
-
   !> Earliest theta in [0, h] where p turns negative: the zero at the start of the first
   !> piece of [0, h] (between consecutive roots) on which p falls below -tol. Returns a value
   !> > h when there is none. tol keeps rounding-level wiggles of a resting function from
   !> counting, while the reported time is the true zero, not the -tol crossing.
   pure real(wp) function earliest_crossing(p, h, tol) result(theta)
     real(wp), intent(in) :: p(0:3), h, tol
-    real(wp) :: nodes(8), crit(2)
+    real(wp) :: nodes(5), crit(2)
     integer :: n_nodes, n_crit, j
     real(wp) :: a, b
 

@@ -6,9 +6,7 @@ module impact1d_io
   use impact1d_error, only: error_type, raise, status_input, fmt
   use impact1d_scene, only: scene_input, scene_type, build_scene, validate, n_real, real_names, &
     i_m1, i_m2, i_mu1, i_mu2, i_g, i_r_left, i_r_right, i_r_min, i_r_max, i_x_left, i_x_right, &
-    i_d_min, i_d_max, i_x1, i_x2, i_v1, i_v2, i_f1, i_f2, i_t_end, i_dt, i_dt_out, &
-    i_f1_amp, i_f1_period, i_f1_phase, i_f2_amp, i_f2_period, i_f2_phase, &
-    i_title, i_f1_table, i_f2_table, i_method
+    i_d_min, i_d_max, i_x1, i_x2, i_v1, i_v2, i_f1, i_f2, i_title, i_f1_table, i_f2_table, i_method
   use impact1d_forcing, only: table_type
   implicit none
   private
@@ -217,6 +215,7 @@ contains
       if (.not. found) exit
       n_read = n_read + 1
       if (n_read <= size(dat_order)) then
+        extra = -1
         read(line, *, iostat=ios) value
         if (ios == 0) read(line, *, iostat=extra) value, surplus
         if (ios /= 0 .or. extra == 0) then
@@ -272,6 +271,7 @@ contains
     do
       call next_data_line(unit, line, line_number, found)
       if (.not. found) exit
+      extra = -1
       read(line, *, iostat=ios) row
       if (ios == 0) read(line, *, iostat=extra) row, surplus
       if (ios /= 0 .or. extra == 0) then

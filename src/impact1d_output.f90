@@ -29,7 +29,7 @@ module impact1d_output
 
   !> What a run did, for the CLI's summary and Python's result.
   type :: run_stats
-    integer :: steps = 0
+    integer(int64) :: steps = 0
     integer :: events(n_event_kinds) = 0
     real(wp) :: last_row(n_columns) = 0.0_wp
     real(wp) :: max_residual = 0.0_wp

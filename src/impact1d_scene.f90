@@ -8,12 +8,12 @@ module impact1d_scene
   implicit none
   private
   public :: n_real, n_text, real_names, text_names, scene_input, scene_type, build_scene, validate
-  public :: n_contacts, contact_names, normal, i_left, i_right, i_slot_min, i_slot_max
+  public :: n_contacts, normal, i_left, i_right, i_slot_min, i_slot_max
   public :: i_m1, i_m2, i_mu1, i_mu2, i_g, i_x_left, i_r_left, i_x_right, i_r_right, i_d_min, &
     i_r_min, i_d_max, i_r_max, i_x1, i_v1, i_x2, i_v2, i_f1, i_f2, i_f1_amp, i_f1_period, &
-    i_f1_phase, i_f2_amp, i_f2_period, i_f2_phase, i_t_end, i_dt, i_dt_out, i_zero_vel
+    i_f1_phase, i_f2_amp, i_f2_period, i_f2_phase, i_t_end, i_dt, i_dt_out
   public :: sample_time
-  public :: i_title, i_f1_table, i_f2_table, i_method, max_samples, default_gravity
+  public :: i_title, i_f1_table, i_f2_table, i_method, default_gravity
 
   integer, parameter :: n_real = 29, n_text = 4
   !> Names of the real inputs, as in the namelist and in Python's Scene, in this order.
@@ -119,11 +119,12 @@ contains
     call sine_terms(i_f2_amp, i_f2_period, i_f2_phase)
     if (allocated(error)) return
 
-    ! The initial state must satisfy every constraint; a gap within rounding of zero is contact.
-    scale = max(abs(input%value(i_x1)), abs(input%value(i_x2)))
+    ! The initial state must satisfy every constraint; a gap within the rounding of the
+    ! numbers it is made of (this contact's positions and limit) is contact.
     do k = 1, n_contacts
       if (.not. input%given(limit_index(k))) cycle
       gap = normal(1, k) * input%value(i_x1) + normal(2, k) * input%value(i_x2) + offset_of(k)
+      scale = maxval(abs(normal(:, k) * input%value([i_x1, i_x2])))
       if (gap < -16.0_wp * eps_wp * max(scale, abs(offset_of(k)))) then
         call raise(error, status_input, 'the initial state x1 = ' // fmt(input%value(i_x1)) // &
           ', x2 = ' // fmt(input%value(i_x2)) // ' violates the ' // trim(contact_names(k)) // &

@@ -3,6 +3,7 @@
 !> re-step to the event time, then impacts, Zeno rest and a new mode at the event point.
 !> Nothing here allocates, formats or writes per step; output goes to a sink at sample times.
 module impact1d_solver
+  use, intrinsic :: iso_fortran_env, only: int64
   use impact1d_kinds, only: wp, eps_wp
   use impact1d_error, only: error_type, raise, status_simulation, fmt
   use impact1d_scene, only: scene_type, n_contacts, normal, sample_time, i_slot_min, i_slot_max
@@ -18,7 +19,7 @@ module impact1d_solver
   public :: run, run_stats
 
   !> Tolerances, each a multiple of the unit roundoff of the quantity it guards.
-  real(wp), parameter :: gap_rounding = 16.0_wp * eps_wp      !< a gap this small (x scale) is closed
+  real(wp), parameter :: gap_rounding = 16.0_wp * eps_wp      !< rounding of a gap, per unit it moved
   real(wp), parameter :: velocity_rounding = 64.0_wp * eps_wp !< a velocity this small is zero
   real(wp), parameter :: time_rounding = 64.0_wp * eps_wp     !< instants closer than this coincide
   integer, parameter :: max_impulses = 1000000   !< per event point; elastic chains need ~pi sqrt(M/m)
@@ -52,7 +53,8 @@ contains
     type(mode_type) :: mode
     real(wp) :: ke0, t_stop, t_break, h, h_event, pending_rest(n_contacts), sample_t
     logical :: in_contact(n_contacts), at_rest(2), located, at_stop, constant_forcing, watching
-    logical :: polynomial_forcing
+    logical :: polynomial_forcing, event_due
+    real(wp) :: t_rest
     ! Velocity scale of each body entering the current event point: impulses redistribute
     ! velocity but cannot create precision, so what is below its rounding is zero.
     real(wp) :: entry_scale(2)
@@ -91,7 +93,8 @@ contains
     do while (j_sample < scene%n_samples)
       sample_t = sample_time(scene, j_sample)
       if (t_break <= s%t) t_break = scene%forcing%next_breakpoint(s%t)
-      t_stop = min(sample_t, t_break, minval(pending_rest))
+      t_rest = minval(pending_rest)
+      t_stop = min(sample_t, t_break, t_rest)
       h = min(scene%dt, (t_stop - s%t) - s%t_lo)
       ! No sliver steps: a step that would stop just short of a stop goes to it.
       if ((t_stop - s%t) - s%t_lo - h <= 1.0e-9_wp * scene%dt) h = (t_stop - s%t) - s%t_lo
@@ -139,7 +142,7 @@ contains
         s%t_lo = 0.0_wp
       end if
       stats%steps = stats%steps + 1
-      if (iand(stats%steps, 4095) == 0) call sink%progress(s%t, scene%t_end)
+      if (iand(stats%steps, 4095_int64) == 0) call sink%progress(s%t, scene%t_end)
       if (any(.not. ieee_finite_state(s))) then
         call raise(error, status_simulation, 'at t = ' // fmt(s%t) // ': the state is no longer finite')
         return
@@ -147,8 +150,10 @@ contains
 
       ! Events, table corners (the force's slope changes) and accumulation times need an
       ! event point; a sample time does not.
-      if (located .or. (at_stop .and. (t_stop == t_break .or. t_stop == minval(pending_rest) &
-          .or. impact_due()))) then
+      event_due = located
+      if (.not. event_due .and. at_stop) event_due = t_stop == t_break .or. t_stop == t_rest
+      if (.not. event_due .and. at_stop) event_due = impact_due()
+      if (event_due) then
         if (s%t - t_last_event <= time_rounding * max(abs(s%t), scene%dt)) then
           stalls = stalls + 1
           if (stalls > max_stalls) then
@@ -177,8 +182,7 @@ contains
   contains
 
     subroutine emit()
-      call emit_sample(sink, stats, s%t, s%x + s%x_lo, s%v + s%v_lo, scene%mass, ke0, s%work + s%work_lo, &
-        s%friction_loss + s%friction_lo, s%impact_loss)
+      call emit_sample(sink, stats, s%t, s%x, s%v, scene%mass, ke0, s%work, s%friction_loss, s%impact_loss)
       j_sample = j_sample + 1
     end subroutine emit
 
@@ -238,7 +242,7 @@ contains
       call add_compensated(b%work, b%work_lo, step / 6.0_wp * (dot_product(f0, a%v) + &
         4.0_wp * dot_product(fm, vm) + dot_product(f1, b%v)))
       call add_compensated(b%friction_loss, b%friction_lo, step / 6.0_wp * &
-        dot_product(scene%friction * mode%sgn, a%v + 4.0_wp * vm + b%v))
+        dot_product(-mode%f_slide, a%v + 4.0_wp * vm + b%v))
     end subroutine rk4_step
 
     !> Earliest event in (0, step]: a gap closing, a sliding body stopping, a mode condition
@@ -303,7 +307,7 @@ contains
       c(:, 2) = hermite((b%x(2) - a%x(2)) + (b%x_lo(2) - a%x_lo(2)), a%v(2), b%v(2), step)
     end function dense_output
 
-    !> Earliest time in (0, step] at which a condition of the mode (a contact force, a static
+    !> Earliest time in [0, step] at which a condition of the mode (a contact force, a static
     !> friction margin) turns negative. They depend on time only: linear within a step under
     !> piecewise-linear forcing, so the ends decide; a sine is sampled finer before bisection.
     real(wp) function hold_crossing(t0, step) result(theta)
@@ -358,15 +362,16 @@ contains
     end function force_scale
 
     !> Re-take the step to the located time and polish it by Newton's method on the watched
-    !> function evaluated on the integrator's own state (needed only for non-polynomial forcing,
-    !> where the Hermite dense output is approximate).
+    !> function evaluated on the integrator's own state: under polynomial forcing the dense
+    !> output is exact and the first check passes; under a sine it is approximate.
     subroutine refine(a, step, which, b)
       type(state_type), intent(in) :: a
       real(wp), intent(inout) :: step
       integer, intent(in) :: which
       type(state_type), intent(out) :: b
-      real(wp) :: value, slope, tol, acc(2)
+      real(wp) :: value, slope, tol, acc(2), located_step
       integer :: iteration
+      located_step = step
       call rk4_step(a, step, b)
       if (which <= 0) return
       do iteration = 1, 8
@@ -381,7 +386,8 @@ contains
           tol = gap_tolerance(which, b, displacement(which, a, b))
         end if
         if (abs(value) <= tol .or. slope == 0.0_wp) exit
-        if (step - value / slope <= 0.0_wp) exit
+        ! Newton stays inside the step that was located, or the clock could pass a stop.
+        if (step - value / slope <= 0.0_wp .or. step - value / slope > located_step) exit
         step = step - value / slope
         call rk4_step(a, step, b)
       end do
@@ -484,7 +490,7 @@ contains
     !> Everything that happens at one instant: closed contacts snapped, impacts resolved by
     !> sequential impulses, unresolvable bounce series put to rest (Zeno), stopped bodies
     !> zeroed, then the new mode from the complementarity problem, and the log of what changed.
-    !> which: what the location found (contact k, 100 + body i) or 0.
+    !> which: what the location found (contact k, 100 + body i, -1 a mode condition) or 0.
     subroutine event_point(initial, which)
       logical, intent(in) :: initial
       integer, intent(in) :: which
@@ -516,13 +522,12 @@ contains
       ! A sliding body whose stop was located, or that stopped within rounding (its velocity
       ! change over a step is the scale), is at rest.
       acc = mode%acceleration(f)
+      if (initial) acc = f / scene%mass     ! no mode yet: the free accelerations set the scale
       entry_scale = abs(s%v) + abs(acc) * scene%dt
       do i = 1, 2
         if (scene%friction(i) == 0.0_wp) cycle
-        if (i == which - 100 .or. abs(s%v(i)) <= velocity_rounding * abs(acc(i)) * scene%dt) then
-          s%v(i) = 0.0_wp
-          s%v_lo(i) = 0.0_wp
-        end if
+        if (i == which - 100 .or. abs(s%v(i)) <= velocity_rounding * abs(acc(i)) * scene%dt) &
+          call zero_velocity(i)
       end do
 
       n_impulses = 0
@@ -547,7 +552,7 @@ contains
       do k = 1, n_contacts
         if (.not. closed(k)) cycle
         if (abs(normal_velocity(k, s%v)) <= u_tolerance(k) .and. normal_velocity(k, s%v) /= 0.0_wp) &
-          call apply(impulse(scene, k, 0.0_wp, s%v))
+          call apply(impulse(scene, k, 0.0_wp, s%v, rigid_pair(closed)))
       end do
 
       ! Zeno: a bounce series whose remaining time is below the clock's resolution ends in
@@ -629,7 +634,7 @@ contains
       if (u <= u_tolerance(k)) return
       a_up = free_gap_acceleration(k, s%v, f, df, closed)
       if (a_up >= 0.0_wp) return
-      a_down = free_gap_acceleration(k, impulse(scene, k, 1.0_wp, s%v), f, df, closed)
+      a_down = free_gap_acceleration(k, impulse(scene, k, 1.0_wp, s%v, rigid_pair(closed)), f, df, closed)
       r = restitution_of(scene, k, closed)
       remaining = huge(1.0_wp)
       if (a_down < 0.0_wp) then
@@ -640,7 +645,7 @@ contains
       ! Gaps are exact to their own size, so the series is followed until what remains of it
       ! is below the clock's resolution.
       if (remaining > time_rounding * max(abs(s%t), scene%dt)) return
-      call apply(impulse(scene, k, 0.0_wp, s%v))
+      call apply(impulse(scene, k, 0.0_wp, s%v, rigid_pair(closed)))
       in_contact(k) = .true.
       if (remaining < huge(1.0_wp)) then
         pending_rest(k) = s%t + remaining
@@ -722,13 +727,17 @@ contains
       integer :: i
       do i = 1, 2
         if (s%v(i) /= 0.0_wp .and. abs(s%v(i)) <= velocity_rounding * max(abs(acc(i)) * scene%dt, &
-            entry_scale(i))) then
-          s%impact_loss = s%impact_loss + 0.5_wp * scene%mass(i) * s%v(i)**2
-          s%v(i) = 0.0_wp
-          s%v_lo(i) = 0.0_wp
-        end if
+            entry_scale(i))) call zero_velocity(i)
       end do
     end subroutine zero_stopped
+
+    !> Body i is at rest; the rounding-level energy it had goes to the impact loss.
+    subroutine zero_velocity(i)
+      integer, intent(in) :: i
+      s%impact_loss = s%impact_loss + 0.5_wp * scene%mass(i) * s%v(i)**2
+      s%v(i) = 0.0_wp
+      s%v_lo(i) = 0.0_wp
+    end subroutine zero_velocity
 
     !> Set new velocities at an instant, booking the kinetic energy they remove as impact loss.
     subroutine apply(v_new)
@@ -770,9 +779,9 @@ contains
     end function u_tolerances
 
     !> hi + lo += increment: the exact rounding error of hi + increment (Knuth's two-sum, valid
-    !> whichever is larger) goes into lo, which is never itself added to a large number; then
-    !> hi takes what of lo it can hold (Fast2Sum), so hi alone is the sum correctly rounded
-    !> (event times and samples read hi) and lo stays below half an ulp of it.
+    !> whichever is larger) goes into lo; then hi takes what of lo it can hold (Fast2Sum), so
+    !> hi alone is the sum correctly rounded (event times and samples read hi) and lo stays
+    !> below half an ulp of it.
     elemental subroutine add_compensated(hi, lo, increment)
       real(wp), intent(inout) :: hi, lo
       real(wp), intent(in) :: increment

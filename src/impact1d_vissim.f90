@@ -5,6 +5,7 @@
 !> one-step delay); walls are limited integrators (positions clamped); friction follows the
 !> diagram's rules with a zero-velocity threshold. Its errors are O(dt) by design.
 module impact1d_vissim
+  use, intrinsic :: iso_fortran_env, only: int64
   use impact1d_kinds, only: wp
   use impact1d_error, only: error_type, raise, status_simulation, fmt
   use impact1d_scene, only: scene_type, n_contacts, normal, i_left, i_right, i_slot_min, i_slot_max, &
@@ -52,17 +53,17 @@ contains
       work = work + dwork
       friction_loss = friction_loss + dfriction
       stats%steps = stats%steps + 1
-      if (iand(stats%steps, 4095) == 0) call sink%progress(t, scene%t_end)
+      if (iand(stats%steps, 4095_int64) == 0) call sink%progress(t, scene%t_end)
       if (.not. all(abs([x, v]) <= huge(1.0_wp))) then
         call raise(error, status_simulation, 'at t = ' // fmt(t) // ': the state is no longer finite')
         return
       end if
       ! Collisions seen at the step's end: the slot's first, then the walls on what it left.
-      v_hit = threshold(v)
       do k = 1, n_contacts
         associate (c => slot_first(k))
           if (.not. scene%has_contact(c)) cycle
           if (.not. (gap_before(c) >= 0.0_wp .and. gap(c, x) < 0.0_wp)) cycle
+          v_hit = threshold(v)
           if (c == i_left) x(1) = -scene%offset(i_left)
           if (c == i_right) x(2) = scene%offset(i_right)
           v_new = impulse(scene, c, scene%restitution(c), threshold(v_prev))
