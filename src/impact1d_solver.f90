@@ -61,6 +61,8 @@ contains
     real(wp) :: constant_acceleration(2)
     ! Until when each open gap (1..4) and each sliding body (5, 6) needs no location.
     real(wp) :: quiet_until(n_contacts + 2)
+    ! A release waiting for time to move on (see begin_rest), with its velocities.
+    real(wp) :: release_time(n_contacts), release_v(2, n_contacts)
     integer :: j_sample, stalls, halvings, watched, event_points
     real(wp) :: t_last_event
 
@@ -70,6 +72,8 @@ contains
     end if
     constant_forcing = .not. (any(scene%forcing%has_table) .or. any(scene%forcing%has_sine))
     quiet_until = -huge(1.0_wp)
+    release_time = huge(1.0_wp)
+    release_v = 0.0_wp
     polynomial_forcing = scene%forcing%is_polynomial()
     entry_scale = 0.0_wp
     event_points = 0
@@ -165,6 +169,7 @@ contains
           stalls = 0
         end if
         t_last_event = s%t
+        call flush_releases(.false.)
         event_points = event_points + 1
         if (event_points > max_event_points) then
           call raise(error, status_simulation, 'at t = ' // fmt(s%t) // ': more than ' // fmt(max_event_points) // &
@@ -177,6 +182,7 @@ contains
       end if
       if (at_stop .and. s%t == sample_t) call emit()
     end do
+    call flush_releases(.true.)
     call sink%end_progress()
 
   contains
@@ -580,8 +586,7 @@ contains
       tol_a = 1.0e3_wp * eps_wp * force_scale(f, df) / scene%mass
       do k = 1, n_contacts
         if (new_mode%active(k) .and. .not. in_contact(k)) then
-          in_contact(k) = .true.
-          if (pending_rest(k) == huge(1.0_wp)) call log_event(event_rest + k, s%v, s%v)
+          call begin_rest(k, s%t)
         else if (in_contact(k) .and. .not. new_mode%active(k)) then
           if (.not. candidate(k) .or. dot_product(normal(:, k), acc) > dot_product(abs(normal(:, k)), tol_a) .or. &
               (dot_product(normal(:, k), acc) >= -dot_product(abs(normal(:, k)), tol_a) .and. &
@@ -591,8 +596,11 @@ contains
               call log_event(event_rest + k, s%v, s%v)
               pending_rest(k) = huge(1.0_wp)
             end if
+            ! Logged once time has moved on: a contact that closes again at this same
+            ! instant never opened (rounding-level relabelling), and neither entry is kept.
             in_contact(k) = .false.
-            call log_event(event_release + k, s%v, s%v)
+            release_time(k) = s%t
+            release_v(:, k) = s%v
           end if
         end if
       end do
@@ -646,13 +654,46 @@ contains
       ! is below the clock's resolution.
       if (remaining > time_rounding * max(abs(s%t), scene%dt)) return
       call apply(impulse(scene, k, 0.0_wp, s%v, rigid_pair(closed)))
-      in_contact(k) = .true.
       if (remaining < huge(1.0_wp)) then
-        pending_rest(k) = s%t + remaining
+        call begin_rest(k, s%t + remaining)
+      else
+        call begin_rest(k, s%t)
+      end if
+    end subroutine bounce_series
+
+    !> Contact k starts to rest, logged at `when` (now, or a series' accumulation time).
+    !> Nothing is logged if it already rests, or if it was released at this same instant.
+    subroutine begin_rest(k, when)
+      integer, intent(in) :: k
+      real(wp), intent(in) :: when
+      if (in_contact(k)) return
+      in_contact(k) = .true.
+      if (release_time(k) < huge(1.0_wp)) then
+        if (s%t - release_time(k) <= time_rounding * max(abs(s%t), scene%dt)) then
+          release_time(k) = huge(1.0_wp)
+          return
+        end if
+      end if
+      call flush_releases(.true.)
+      if (when > s%t) then
+        pending_rest(k) = when
       else
         call log_event(event_rest + k, s%v, s%v)
       end if
-    end subroutine bounce_series
+    end subroutine begin_rest
+
+    !> Log the releases decided at an earlier instant (all of them with everything).
+    subroutine flush_releases(everything)
+      logical, intent(in) :: everything
+      integer :: k
+      do k = 1, n_contacts
+        if (release_time(k) == huge(1.0_wp)) cycle
+        if (.not. everything .and. s%t - release_time(k) <= time_rounding * max(abs(s%t), scene%dt)) cycle
+        stats%events(event_release + k) = stats%events(event_release + k) + 1
+        call sink%put_event(release_time(k), event_release + k, release_v(:, k), release_v(:, k))
+        release_time(k) = huge(1.0_wp)
+      end do
+    end subroutine flush_releases
 
     !> Under constant forces a mode's motion is an exact quadratic, so the first instant an
     !> open gap can close, or a sliding body can stop, is known in closed form; steps that end
