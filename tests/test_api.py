@@ -239,3 +239,36 @@ def test_bad_dat_file(tmp_path):
     path = write_scene(tmp_path, "\n".join(short) + "\n", name="short.dat")
     with pytest.raises(InputError):
         impact1d.simulate(impact1d.load_scene(path), t_end=1.0, dt=1e-3)
+
+
+# --- sweeps and progress -------------------------------------------------------------
+
+# A free flight long enough (6e7 steps, about 3 s here, the line appears after 1 s) for
+# the progress line to appear even on a machine twice as fast.
+LONG_RUN = dict(t_end=6.0e4, dt=1.0e-3, dt_out=1.0e4)
+
+
+def _free_flight():
+    return impact1d.Scene(m1=1.0, m2=2.0, x1=0.0, x2=5.0, v1=1.0, v2=-0.5, f1=0.001, f2=-0.002)
+
+
+def test_sweep_equals_separate_runs():
+    scene = impact1d.load_scene(str(INPUT / "case3.nml"))
+    runs = [dict(dt=1e-3), dict(dt=1e-2, dt_out=1e-2), dict(t_end=1.0)]
+    swept = impact1d.sweep(scene, runs)
+    assert len(swept) == len(runs)
+    for result, overrides in zip(swept, runs):
+        alone = impact1d.simulate(scene, **overrides)
+        np.testing.assert_array_equal(result.samples, alone.samples)
+        np.testing.assert_array_equal(result.events, alone.events)
+
+
+def test_progress_only_when_asked(capfd):
+    """progress=True shows a line on stderr (the Fortran side writes it) once a run has taken
+    a second, and clears it; without it a long run says nothing."""
+    impact1d.simulate(_free_flight(), **LONG_RUN)
+    assert capfd.readouterr().err == ""
+    res = impact1d.simulate(_free_flight(), progress=True, **LONG_RUN)
+    err = capfd.readouterr().err
+    assert "impact1d: " in err and "% (t = " in err and "of 60000.0 s)" in err
+    assert res.t[-1] == LONG_RUN["t_end"]
