@@ -158,7 +158,7 @@ contains
       if (.not. event_due .and. at_stop) event_due = t_stop == t_break .or. t_stop == t_rest
       if (.not. event_due .and. at_stop) event_due = impact_due()
       if (event_due) then
-        if (s%t - t_last_event <= time_rounding * max(abs(s%t), scene%dt)) then
+        if (same_instant(s%t, t_last_event)) then
           stalls = stalls + 1
           if (stalls > max_stalls) then
             call raise(error, status_simulation, 'at t = ' // fmt(s%t) // ': ' // fmt(max_stalls) // &
@@ -669,7 +669,7 @@ contains
       if (in_contact(k)) return
       in_contact(k) = .true.
       if (release_time(k) < huge(1.0_wp)) then
-        if (s%t - release_time(k) <= time_rounding * max(abs(s%t), scene%dt)) then
+        if (same_instant(s%t, release_time(k))) then
           release_time(k) = huge(1.0_wp)
           return
         end if
@@ -682,13 +682,19 @@ contains
       end if
     end subroutine begin_rest
 
+    !> Instants closer than the clock resolves are one (t_later >= t_earlier).
+    pure logical function same_instant(t_later, t_earlier)
+      real(wp), intent(in) :: t_later, t_earlier
+      same_instant = t_later - t_earlier <= time_rounding * max(abs(t_later), scene%dt)
+    end function same_instant
+
     !> Log the releases decided at an earlier instant (all of them with everything).
     subroutine flush_releases(everything)
       logical, intent(in) :: everything
       integer :: k
       do k = 1, n_contacts
         if (release_time(k) == huge(1.0_wp)) cycle
-        if (.not. everything .and. s%t - release_time(k) <= time_rounding * max(abs(s%t), scene%dt)) cycle
+        if (.not. everything .and. same_instant(s%t, release_time(k))) cycle
         stats%events(event_release + k) = stats%events(event_release + k) + 1
         call sink%put_event(release_time(k), event_release + k, release_v(:, k), release_v(:, k))
         release_time(k) = huge(1.0_wp)
