@@ -99,57 +99,63 @@ contains
       if (t_break <= s%t) t_break = scene%forcing%next_breakpoint(s%t)
       t_rest = minval(pending_rest)
       t_stop = min(sample_t, t_break, t_rest)
-      h = min(scene%dt, (t_stop - s%t) - s%t_lo)
-      ! No sliver steps: a step that would stop just short of a stop goes to it.
-      if ((t_stop - s%t) - s%t_lo - h <= 1.0e-9_wp * scene%dt) h = (t_stop - s%t) - s%t_lo
 
-      halvings = 0
-      do
-        located = .false.
-        watched = 0
-        ! An event that landed exactly on the stop leaves nothing to step.
-        if (h <= 0.0_wp) then
-          trial = s
-          exit
-        end if
-        call rk4_step(s, h, trial)
-        if (.not. watching) exit      ! nothing in this mode can end it: no location needed
-        call locate(s, trial, h, h_event, watched)
-        located = h_event <= h
-        if (located) then
-          h = h_event
-          if (h > 0.0_wp) then
-            call refine(s, h, watched, trial)
-          else
-            trial = s     ! the event is at the step's start: nothing to step
+      located = .false.
+      at_stop = .false.
+      if (constant_forcing) then
+        call glide(t_stop, at_stop)
+        if (allocated(error)) return
+      end if
+      if (.not. at_stop) then
+        h = step_toward(t_stop)
+        halvings = 0
+        do
+          located = .false.
+          watched = 0
+          ! An event that landed exactly on the stop leaves nothing to step.
+          if (h <= 0.0_wp) then
+            trial = s
             exit
           end if
+          call rk4_step(s, h, trial)
+          if (.not. watching) exit      ! nothing in this mode can end it: no location needed
+          call locate(s, trial, h, h_event, watched)
+          located = h_event <= h
+          if (located) then
+            h = h_event
+            if (h > 0.0_wp) then
+              call refine(s, h, watched, trial)
+            else
+              trial = s     ! the event is at the step's start: nothing to step
+              exit
+            end if
+          end if
+          ! Under polynomial forcing the dense output is exact and nothing can be missed; only
+          ! a sine's approximate dense output needs the step's end checked.
+          if (polynomial_forcing) exit
+          if (constraints_hold(trial, merge(watched, 0, located))) exit
+          ! The location missed a root (only possible for non-polynomial forcing): retry shorter.
+          halvings = halvings + 1
+          if (halvings > max_halvings) then
+            call raise(error, status_simulation, 'at t = ' // fmt(s%t) // &
+              ': no step keeps the constraints (event location failed)')
+            return
+          end if
+          h = 0.5_wp * h
+        end do
+
+        at_stop = .not. located .and. h == (t_stop - s%t) - s%t_lo
+        s = trial
+        if (at_stop) then
+          s%t = t_stop
+          s%t_lo = 0.0_wp
         end if
-        ! Under polynomial forcing the dense output is exact and nothing can be missed; only
-        ! a sine's approximate dense output needs the step's end checked.
-        if (polynomial_forcing) exit
-        if (constraints_hold(trial, merge(watched, 0, located))) exit
-        ! The location missed a root (only possible for non-polynomial forcing): retry shorter.
-        halvings = halvings + 1
-        if (halvings > max_halvings) then
-          call raise(error, status_simulation, 'at t = ' // fmt(s%t) // &
-            ': no step keeps the constraints (event location failed)')
+        stats%steps = stats%steps + 1
+        if (iand(stats%steps, 4095_int64) == 0) call sink%progress(s%t, scene%t_end)
+        if (.not. finite_state(s)) then
+          call raise(error, status_simulation, 'at t = ' // fmt(s%t) // ': the state is no longer finite')
           return
         end if
-        h = 0.5_wp * h
-      end do
-
-      at_stop = .not. located .and. h == (t_stop - s%t) - s%t_lo
-      s = trial
-      if (at_stop) then
-        s%t = t_stop
-        s%t_lo = 0.0_wp
-      end if
-      stats%steps = stats%steps + 1
-      if (iand(stats%steps, 4095_int64) == 0) call sink%progress(s%t, scene%t_end)
-      if (any(.not. ieee_finite_state(s))) then
-        call raise(error, status_simulation, 'at t = ' // fmt(s%t) // ': the state is no longer finite')
-        return
       end if
 
       ! Events, table corners (the force's slope changes) and accumulation times need an
@@ -210,6 +216,107 @@ contains
       end do
     end subroutine flush_pending_rest
 
+    !> The step toward a stop: dt, or what is left when that is less. No sliver steps: a step
+    !> that would end just short of the stop goes to it.
+    real(wp) function step_toward(t_stop) result(h)
+      real(wp), intent(in) :: t_stop
+      real(wp) :: remaining
+      remaining = (t_stop - s%t) - s%t_lo
+      h = min(scene%dt, remaining)
+      if (remaining - h <= 1.0e-9_wp * scene%dt) h = remaining
+    end function step_toward
+
+    !> Under constant forces the steps that end before every watched gap's and sliding body's
+    !> quiet time (find_quiet_times) can meet no event: they need no location, and the ledger
+    !> over them is the forces times the displacement. Their bulk is taken here in a tight
+    !> loop, each step RK4's closed form under constant acceleration; the sums are compensated
+    !> as in add_compensated but renormalised once at the end (the low parts carry the rounding
+    !> meanwhile, and a position's increment reads its velocity's low part). The last steps
+    !> before the stop follow step_toward, so the steps are those of the located path.
+    subroutine glide(t_stop, at_stop)
+      real(wp), intent(in) :: t_stop
+      logical, intent(out) :: at_stop
+      type(state_type) :: start
+      real(wp) :: t_quiet, h, t, t_lo, x(2), x_lo(2), v(2), v_lo(2), dv(2), half_dv(2)
+      integer(int64) :: n_bulk, n, j
+
+      at_stop = .false.
+      t_quiet = minval(quiet_until)
+      if (s%t + step_toward(t_stop) >= t_quiet) return
+      start = s
+      ! Whole steps of dt ending at least two steps short of the stop and the quiet time.
+      n_bulk = int(min((t_stop - s%t) - s%t_lo, t_quiet - s%t) / scene%dt, int64) - 2
+      h = scene%dt
+      dv = h * constant_acceleration
+      half_dv = 0.5_wp * dv
+      t = s%t
+      t_lo = s%t_lo
+      x = s%x
+      x_lo = s%x_lo
+      v = s%v
+      v_lo = s%v_lo
+      do while (n_bulk > 0)
+        ! In runs of up to the next progress report.
+        n = min(n_bulk, 4096_int64 - iand(stats%steps, 4095_int64))
+        do j = 1, n
+          call accumulate(t, t_lo, h)
+          call accumulate(x, x_lo, h * ((v + v_lo) + half_dv))
+          call accumulate(v, v_lo, dv)
+        end do
+        n_bulk = n_bulk - n
+        stats%steps = stats%steps + n
+        if (iand(stats%steps, 4095_int64) == 0) call sink%progress(t, scene%t_end)
+      end do
+      call renormalise(t, t_lo)
+      call renormalise(x, x_lo)
+      call renormalise(v, v_lo)
+      s%t = t
+      s%t_lo = t_lo
+      s%x = x
+      s%x_lo = x_lo
+      s%v = v
+      s%v_lo = v_lo
+      ! The last steps: to the stop by the step rule, while they stay quiet.
+      do
+        h = step_toward(t_stop)
+        if (h <= 0.0_wp .or. s%t + h >= t_quiet) exit
+        at_stop = h == (t_stop - s%t) - s%t_lo
+        call advance_constant(s, h)
+        stats%steps = stats%steps + 1
+        if (iand(stats%steps, 4095_int64) == 0) call sink%progress(s%t, scene%t_end)
+        if (at_stop) then
+          s%t = t_stop
+          s%t_lo = 0.0_wp
+          exit
+        end if
+      end do
+      call book_constant_ledger(start, s)
+      if (.not. finite_state(s)) call raise(error, status_simulation, 'at t = ' // fmt(s%t) // &
+        ': the state is no longer finite')
+    end subroutine glide
+
+    !> One step of the mode under constant acceleration: RK4 is exact there, and its step is
+    !> the quadratic x + h v + h^2 a / 2, v + h a.
+    pure subroutine advance_constant(state, step)
+      type(state_type), intent(inout) :: state
+      real(wp), intent(in) :: step
+      call add_compensated(state%t, state%t_lo, step)
+      call add_compensated(state%x, state%x_lo, step * ((state%v + state%v_lo) + &
+        (0.5_wp * step) * constant_acceleration))
+      call add_compensated(state%v, state%v_lo, step * constant_acceleration)
+    end subroutine advance_constant
+
+    !> Under constant forces the work and the friction loss over any stretch of one mode are
+    !> the forces times the displacement, exactly (no quadrature).
+    subroutine book_constant_ledger(a, b)
+      type(state_type), intent(in) :: a
+      type(state_type), intent(inout) :: b
+      real(wp) :: dx(2)
+      dx = (b%x - a%x) + (b%x_lo - a%x_lo)
+      call add_compensated(b%work, b%work_lo, dot_product(scene%forcing%constant, dx))
+      call add_compensated(b%friction_loss, b%friction_lo, -dot_product(mode%f_slide, dx))
+    end subroutine book_constant_ledger
+
     !> One classical RK4 step of the mode's equations from a to b; the energy ledger by
     !> Simpson's rule on the step's Hermite velocity, exact where RK4 is (polynomial forcing).
     subroutine rk4_step(a, step, b)
@@ -218,28 +325,24 @@ contains
       type(state_type), intent(out) :: b
       real(wp) :: f0(2), fm(2), f1(2), a0(2), am(2), a1(2)
       real(wp) :: k1x(2), k2x(2), k3x(2), k4x(2), vm(2), dx(2)
+      b = a
       if (constant_forcing) then
-        ! Constant forces: the mode's acceleration was worked out once, at the event point.
-        f0 = scene%forcing%constant
-        fm = f0
-        f1 = f0
-        a0 = constant_acceleration
-        am = a0
-        a1 = a0
-      else
-        f0 = scene%forcing%force(a%t)
-        fm = scene%forcing%force(a%t + 0.5_wp * step)
-        f1 = scene%forcing%force(a%t + step)
-        ! Within a mode the acceleration depends on time only, so stages 2 and 3 share it.
-        a0 = mode%acceleration(f0)
-        am = mode%acceleration(fm)
-        a1 = mode%acceleration(f1)
+        ! The mode's acceleration was worked out once, at the event point.
+        call advance_constant(b, step)
+        call book_constant_ledger(a, b)
+        return
       end if
+      f0 = scene%forcing%force(a%t)
+      fm = scene%forcing%force(a%t + 0.5_wp * step)
+      f1 = scene%forcing%force(a%t + step)
+      ! Within a mode the acceleration depends on time only, so stages 2 and 3 share it.
+      a0 = mode%acceleration(f0)
+      am = mode%acceleration(fm)
+      a1 = mode%acceleration(f1)
       k1x = a%v
       k2x = a%v + 0.5_wp * step * a0
       k3x = a%v + 0.5_wp * step * am
       k4x = a%v + step * am
-      b = a
       call add_compensated(b%t, b%t_lo, step)
       dx = step / 6.0_wp * (k1x + 2.0_wp * k2x + 2.0_wp * k3x + k4x)
       call add_compensated(b%x, b%x_lo, dx)
@@ -707,6 +810,7 @@ contains
     !> shortcut: the location itself still finds the event.
     subroutine find_quiet_times()
       integer :: k, i
+      quiet_until = huge(1.0_wp)     ! what is not watched needs no location
       do k = 1, n_contacts
         if (.not. scene%has_contact(k) .or. mode%active(k)) cycle
         quiet_until(k) = s%t + 0.99_wp * first_negative(gap(k, s), normal_velocity(k, s%v), &
@@ -832,18 +936,34 @@ contains
     elemental subroutine add_compensated(hi, lo, increment)
       real(wp), intent(inout) :: hi, lo
       real(wp), intent(in) :: increment
+      call accumulate(hi, lo, increment)
+      call renormalise(hi, lo)
+    end subroutine add_compensated
+
+    !> hi += increment, its exact rounding error (two-sum) into lo; hi + lo is the sum.
+    elemental subroutine accumulate(hi, lo, increment)
+      real(wp), intent(inout) :: hi, lo
+      real(wp), intent(in) :: increment
       real(wp) :: total, rounded
       total = hi + increment
       rounded = total - hi
       lo = lo + ((hi - (total - rounded)) + (increment - rounded))
-      hi = total + lo
-      lo = lo - (hi - total)
-    end subroutine add_compensated
+      hi = total
+    end subroutine accumulate
 
-    pure function ieee_finite_state(state) result(finite)
+    !> hi becomes hi + lo correctly rounded and lo what is left (Fast2Sum, exact while |lo| is
+    !> below |hi|, as it is but for a sum passing through zero).
+    elemental subroutine renormalise(hi, lo)
+      real(wp), intent(inout) :: hi, lo
+      real(wp) :: total
+      total = hi + lo
+      lo = lo - (total - hi)
+      hi = total
+    end subroutine renormalise
+
+    pure logical function finite_state(state)
       type(state_type), intent(in) :: state
-      logical :: finite(5)
-      finite = abs([state%x, state%v, state%work]) <= huge(1.0_wp)
-    end function ieee_finite_state
+      finite_state = all(abs([state%x, state%v, state%work]) <= huge(1.0_wp))
+    end function finite_state
   end subroutine run
 end module impact1d_solver

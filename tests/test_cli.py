@@ -172,10 +172,12 @@ def test_read_output_missing_file(tmp_path):
 
 
 def test_no_progress_line_when_stderr_is_not_a_terminal(cli, tmp_path):
-    """The progress line is for a person at a terminal: a long run (over a second) with
-    stderr piped, as here and in scripts, writes nothing there."""
+    """The progress line is for a person at a terminal: a long run (about 2 s here: a sine
+    force, which every step evaluates) with stderr piped, as here and in scripts, writes
+    nothing there."""
     scene = tmp_path / "long.nml"
     scene.write_text("&bodies m1 = 1.0, m2 = 2.0 /\n&initial x1 = 0.0, v1 = 1.0, x2 = 5.0 /\n"
-                     "&forces f1 = 0.001 /\n&run t_end = 3.0e4, dt = 1.0e-3, dt_out = 1.0e4 /\n")
+                     "&forces f1 = 0.001, f1_amp = 0.1, f1_period = 7.0 /\n"
+                     "&run t_end = 1.5e4, dt = 1.0e-3, dt_out = 1.0e4 /\n")
     done = run_cli(cli, scene, "-o", tmp_path / "long.dat", cwd=tmp_path)
     assert done.stderr == ""
