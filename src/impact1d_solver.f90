@@ -427,7 +427,7 @@ contains
     end function dense_output
 
     !> Earliest time in [0, step] at which a condition of the mode (a contact force, a static
-    !> friction margin) turns negative. They depend on time only: linear within a step under
+    !> friction margin) has turned negative. They depend on time only: linear within a step under
     !> piecewise-linear forcing, so the ends decide; a sine is sampled finer before bisection.
     real(wp) function hold_crossing(t0, step) result(theta)
       real(wp), intent(in) :: t0, step
@@ -444,7 +444,10 @@ contains
       do j = 1, n_sub
         hi = step * real(j, wp) / real(n_sub, wp)
         if (worst_hold(t0 + hi) < -tol) then
-          ! Bisection to the last instant at which every condition still holds.
+          ! Bisection to the first instant at which a condition has failed (within rounding):
+          ! there the new mode's accelerations have the sign of the change. At the last
+          ! instant that held, a released contact would be left a rounding-level acceleration
+          ! back into it and close again at once, for ever.
           do while (hi - lo > 2.0_wp * eps_wp * max(abs(t0 + hi), step))
             mid = 0.5_wp * (lo + hi)
             if (worst_hold(t0 + mid) < 0.0_wp) then
@@ -453,7 +456,7 @@ contains
               lo = mid
             end if
           end do
-          theta = lo
+          theta = hi
           return
         end if
         lo = hi

@@ -176,8 +176,8 @@ def describe(scene, tables=None):
     return "\n".join(lines)
 
 
-def check(scene, label, tables=None):
-    res = impact1d.simulate(scene, dt=DT, dt_out=scene.t_end / 100)
+def check(scene, label, tables=None, dt=DT):
+    res = impact1d.simulate(scene, dt=dt, dt_out=scene.t_end / 100)
     sol = ref.solve(scene)
     problems = compare(scene, res, sol)
     if problems:
@@ -394,6 +394,24 @@ def test_generated_scene_matches_reference(index, table_folder):
     scene, tables = generate(index, table_folder)
     check(scene, f"generated scene {index} (SEED = {SEED}, family "
                  f"{FAMILIES[index % len(FAMILIES)]})", tables)
+
+
+# Fine steps: 10^4..10^6 steps a run, most of them (under constant forces) taken in bulk
+# between events, the rest located one by one; rounding must not build up over them.
+FINE_DT = 1e-5
+FINE_EVERY = 5      # every 5th generated scene (the seeds all)
+
+
+@pytest.mark.parametrize("case", (2, 3, 4, 5, 6))
+def test_seed_case_at_fine_step_matches_reference(case):
+    scene = impact1d.load_scene(INPUT / f"case{case}.nml")
+    check(scene, f"input/case{case}.nml at dt = {FINE_DT}", dt=FINE_DT)
+
+
+@pytest.mark.parametrize("index", [p for p in _params() if p.values[0] % FINE_EVERY == 0])
+def test_generated_scene_at_fine_step_matches_reference(index, table_folder):
+    scene, tables = generate(index, table_folder)
+    check(scene, f"generated scene {index} at dt = {FINE_DT}", tables, dt=FINE_DT)
 
 
 def test_generated_scenes_cover_the_physics(table_folder):
