@@ -6,7 +6,8 @@
  2. the stepping loop: RK4 steps per second of the `impact1d` CLI on a long free-flight run
     (bench/scenes/freeflight.nml, output at 0 and t_end only) against bench/bare_rk4.f90,
     a plain RK4 loop on the same force law compiled here with the release build's -O3;
-    both timed the same way (wall and CPU time of the process), alternating;
+    both timed the same way (wall and CPU time of the process), alternating; and the same
+    under a sine force (bench/scenes/sineflight.nml), where the engine's general step runs;
  3. cost against t_end (free flight) and against the number of events (slot rattle at a
     fixed step count), with linear fits;
  4. the CLI's peak memory (/usr/bin/time -f %M) at 10^6 and 10^7 steps, output streamed.
@@ -35,6 +36,7 @@ import common
 from scipy_reference import simulate_scipy
 
 FREEFLIGHT = common.BENCH / "scenes" / "freeflight.nml"
+SINEFLIGHT = common.BENCH / "scenes" / "sineflight.nml"
 SLOTRATTLE = common.BENCH / "scenes" / "slotrattle.nml"
 BARE_SOURCE = common.BENCH / "bare_rk4.f90"
 # The meson release build compiles the core with these (buildtype=release: -O3, -DNDEBUG).
@@ -42,7 +44,8 @@ RELEASE_FLAGS = ["-O3"]
 
 PAIRS_CASE3 = 21           # paired alternating runs for the case-3 ratio
 PAIRS_LOOP = 5             # paired alternating runs, CLI against the bare loop
-LOOP_STEPS = 10_000_000    # free-flight steps per run (t_end = 1e4 s at dt = 1e-3 s)
+LOOP_STEPS = 100_000_000   # free-flight steps per run (t_end = 1e5 s at dt = 1e-3 s)
+SINE_STEPS = 10_000_000    # the same under a sine force (t_end = 1e4 s)
 
 
 def cli_path() -> str:
@@ -128,16 +131,18 @@ def build_bare(workdir: Path) -> Path:
     return exe
 
 
-def stepping_loop(workdir: Path):
-    scene = impact1d.load_scene(FREEFLIGHT)
+def stepping_loop(workdir: Path, scene_path: Path, n_steps: int):
+    scene = impact1d.load_scene(scene_path)
     dt = scene.dt
-    t_end = LOOP_STEPS * dt
+    t_end = n_steps * dt
     bare = build_bare(workdir)
-    cli = [cli_path(), str(FREEFLIGHT), "--t-end", repr(t_end), "--dt", repr(dt),
+    cli = [cli_path(), str(scene_path), "--t-end", repr(t_end), "--dt", repr(dt),
            "--dt-out", repr(t_end), "-o", str(workdir / "freeflight.dat")]
-    bare_cmd = [str(bare), str(LOOP_STEPS), repr(dt), repr(scene.m1), repr(scene.m2),
+    bare_cmd = [str(bare), str(n_steps), repr(dt), repr(scene.m1), repr(scene.m2),
                 repr(scene.f1), repr(scene.f2), repr(scene.x1), repr(scene.v1),
                 repr(scene.x2), repr(scene.v2)]
+    if scene.f1_amp is not None:
+        bare_cmd += [repr(scene.f1_amp), repr(scene.f1_period)]
     timed_process(bare_cmd), timed_process(cli)          # warm-up (page cache)
     rows = []
     for i in range(PAIRS_LOOP):
@@ -147,14 +152,16 @@ def stepping_loop(workdir: Path):
             row[name] = timed_process(cmd)
         rows.append(row)
     steps_reported = int(re.search(r"steps\s+(\d+)", rows[0]["cli"]["stdout"]).group(1))
-    out = {"steps": LOOP_STEPS, "cli_steps_reported": steps_reported, "dt": dt,
-           "pairs": PAIRS_LOOP}
+    # How far each lands from the exact final time (the bare loop's clock is a plain sum).
+    bare_t = float(rows[0]["bare"]["stdout"].split()[0])
+    out = {"scene": scene_path.name, "steps": n_steps, "cli_steps_reported": steps_reported,
+           "dt": dt, "pairs": PAIRS_LOOP, "bare_clock_error": abs(bare_t - t_end)}
     for clock in ("wall", "cpu"):
         cli_t = statistics.median(r["cli"][clock] for r in rows)
         bare_t = statistics.median(r["bare"][clock] for r in rows)
         out[clock] = {"cli_s": cli_t, "bare_s": bare_t,
-                      "cli_steps_per_s": LOOP_STEPS / cli_t,
-                      "bare_steps_per_s": LOOP_STEPS / bare_t,
+                      "cli_steps_per_s": n_steps / cli_t,
+                      "bare_steps_per_s": n_steps / bare_t,
                       "ratio_median": statistics.median(r["cli"][clock] / r["bare"][clock]
                                                         for r in rows)}
     # The same loop through the Python API (output at 0 and t_end only).
@@ -249,7 +256,9 @@ def _plot(results, path):
 def run():
     with tempfile.TemporaryDirectory(prefix="impact1d-bench-") as tmp:
         work = Path(tmp)
-        results = {"case3": case3_against_scipy(), "loop": stepping_loop(work),
+        results = {"case3": case3_against_scipy(),
+                   "loop": stepping_loop(work, FREEFLIGHT, LOOP_STEPS),
+                   "loop_sine": stepping_loop(work, SINEFLIGHT, SINE_STEPS),
                    "scaling": scaling(), "memory": memory(work)}
     common.save_json("performance", results)
     _plot(results, common.DOCS / "performance.png")

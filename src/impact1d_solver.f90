@@ -687,6 +687,15 @@ contains
 
       ! Impulses can leave a rounding-level velocity on a body that had stopped; it is zero.
       call zero_stopped(acc)
+      ! A body still against the other one (a closed slot limit) that has stopped has stopped
+      ! too: its velocity is the contact's rounding-level normal velocity.
+      do k = 1, n_contacts
+        if (.not. closed(k) .or. any(normal(:, k) == 0.0_wp)) cycle
+        if (abs(normal_velocity(k, s%v)) > u_tolerance(k)) cycle
+        do i = 1, 2
+          if (s%v(i) == 0.0_wp) call zero_velocity(3 - i)
+        end do
+      end do
 
       call candidates(closed, candidate, resting, moving_sign)
       call solve_mode(scene, f, df, candidate, resting, moving_sign, new_mode, found, force_scale(f, df))
