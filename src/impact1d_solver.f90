@@ -249,8 +249,9 @@ contains
       t_quiet = minval(quiet_until)
       if (s%t + step_toward(t_stop) >= t_quiet) return
       start = s
-      ! Whole steps of dt ending at least two steps short of the stop and the quiet time.
-      n_bulk = int(min((t_stop - s%t) - s%t_lo, t_quiet - s%t) / scene%dt, int64) - 2
+      ! Whole steps of dt ending at least a step short of the stop and the quiet time
+      ! (capped where the count would not fit an integer: such a run never ends anyway).
+      n_bulk = int(min(min((t_stop - s%t) - s%t_lo, t_quiet - s%t) / scene%dt, 1.0e18_wp), int64) - 1
       h = scene%dt
       dv = h * constant_acceleration
       half_dv = 0.5_wp * dv

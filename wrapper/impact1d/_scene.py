@@ -127,20 +127,24 @@ def _fortran_text(value) -> str:
 
 def to_core(scene: Scene):
     """Scene -> (values, given, title, f1_table, f2_table, method) for the api."""
-    values = np.zeros(len(REAL_FIELDS), dtype=np.float64)
-    given = np.zeros(len(REAL_FIELDS), dtype=np.int32)
-    for i, name in enumerate(REAL_FIELDS):
-        value = getattr(scene, name)
-        if value is None:
-            continue
-        try:
-            values[i] = float(value)
-        except (TypeError, ValueError):
-            raise InputError(f"{name} must be a number, got {value!r}") from None
-        given[i] = 1
+    fields = vars(scene)
+    reals = [fields[name] for name in REAL_FIELDS]
+    given = np.array([value is not None for value in reals], dtype=np.int32)
+    try:
+        values = np.array([0.0 if value is None else value for value in reals], dtype=np.float64)
+    except (TypeError, ValueError):
+        values = None
+    if values is None or values.shape != (len(REAL_FIELDS),):
+        # Name the field that is not a number.
+        for name, value in zip(REAL_FIELDS, reals):
+            try:
+                float(value if value is not None else 0.0)
+            except (TypeError, ValueError):
+                raise InputError(f"{name} must be a number, got {value!r}") from None
+        raise InputError("scene fields must be numbers")
     texts = []
     for name in TEXT_FIELDS:
-        value = getattr(scene, name)
+        value = fields[name]
         if value is not None and not isinstance(value, (str, os.PathLike)):
             raise InputError(f"{name} must be text, got {value!r}")
         texts.append(_fortran_text(None if value is None else os.fspath(value)))

@@ -35,6 +35,12 @@ def event_kinds() -> tuple:
     return _words(_api.event_kind_names())
 
 
+@lru_cache(maxsize=None)
+def _kind_names() -> np.ndarray:
+    """Event kind words indexed by the core's code (index 0: an unknown code)."""
+    return np.array(("unknown",) + event_kinds())
+
+
 def _empty():
     return np.empty(0, dtype=np.float64)
 
@@ -88,7 +94,12 @@ def simulate(scene: Scene, *, progress: bool = False, **overrides) -> Result:
     if unknown:
         raise InputError(f"unknown scene field(s) in overrides: {', '.join(unknown)} "
                          f"(known: {', '.join(_OVERRIDABLE)})")
-    scene = dataclasses.replace(scene, **overrides)
+    if overrides:
+        # dataclasses.replace without re-running __init__ (it only assigns the fields):
+        # a tenth of the time, which counts when a run itself takes 0.1 ms.
+        changed = object.__new__(Scene)
+        vars(changed).update(vars(scene), **overrides)
+        scene = changed
     values, given, title, f1_table, f2_table, method = to_core(scene)
 
     (n_samples, n_events, steps, energy_residual,
@@ -104,10 +115,10 @@ def simulate(scene: Scene, *, progress: bool = False, **overrides) -> Result:
     events = np.empty(n_events, dtype=EVENT_DTYPE)
     if n_events > 0:
         t, kind, v1b, v2b, v1a, v2a = _api.get_events(n_events)
-        names = event_kinds()
+        names = _kind_names()
+        kind = np.asarray(kind)
         events["t"] = t
-        events["kind"] = [names[k - 1] if 1 <= k <= len(names) else f"unknown_{k}"
-                          for k in np.asarray(kind).tolist()]
+        events["kind"] = names[np.where((kind >= 1) & (kind < len(names)), kind, 0)]
         events["v1_before"], events["v2_before"] = v1b, v2b
         events["v1_after"], events["v2_after"] = v1a, v2a
     return result_from_columns(samples, events, energy_residual=float(energy_residual),
