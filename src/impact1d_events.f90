@@ -118,30 +118,42 @@ contains
     end if
   end subroutine stationary_points
 
-  !> The root of p in (a, b), where p(a) and p(b) differ in sign: bisection to the last bit,
-  !> since a monotone piece has exactly one root and bisection cannot leave it.
+  !> The root of p in (a, b), where p(a) and p(b) differ in sign, to the last bit: the bracket
+  !> shrinks until its ends are adjacent numbers. Newton's point is taken when it falls inside
+  !> the bracket, the midpoint otherwise, so the root is never left (a monotone piece has
+  !> exactly one); once Newton's step is below the numbers' spacing, a point just across the
+  !> root closes the bracket. A handful of evaluations instead of bisection's fifty.
   pure real(wp) function bracketed_root(p, a0, b0) result(root)
     real(wp), intent(in) :: p(0:3), a0, b0
-    real(wp) :: a, b, fa, mid, fm
+    real(wp) :: a, b, fa, x, fx, slope, step
     integer :: iteration
     a = a0
     b = b0
     fa = poly_value(p, a)
+    x = 0.5_wp * (a + b)
     do iteration = 1, 200
-      mid = 0.5_wp * (a + b)
-      if (mid <= a .or. mid >= b) exit
-      fm = poly_value(p, mid)
-      if (fm == 0.0_wp) then
-        a = mid
-        b = mid
+      if (.not. (x > a .and. x < b)) x = 0.5_wp * (a + b)
+      if (.not. (x > a .and. x < b)) exit      ! a and b are adjacent numbers
+      fx = poly_value(p, x)
+      if (fx == 0.0_wp) then
+        a = x
+        b = x
         exit
       end if
-      if ((fm < 0.0_wp) .eqv. (fa < 0.0_wp)) then
-        a = mid
-        fa = fm
+      if ((fx < 0.0_wp) .eqv. (fa < 0.0_wp)) then
+        a = x
+        fa = fx
       else
-        b = mid
+        b = x
       end if
+      slope = p(1) + x * (2.0_wp * p(2) + 3.0_wp * x * p(3))
+      if (slope == 0.0_wp) then
+        x = 0.5_wp * (a + b)
+        cycle
+      end if
+      step = fx / slope
+      if (abs(step) <= spacing(x)) step = sign(2.0_wp * spacing(x), step)
+      x = x - step
     end do
     ! The earlier end: a crossing is never reported after the function went negative.
     root = a
