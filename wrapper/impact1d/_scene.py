@@ -118,11 +118,11 @@ assert _SCENE_FIELDS == REAL_FIELDS + TEXT_FIELDS + ("source",)
 
 
 def _fortran_text(value) -> str:
-    # Blank-padded to the buffer length: Fortran's len_trim ignores blanks, not NULs.
+    # The api takes character(len=*) and blank-pads it into its buffers itself.
     text = "" if value is None else str(value)
     if len(text) > TEXT_LEN:
         raise InputError(f"text longer than {TEXT_LEN} characters: {text[:60]}...")
-    return text.ljust(TEXT_LEN)
+    return text
 
 
 def to_core(scene: Scene):

@@ -79,7 +79,9 @@ class Result:
 def result_from_columns(samples: np.ndarray, events: np.ndarray, **extra) -> Result:
     """Build a Result from an (n, 10) sample array in COLUMNS order."""
     samples = np.asarray(samples, dtype=np.float64).reshape(-1, len(COLUMNS))
-    columns = {name: np.ascontiguousarray(samples[:, i]) for i, name in enumerate(COLUMNS)}
+    # Column-major (as f2py returns it, a copy otherwise): each column is a contiguous row
+    # of the transpose, shared rather than copied.
+    columns = dict(zip(COLUMNS, np.asfortranarray(samples).T))
     return Result(**columns, events=events, **extra)
 
 
