@@ -63,6 +63,8 @@ contains
     real(wp) :: end_force(2), end_force_t
     ! Until when each open gap (1..4) and each sliding body (5, 6) needs no location.
     real(wp) :: quiet_until(n_contacts + 2)
+    ! When impulses last moved each body off its rest (see the stick log in event_point).
+    real(wp) :: rest_lost_time(2)
     ! A release waiting for time to move on (see begin_rest), with its velocities.
     real(wp) :: release_time(n_contacts), release_v(2, n_contacts)
     integer :: j_sample, stalls, halvings, watched, event_points
@@ -75,6 +77,7 @@ contains
     constant_forcing = .not. (any(scene%forcing%has_table) .or. any(scene%forcing%has_sine))
     quiet_until = -huge(1.0_wp)
     end_force_t = -huge(1.0_wp)
+    rest_lost_time = -huge(1.0_wp)
     release_time = huge(1.0_wp)
     release_v = 0.0_wp
     polynomial_forcing = scene%forcing%is_polynomial()
@@ -738,8 +741,18 @@ contains
         leaving = new_mode%sgn(i) * acc(i) > tol_a(i) .or. (new_mode%sgn(i) * acc(i) >= -tol_a(i) .and. &
           new_mode%sgn(i) * acc_rate(i) > 1.0e3_wp * eps_wp * sum(abs(df)) / scene%mass(i))
         resting_now = s%v(i) == 0.0_wp .and. .not. leaving
-        if (resting_now .and. .not. at_rest(i) .and. .not. initial) call log_event(event_stick + i, s%v, s%v)
-        if (.not. resting_now .and. at_rest(i) .and. s%v(i) == 0.0_wp) call log_event(event_slip + i, s%v, s%v)
+        ! A body that impulses moved off its rest and that stops again at that same instant
+        ! (a chain of impacts ending there) never left rest: no stick (its leaving was not
+        ! logged either).
+        if (resting_now .and. .not. at_rest(i) .and. .not. initial .and. &
+            .not. same_instant(s%t, rest_lost_time(i))) call log_event(event_stick + i, s%v, s%v)
+        if (.not. resting_now .and. at_rest(i)) then
+          if (s%v(i) == 0.0_wp) then
+            call log_event(event_slip + i, s%v, s%v)
+          else
+            rest_lost_time(i) = s%t
+          end if
+        end if
         at_rest(i) = resting_now
       end do
       mode = new_mode
