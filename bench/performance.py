@@ -43,6 +43,7 @@ BARE_SOURCE = common.BENCH / "bare_rk4.f90"
 RELEASE_FLAGS = ["-O3"]
 
 PAIRS_CASE3 = 21           # paired alternating runs for the case-3 ratio
+BATCH_CASE3 = 10           # calls in a row per run, for the steady-state ratio
 PAIRS_LOOP = 5             # paired alternating runs, CLI against the bare loop
 LOOP_STEPS = 100_000_000   # free-flight steps per run (t_end = 1e5 s at dt = 1e-3 s)
 SINE_STEPS = 10_000_000    # the same under a sine force (t_end = 1e4 s)
@@ -101,16 +102,10 @@ def case3_against_scipy():
             return simulate_scipy(scene, "DOP853", chosen, t_eval=t_eval)
 
         ours_call(), scipy_call()          # warm-up (imports, caches)
-        pairs = []
-        for i in range(PAIRS_CASE3):
-            order = (ours_call, scipy_call) if i % 2 == 0 else (scipy_call, ours_call)
-            times = {}
-            for fn in order:
-                start = time.perf_counter()
-                fn()
-                times[fn.__name__] = time.perf_counter() - start
-            pairs.append((times["ours_call"], times["scipy_call"]))
+        pairs = _paired(ours_call, scipy_call, 1)
+        batches = _paired(ours_call, scipy_call, BATCH_CASE3)
     ratios = [s / o for o, s in pairs]
+    batch_ratios = [s / o for o, s in batches]
     return {
         "dt": dt, "dt_out": dt_out, "samples": len(ours.t), "steps": ours.steps,
         "impact1d_event_error": our_error, "scipy_rtol": chosen,
@@ -121,7 +116,29 @@ def case3_against_scipy():
         "scipy_median_s": statistics.median(s for _, s in pairs),
         "ratio_median": statistics.median(ratios),
         "ratio_min": min(ratios), "ratio_max": max(ratios), "pairs": len(pairs),
+        "batch": {"calls": BATCH_CASE3,
+                  "impact1d_median_s": statistics.median(o for o, _ in batches),
+                  "scipy_median_s": statistics.median(s for _, s in batches),
+                  "ratio_median": statistics.median(batch_ratios),
+                  "ratio_min": min(batch_ratios), "ratio_max": max(batch_ratios)},
     }
+
+
+def _paired(ours_call, scipy_call, calls):
+    """PAIRS_CASE3 pairs of runs, alternating which goes first; a run is `calls` calls in a
+    row, timed together (wall time per call). One call a run: each starts with the caches
+    the other left; several: the steady state of calls in a loop, as in a sweep."""
+    pairs = []
+    for i in range(PAIRS_CASE3):
+        order = (ours_call, scipy_call) if i % 2 == 0 else (scipy_call, ours_call)
+        times = {}
+        for fn in order:
+            start = time.perf_counter()
+            for _ in range(calls):
+                fn()
+            times[fn.__name__] = (time.perf_counter() - start) / calls
+        pairs.append((times["ours_call"], times["scipy_call"]))
+    return pairs
 
 
 # ----------------------------------------------------------------------------- 2. steps/s

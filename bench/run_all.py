@@ -226,7 +226,9 @@ def work_precision_md(wp, perf):
 def performance_md(perf, info) -> str:
     c3, loop, sine = perf["case3"], perf["loop"], perf["loop_sine"]
     sc, mem = perf["scaling"], perf["memory"]
-    verdict_100 = "meets" if c3["ratio_median"] >= 100 else "**does not meet**"
+    bt = c3["batch"]
+    verdict_100 = "meets" if bt["ratio_median"] >= 100 else "**does not meet**"
+    verdict_single = "meets" if c3["ratio_median"] >= 100 else "**does not meet**"
     verdict_2 = "within" if loop["wall"]["ratio_median"] <= 2 else "**not within**"
     out = [
         "# Performance",
@@ -249,21 +251,29 @@ def performance_md(perf, info) -> str:
         f"solve_ivp calls, {c3['scipy_nfev']} right-hand-side calls). {c3['pairs']} paired "
         "runs, alternating which goes first, wall time (`time.perf_counter`):",
         "",
-        _table([[f"{c3['impact1d_median_s'] * 1e3:.3f} ms", f"{c3['scipy_median_s'] * 1e3:.2f} ms",
-                 f"**{c3['ratio_median']:.0f}x**",
-                 f"{c3['ratio_min']:.0f}x .. {c3['ratio_max']:.0f}x"]],
-               ["impact1d (median)", "SciPy DOP853 (median)", "median of the paired ratios",
-                "range of the ratios"]),
+        _table([["one call each, alternating", f"{c3['impact1d_median_s'] * 1e3:.3f} ms",
+                 f"{c3['scipy_median_s'] * 1e3:.2f} ms", f"**{c3['ratio_median']:.0f}x**",
+                 f"{c3['ratio_min']:.0f}x .. {c3['ratio_max']:.0f}x"],
+                [f"{bt['calls']} calls each in a row, alternating",
+                 f"{bt['impact1d_median_s'] * 1e3:.3f} ms", f"{bt['scipy_median_s'] * 1e3:.2f} ms",
+                 f"**{bt['ratio_median']:.0f}x**",
+                 f"{bt['ratio_min']:.0f}x .. {bt['ratio_max']:.0f}x"]],
+               ["runs", "impact1d (median, per call)", "SciPy DOP853 (median, per call)",
+                "median of the paired ratios", "range of the ratios"]),
         "",
-        f"impact1d is {c3['ratio_median']:.0f} times faster: this {verdict_100} the issue's "
-        "target of 100 times. On this polynomial scene SciPy is exact at any tolerance, so "
-        "the loosest, rtol = 1e-3, is the fair comparison (a few steps per flight), and its "
-        f"time is mostly the Python overhead of {c3['scipy_restarts']} solve_ivp calls "
-        f"(~{c3['scipy_median_s'] / c3['scipy_restarts'] * 1e3:.1f} ms each). impact1d takes "
-        f"the tutorial's {c3['steps']} steps; between impacts, where the forces are constant "
-        "and no gap can close within the next steps (a closed-form bound), they run in a "
-        "tight loop without event location (`glide` in src/impact1d_solver.f90), and the "
-        "time left is the impacts, the located steps next to them and the samples.",
+        f"Called in a loop, as a sweep or a study does, impact1d is {bt['ratio_median']:.0f} "
+        f"times faster; one call at a time, each right after the other tool's, "
+        f"{c3['ratio_median']:.0f} times: there each call starts with the caches the other "
+        "left, which costs impact1d's short run (mostly its Python glue) proportionally more. "
+        f"Against the issue's target of 100 times this {verdict_100} it by the first measure "
+        f"and {verdict_single} it by the second. On this polynomial scene SciPy is exact at "
+        "any tolerance, so the loosest, rtol = 1e-3, is the fair comparison (a few steps per "
+        f"flight), and its time is mostly the Python overhead of {c3['scipy_restarts']} "
+        f"solve_ivp calls (~{c3['scipy_median_s'] / c3['scipy_restarts'] * 1e3:.1f} ms each). "
+        f"impact1d takes the tutorial's {c3['steps']} steps; between impacts, where the forces "
+        "are constant and no gap can close within the next steps (a closed-form bound), they "
+        "run in a tight loop without event location (`glide` in src/impact1d_solver.f90), "
+        "and the time left is the impacts, the located steps next to them and the samples.",
         "",
         "## The stepping loop against a bare RK4 loop",
         "",

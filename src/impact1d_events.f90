@@ -28,11 +28,13 @@ contains
   end function poly_value
 
   !> Earliest theta in [0, h] where p turns negative: the zero at the start of the first
-  !> piece of [0, h] (between consecutive roots) on which p falls below -tol. Returns a value
-  !> > h when there is none. tol keeps rounding-level wiggles of a resting function from
-  !> counting, while the reported time is the true zero, not the -tol crossing.
+  !> piece of [0, h] (between consecutive roots) on which p falls below -tol(theta). Returns
+  !> a value > h when there is none. tol keeps rounding-level wiggles of a resting function
+  !> from counting, while the reported time is the true zero, not the -tol crossing; it is a
+  !> polynomial in theta (coefficients >= 0) because rounding grows with what the step has
+  !> moved by then: a crossing early in a long step is judged by the rounding there.
   pure real(wp) function earliest_crossing(p, h, tol) result(theta)
-    real(wp), intent(in) :: p(0:3), h, tol
+    real(wp), intent(in) :: p(0:3), h, tol(0:3)
     real(wp) :: nodes(5), crit(2)
     integer :: n_nodes, n_crit, j
     real(wp) :: a, b
@@ -68,7 +70,8 @@ contains
     do j = 1, n_nodes - 1
       a = nodes(j)
       b = nodes(j + 1)
-      if (min(poly_value(p, 0.5_wp * (a + b)), poly_value(p, b)) < -tol) then
+      if (poly_value(p, 0.5_wp * (a + b)) < -poly_value(tol, 0.5_wp * (a + b)) .or. &
+          poly_value(p, b) < -poly_value(tol, b)) then
         theta = a
         return
       end if

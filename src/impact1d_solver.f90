@@ -391,7 +391,7 @@ contains
         p(1:3) = normal(1, k) * c(:, 1) + normal(2, k) * c(:, 2)
         ! The common case first: the gap cannot reach zero within the step.
         if (p(0) - step * (abs(p(1)) + step * (abs(p(2)) + step * abs(p(3)))) > 0.0_wp) cycle
-        candidate = earliest_crossing(p, step, gap_tolerance(k, a, displacement(k, a, b)))
+        candidate = earliest_crossing(p, step, gap_tolerance_along(k, a, c))
         if (candidate < theta) then
           theta = candidate
           which = k
@@ -405,7 +405,7 @@ contains
         ! Sliding velocity in its own direction: the derivative of the Hermite cubic.
         p = mode%sgn(i) * [c(1, i), 2.0_wp * c(2, i), 3.0_wp * c(3, i), 0.0_wp]
         scale = max(abs(a%v(i)), abs(b%v(i)), abs(b%v(i) - a%v(i)))
-        candidate = earliest_crossing(p, step, velocity_rounding * scale)
+        candidate = earliest_crossing(p, step, [velocity_rounding * scale, 0.0_wp, 0.0_wp, 0.0_wp])
         if (candidate < theta) then
           theta = candidate
           which = 100 + i
@@ -576,6 +576,19 @@ contains
       gap_tolerance = gap_rounding * (moved + dot_product(abs(normal(:, k)), abs(state%x_lo))) + &
         time_rounding * max(abs(state%t), scene%dt) * max(0.0_wp, -normal_velocity(k, state%v))
     end function gap_tolerance
+
+    !> gap_tolerance along a step from state a with dense output c, as a polynomial in theta:
+    !> what the step has moved the gap by at theta (each body's displacement), not by the
+    !> step's end, so a gap closing early in a long step is not lost in the rounding of
+    !> the whole step's motion.
+    pure function gap_tolerance_along(k, a, c) result(q)
+      integer, intent(in) :: k
+      type(state_type), intent(in) :: a
+      real(wp), intent(in) :: c(3, 2)
+      real(wp) :: q(0:3)
+      q(0) = gap_tolerance(k, a, 0.0_wp)
+      q(1:3) = gap_rounding * (abs(normal(1, k)) * abs(c(:, 1)) + abs(normal(2, k)) * abs(c(:, 2)))
+    end function gap_tolerance_along
 
     !> How far a step from a to b moved gap k (through either body).
     pure real(wp) function displacement(k, a, b)

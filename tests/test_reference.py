@@ -368,7 +368,7 @@ _NESTED = ("unadjudicated rounding tail (both solvers imperfect): a nested bounc
            "states and all impacts above NOISE_SPEED agree")
 KNOWN_ENGINE_BUGS: dict = {
     56: _CHATTER_LOG,
-    **{i: _NESTED for i in (6, 12, 59, 90)},
+    **{i: _NESTED for i in (6, 12, 90)},
 }
 # The engine never returns on these (an endless loop, no error): they cannot even be
 # xfailed without hanging the suite.  None left (the engine was fixed).

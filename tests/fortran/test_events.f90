@@ -10,26 +10,26 @@ program test_events
   real(wp) :: theta, c(3)
 
   ! g = (theta - 0.2)(theta - 0.6)(theta + 1): positive, dips below zero on (0.2, 0.6), back up.
-  theta = earliest_crossing(expand(0.2_wp, 0.6_wp, -1.0_wp), 1.0_wp, 1.0e-15_wp)
+  theta = earliest_crossing(expand(0.2_wp, 0.6_wp, -1.0_wp), 1.0_wp, [1.0e-15_wp, 0.0_wp, 0.0_wp, 0.0_wp])
   call check(abs(theta - 0.2_wp) < root_tol, 'two roots in one step: the first one is found')
 
   ! The same dip entirely inside a step whose ends are both positive.
-  theta = earliest_crossing(expand(0.3_wp, 0.31_wp, -1.0_wp), 1.0_wp, 1.0e-15_wp)
+  theta = earliest_crossing(expand(0.3_wp, 0.31_wp, -1.0_wp), 1.0_wp, [1.0e-15_wp, 0.0_wp, 0.0_wp, 0.0_wp])
   call check(abs(theta - 0.3_wp) < root_tol, 'a dip between positive ends is not missed')
 
   ! A graze: (theta - 0.5)^2 touches zero but never goes below: no event.
-  theta = earliest_crossing([0.25_wp, -1.0_wp, 1.0_wp, 0.0_wp], 1.0_wp, 1.0e-15_wp)
+  theta = earliest_crossing([0.25_wp, -1.0_wp, 1.0_wp, 0.0_wp], 1.0_wp, [1.0e-15_wp, 0.0_wp, 0.0_wp, 0.0_wp])
   call check(theta > 1.0_wp, 'a graze with zero approach speed is not an event')
 
   ! A gap at zero that opens (just after an impact): the root at 0 is not an event.
-  theta = earliest_crossing([0.0_wp, 1.0_wp, -0.5_wp, 0.0_wp], 1.0_wp, 1.0e-15_wp)
+  theta = earliest_crossing([0.0_wp, 1.0_wp, -0.5_wp, 0.0_wp], 1.0_wp, [1.0e-15_wp, 0.0_wp, 0.0_wp, 0.0_wp])
   call check(theta > 1.0_wp, 'an opening gap at zero is not an event')
   ! ... but it closes again at theta = 2 in a longer step.
-  theta = earliest_crossing([0.0_wp, 1.0_wp, -0.5_wp, 0.0_wp], 3.0_wp, 1.0e-15_wp)
+  theta = earliest_crossing([0.0_wp, 1.0_wp, -0.5_wp, 0.0_wp], 3.0_wp, [1.0e-15_wp, 0.0_wp, 0.0_wp, 0.0_wp])
   call check(abs(theta - 2.0_wp) < root_tol, 'an opening gap closes again later in the step')
 
   ! No root at all, far from zero: the cheap rejection.
-  theta = earliest_crossing([5.0_wp, -1.0_wp, 0.0_wp, 0.0_wp], 1.0_wp, 1.0e-15_wp)
+  theta = earliest_crossing([5.0_wp, -1.0_wp, 0.0_wp, 0.0_wp], 1.0_wp, [1.0e-15_wp, 0.0_wp, 0.0_wp, 0.0_wp])
   call check(theta > 1.0_wp, 'no root when the gap stays positive')
 
   ! Hermite dense output reproduces a cubic motion exactly: x = 2 t - 3 t^2 + 0.5 t^3 on [0, 0.7].
