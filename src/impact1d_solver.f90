@@ -375,7 +375,7 @@ contains
       real(wp), intent(in) :: step
       real(wp), intent(out) :: theta
       integer, intent(out) :: which
-      real(wp) :: c(3, 2), p(0:3), candidate, scale
+      real(wp) :: c(3, 2), p(0:3), candidate, scale, acc_rounding(2)
       integer :: k, i
       logical :: have_dense
 
@@ -385,13 +385,17 @@ contains
       do k = 1, n_contacts
         if (.not. scene%has_contact(k) .or. mode%active(k)) cycle
         if (a%t + step < quiet_until(k)) cycle
-        if (.not. have_dense) c = dense_output(a, b, step)
+        if (.not. have_dense) then
+          c = dense_output(a, b, step)
+          acc_rounding = 1.0e3_wp * eps_wp * force_scale(scene%forcing%force(a%t), &
+            scene%forcing%rate(a%t)) / scene%mass
+        end if
         have_dense = .true.
         p(0) = gap(k, a)
         p(1:3) = normal(1, k) * c(:, 1) + normal(2, k) * c(:, 2)
         ! The common case first: the gap cannot reach zero within the step.
         if (p(0) - step * (abs(p(1)) + step * (abs(p(2)) + step * abs(p(3)))) > 0.0_wp) cycle
-        candidate = earliest_crossing(p, step, gap_tolerance_along(k, a, c))
+        candidate = earliest_crossing(p, step, gap_tolerance_along(k, a, c, acc_rounding))
         if (candidate < theta) then
           theta = candidate
           which = k
@@ -580,14 +584,17 @@ contains
     !> gap_tolerance along a step from state a with dense output c, as a polynomial in theta:
     !> what the step has moved the gap by at theta (each body's displacement), not by the
     !> step's end, so a gap closing early in a long step is not lost in the rounding of
-    !> the whole step's motion.
-    pure function gap_tolerance_along(k, a, c) result(q)
+    !> the whole step's motion; and the gap's curvature only to the rounding of the forces
+    !> (acc_rounding per body), so a contact released with a rounding-level acceleration
+    !> back into it (a force ramp through its bound) does not close again at once.
+    pure function gap_tolerance_along(k, a, c, acc_rounding) result(q)
       integer, intent(in) :: k
       type(state_type), intent(in) :: a
-      real(wp), intent(in) :: c(3, 2)
+      real(wp), intent(in) :: c(3, 2), acc_rounding(2)
       real(wp) :: q(0:3)
       q(0) = gap_tolerance(k, a, 0.0_wp)
       q(1:3) = gap_rounding * (abs(normal(1, k)) * abs(c(:, 1)) + abs(normal(2, k)) * abs(c(:, 2)))
+      q(2) = q(2) + 0.5_wp * dot_product(abs(normal(:, k)), acc_rounding)
     end function gap_tolerance_along
 
     !> How far a step from a to b moved gap k (through either body).
