@@ -833,7 +833,8 @@ contains
           return
         end if
       end if
-      call flush_releases(.true.)
+      ! Releases from earlier instants go first; one at this instant may still cancel.
+      call flush_releases(.false.)
       if (when > s%t) then
         pending_rest(k) = when
       else

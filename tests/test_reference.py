@@ -417,7 +417,9 @@ def test_generated_scene_at_fine_step_matches_reference(index, table_folder):
 # a nested bounce series (body 1 between the left wall and body 2) at dt = 0.1, whose
 # 1e-9 s flights were lost in the rounding of the whole step's motion (seed 778, scene
 # 35); a contact released at a force ramp that closed again at once, for ever (seed 777,
-# scene 2, dt = 1e-3).
+# scene 2, dt = 1e-3); a resting slot contact broken by a wall impact and at rest again
+# at the same instant after the chain of impacts, logged as a release and a rest because
+# the wall's rest flushed the pending release (seed 780, scene 137, dt = 3e-4).
 NESTED_AT_COARSE_STEP = impact1d.Scene(
     m1=2.534, m2=2.944, x_left=-1.417, r_left=0.3, x_right=7.213, r_right=0.7, d_min=0.945,
     r_min=0.0, d_max=1.305, r_max=0.3, x1=4.781, v1=0.705, x2=5.903, v2=2.381, f1=6.5825,
@@ -425,6 +427,12 @@ NESTED_AT_COARSE_STEP = impact1d.Scene(
 RELEASE_AT_A_RAMP = dict(
     m1=2.345, m2=1.702, mu1=0.259, x_right=7.436, r_right=0.3, d_min=0.458, r_min=0.2384,
     x1=-0.648, v1=3.02, x2=2.548, v2=3.251, f1=12.7679, f2=-5.2699, t_end=3.381)
+
+
+CHAIN_AT_ONE_INSTANT = dict(
+    m1=1.832, m2=1.861, mu1=0.413, mu2=0.397, g=10.0, x_left=-0.264, r_left=0.7,
+    x_right=6.616, r_right=0.8392, d_min=0.769, r_min=0.0, d_max=2.739, r_max=0.7,
+    x1=2.927, v1=-4.536, x2=4.586, v2=-4.845, f1=-2.5556, f2=-20.308, t_end=2.977)
 
 
 def test_nested_series_at_a_coarse_step():
@@ -437,6 +445,14 @@ def test_release_at_a_force_ramp(tmp_path):
     scene = impact1d.Scene(**RELEASE_AT_A_RAMP, f2_table=str(table))
     check(scene, "release at a force ramp, dt = 1e-3",
           {"f2_table": ((2.113125, 2.789325), (13.208, -14.573))}, dt=1e-3)
+
+
+def test_release_and_rest_at_one_instant_cancel(tmp_path):
+    table = tmp_path / "f2.dat"
+    table.write_text("0.2977 -2.987\n0.372125 2.34\n2.82815 4.435\n")
+    scene = impact1d.Scene(**CHAIN_AT_ONE_INSTANT, f2_table=str(table))
+    check(scene, "chain of impacts at one instant, dt = 3e-4",
+          {"f2_table": ((0.2977, 0.372125, 2.82815), (-2.987, 2.34, 4.435))}, dt=3e-4)
 
 
 def test_generated_scenes_cover_the_physics(table_folder):
