@@ -159,10 +159,8 @@ contains
         end if
         stats%steps = stats%steps + 1
         if (iand(stats%steps, 4095_int64) == 0) call sink%progress(s%t, scene%t_end)
-        if (.not. finite_state(s)) then
-          call raise(error, status_simulation, 'at t = ' // fmt(s%t) // ': the state is no longer finite')
-          return
-        end if
+        call check_finite()
+        if (allocated(error)) return
       end if
 
       ! Events, table corners (the force's slope changes) and accumulation times need an
@@ -300,9 +298,13 @@ contains
         end if
       end do
       call book_constant_ledger(start, s)
+      call check_finite()
+    end subroutine glide
+
+    subroutine check_finite()
       if (.not. finite_state(s)) call raise(error, status_simulation, 'at t = ' // fmt(s%t) // &
         ': the state is no longer finite')
-    end subroutine glide
+    end subroutine check_finite
 
     !> One step of the mode under constant acceleration: RK4 is exact there, and its step is
     !> the quadratic x + h v + h^2 a / 2, v + h a.
