@@ -2,7 +2,9 @@
 
  1. case 3 (dt = 1e-3, output every 0.01 s) through impact1d.simulate against the SciPy
     DOP853 event-restart version (bench/scipy_reference.py, same output times) at equal or
-    better event-time accuracy: median of the ratios of paired, alternating runs;
+    better event-time accuracy: median of the ratios of paired, alternating runs, a run
+    being one call (each starts with the caches the other left) or 10 calls in a row
+    (the steady state of a sweep);
  2. the stepping loop: RK4 steps per second of the `impact1d` CLI on a long free-flight run
     (bench/scenes/freeflight.nml, output at 0 and t_end only) against bench/bare_rk4.f90,
     a plain RK4 loop on the same force law compiled here with the release build's -O3;

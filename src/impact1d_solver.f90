@@ -379,24 +379,25 @@ contains
       integer, intent(out) :: which
       real(wp) :: c(3, 2), p(0:3), candidate, scale, acc_rounding(2)
       integer :: k, i
-      logical :: have_dense
+      logical :: have_dense, have_acc_rounding
 
       theta = huge(1.0_wp)
       which = 0
       have_dense = .false.
+      have_acc_rounding = .false.
       do k = 1, n_contacts
         if (.not. scene%has_contact(k) .or. mode%active(k)) cycle
         if (a%t + step < quiet_until(k)) cycle
-        if (.not. have_dense) then
-          c = dense_output(a, b, step)
-          acc_rounding = 1.0e3_wp * eps_wp * force_scale(scene%forcing%force(a%t), &
-            scene%forcing%rate(a%t)) / scene%mass
-        end if
+        if (.not. have_dense) c = dense_output(a, b, step)
         have_dense = .true.
         p(0) = gap(k, a)
         p(1:3) = normal(1, k) * c(:, 1) + normal(2, k) * c(:, 2)
         ! The common case first: the gap cannot reach zero within the step.
         if (p(0) - step * (abs(p(1)) + step * (abs(p(2)) + step * abs(p(3)))) > 0.0_wp) cycle
+        ! Only a gap that may close needs the forces' rounding (a sine costs two evaluations).
+        if (.not. have_acc_rounding) acc_rounding = 1.0e3_wp * eps_wp * &
+          force_scale(scene%forcing%force(a%t), scene%forcing%rate(a%t)) / scene%mass
+        have_acc_rounding = .true.
         candidate = earliest_crossing(p, step, gap_tolerance_along(k, a, c, acc_rounding))
         if (candidate < theta) then
           theta = candidate
