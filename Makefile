@@ -33,7 +33,8 @@ help:
 	@echo "make setup   gfortran (apt, if missing), .venv, pip install .[test]"
 	@echo "make demo    run input/case1..6.nml with the impact1d CLI and plot them"
 	@echo "make test    Fortran unit tests (meson test), then pytest"
-	@echo "make bench   accuracy and speed studies -> docs/accuracy.md, docs/performance.md"
+	@echo "make bench   accuracy and speed studies, Siconos as a peer (apt, if missing)"
+	@echo "             -> docs/accuracy.md, docs/performance.md"
 	@echo "make clean   remove .venv, build/ and output files"
 
 setup: gfortran $(INSTALL_STAMP)
@@ -92,6 +93,26 @@ clean:
 
 # Accuracy and speed studies (bench/): a few minutes; writes docs/accuracy.md,
 # docs/performance.md and their figures (docs/*.png). Numbers are measured, not asserted.
-.PHONY: bench
-bench: setup
+.PHONY: bench siconos
+bench: setup siconos
 	$(BIN)/python bench/run_all.py
+
+# The Siconos peer (bench/siconos_peer.py) runs under the system interpreter with Debian's
+# python3-siconos: apt-get only when it is missing. Optional: where it cannot be installed
+# the bench runs without it and its docs sections say why.
+SICONOS_PYTHON ?= /usr/bin/python3
+export SICONOS_PYTHON
+siconos:
+	@if ! $(SICONOS_PYTHON) -c 'import siconos.kernel' >/dev/null 2>&1; then \
+	  if [ "$$(id -u)" -eq 0 ]; then SUDO=""; \
+	  elif command -v sudo >/dev/null 2>&1; then SUDO="sudo -E"; \
+	  else SUDO="none"; fi; \
+	  if [ "$$SUDO" = none ] || ! command -v apt-get >/dev/null 2>&1; then \
+	    echo "note: Siconos is not installed and apt-get cannot install it here: the bench runs without it"; \
+	  else \
+	    echo "installing python3-siconos with apt-get"; \
+	    $$SUDO apt-get update -q || true; \
+	    $$SUDO apt-get install -y -q python3-siconos \
+	      || echo "note: apt-get could not install python3-siconos: the bench runs without it"; \
+	  fi; \
+	fi

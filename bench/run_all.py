@@ -1,8 +1,9 @@
-"""`make bench`: run the convergence, work-precision and performance studies in one process
-on one machine, then write docs/accuracy.md and docs/performance.md from the measured
-numbers (figures: docs/convergence.png, docs/work_precision.png, docs/performance.png).
+"""`make bench`: run the convergence, work-precision and performance studies and the Siconos
+peer comparison in one process on one machine, then write docs/accuracy.md and
+docs/performance.md from the measured numbers (figures: docs/convergence.png,
+docs/work_precision.png, docs/performance.png).
 
-    python bench/run_all.py                 # all three (a few minutes)
+    python bench/run_all.py                 # all four (a few minutes)
     python bench/run_all.py --docs-only     # rewrite the docs from bench/results/*.json
 """
 
@@ -12,6 +13,7 @@ import sys
 import time
 
 import common
+import siconos_peer
 
 COMMAND = "make bench"
 
@@ -361,11 +363,17 @@ def main(argv):
         work_precision.run()
         print("performance study ...", flush=True)
         performance.run()
+        print("Siconos peer comparison ...", flush=True)
+        siconos_peer.run()
         print(f"studies done in {time.perf_counter() - start:.0f} s", flush=True)
     info = common.load_json("machine") if info_path.exists() else common.machine()
     conv, wp, perf = (common.load_json(n) for n in ("convergence", "work_precision", "performance"))
-    (common.DOCS / "accuracy.md").write_text(accuracy_md(conv, wp, perf, info))
-    (common.DOCS / "performance.md").write_text(performance_md(perf, info))
+    # Siconos is optional: without results its sections say it was not compared.
+    peer = common.load_json("siconos") if (common.RESULTS / "siconos.json").exists() else None
+    (common.DOCS / "accuracy.md").write_text(
+        accuracy_md(conv, wp, perf, info).rstrip() + "\n\n" + siconos_peer.accuracy_section(peer))
+    (common.DOCS / "performance.md").write_text(
+        performance_md(perf, info).rstrip() + "\n\n" + siconos_peer.performance_section(peer))
     print("wrote docs/accuracy.md, docs/performance.md and docs/*.png")
 
 
