@@ -94,6 +94,7 @@ program impact1d_cli
       end if
       select case (option)
       case ('--method')
+        if (len_trim(value) == 0) call fail(status_input, '--method needs a name: event or vissim')
         method = lower(trim(adjustl(value)))
       case ('-o')
         ! An empty name is a mistake (an unset shell variable), not a request for the default.

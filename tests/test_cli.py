@@ -243,6 +243,15 @@ def test_option_value_must_be_one_number(cli, tmp_path, value):
     assert not (tmp_path / "x.dat").exists()
 
 
+@pytest.mark.parametrize("spelling", [("--method", ""), ("--method=",)])
+def test_empty_method_is_refused(cli, tmp_path, spelling):
+    proc = run_cli(cli, INPUT / "case1.nml", *spelling, "-o", tmp_path / "x.dat", cwd=tmp_path,
+                   check=False)
+    assert proc.returncode == 1
+    _assert_fails_naming(proc, "--method")
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_empty_output_name_is_refused(cli, tmp_path):
     """-o '' (an unset shell variable) is a mistake, not a request for the default."""
     proc = run_cli(cli, INPUT / "case1.nml", "-o", "", cwd=tmp_path, check=False)
