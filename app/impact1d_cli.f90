@@ -3,13 +3,15 @@
 !> stderr and a non-zero exit status (1 bad input, 2 the run could not go on).
 program impact1d_cli
   use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
-  use, intrinsic :: iso_c_binding, only: c_int
+  use, intrinsic :: iso_c_binding, only: c_int, c_char, c_ptr, c_null_char, c_associated
   use impact1d_kinds, only: wp
   use impact1d_error, only: error_type, status_input, fmt
-  use impact1d_scene, only: scene_input, scene_type, i_t_end, i_dt, i_dt_out, i_method, i_title
-  use impact1d_io, only: read_scene_file, prepare_scene
-  use impact1d_output, only: file_sink, make_folder, event_names, n_event_kinds
+  use impact1d_scene, only: scene_input, scene_type, i_t_end, i_dt, i_dt_out, i_method, i_title, &
+    i_f1_table, i_f2_table
+  use impact1d_io, only: read_scene_file, prepare_scene, lower
+  use impact1d_output, only: file_sink, make_folder, event_names, n_event_kinds, events_path
   use impact1d_solver, only: run, run_stats
+  use impact1d_version, only: version
   implicit none
 
   interface
@@ -21,20 +23,41 @@ program impact1d_cli
       import :: c_int
       integer(c_int), value :: fd
     end function c_isatty
+    type(c_ptr) function c_realpath(path, resolved) bind(C, name='realpath')
+      import :: c_ptr, c_char
+      character(kind=c_char), intent(in) :: path(*)
+      character(kind=c_char), intent(out) :: resolved(*)
+    end function c_realpath
   end interface
 
   character(len=*), parameter :: usage = &
-    'usage: impact1d SCENE [--t-end T] [--dt DT] [--dt-out DT_OUT] [--method event] [-o OUT.dat]'
+    'usage: impact1d SCENE [--t-end T] [--dt DT] [--dt-out DT_OUT] [--method event|vissim] [-o OUT.dat]'
+  character(len=*), parameter :: nl = new_line('a')
+  character(len=*), parameter :: help = usage // nl // nl // &
+    'Runs SCENE (a namelist scene, or a VisSim-style .dat parameter file) and writes its samples' // nl // &
+    'to OUT.dat (default output/SCENE_NAME.dat; missing folders are created), its event log to' // nl // &
+    'OUT.events.dat (OUT without its extension, plus .events.dat) and a summary to stdout.' // nl // nl // &
+    'Options override the scene''s &run values; write them --dt 1e-3 or --dt=1e-3:' // nl // &
+    '  --t-end T        end time (s)       .dat scenes have no &run: give --t-end and --dt' // nl // &
+    '  --dt DT          integrator step (s)' // nl // &
+    '  --dt-out DT_OUT  time between samples (s); default dt; finer or coarser than dt' // nl // &
+    '  --method NAME    event   event-driven: every impact, stop and break-away located (default)' // nl // &
+    '                   vissim  the VisSim tutorial''s fixed-step scheme, O(dt) (any letter case)' // nl // &
+    '  -o OUT.dat       where the samples go (never one of the run''s own input files)' // nl // &
+    '  -h, --help       this text' // nl // &
+    '  --version        the version' // nl // nl // &
+    'Exit status: 0 done; 1 bad input (scene, tables, options, output path), nothing written;' // nl // &
+    '2 the run could not go on (the reason and the time on stderr), nothing written.' // nl // &
+    'Formats and method: docs/formats.md, docs/method.md in the impact1d sources.'
   type(scene_input) :: input
   type(scene_type) :: scene
   type(file_sink) :: sink
   type(run_stats) :: stats
   type(error_type), allocatable :: error, close_error
   character(len=:), allocatable :: scene_path, out_path, option, value
-  character(len=4096) :: argument
-  integer :: i, n_args, k
+  integer :: i, n_args, k, equals
   real(wp) :: overrides(3)
-  logical :: overridden(3)
+  logical :: overridden(3), has_value, out_given
   character(len=64) :: method
 
   overridden = .false.
@@ -42,26 +65,42 @@ program impact1d_cli
   method = ''
   scene_path = ''
   out_path = ''
+  out_given = .false.
   n_args = command_argument_count()
   i = 1
   do while (i <= n_args)
-    call get_command_argument(i, argument)
-    option = trim(argument)
+    option = argument_text(i)
+    i = i + 1
+    ! GNU style: --dt=1e-3 is --dt 1e-3.
+    has_value = .false.
+    equals = index(option, '=')
+    if (equals > 3 .and. index(option, '--') == 1) then
+      value = option(equals + 1:)
+      option = option(:equals - 1)
+      has_value = .true.
+    end if
     select case (option)
     case ('-h', '--help')
-      write(output_unit, '(a)') usage
-      write(output_unit, '(a)') 'Writes OUT.dat (default output/SCENE_NAME.dat) and OUT.events.dat; options override &run.'
+      write(output_unit, '(a)') help
+      stop
+    case ('--version')
+      write(output_unit, '(a)') 'impact1d ' // version
       stop
     case ('--t-end', '--dt', '--dt-out', '--method', '-o')
-      if (i == n_args) call fail(status_input, option // ' needs a value')
-      call get_command_argument(i + 1, argument)
-      value = trim(argument)
-      i = i + 2
+      if (.not. has_value) then
+        if (i > n_args) call fail(status_input, option // ' needs a value')
+        value = argument_text(i)
+        i = i + 1
+      end if
       select case (option)
       case ('--method')
-        method = value
+        if (len_trim(value) == 0) call fail(status_input, '--method needs a name: event or vissim')
+        method = lower(trim(adjustl(value)))
       case ('-o')
+        ! An empty name is a mistake (an unset shell variable), not a request for the default.
+        if (len_trim(value) == 0) call fail(status_input, '-o needs a file name, got an empty one')
         out_path = value
+        out_given = .true.
       case ('--t-end')
         call override(1)
       case ('--dt')
@@ -70,13 +109,13 @@ program impact1d_cli
         call override(3)
       end select
     case default
+      if (has_value) call fail(status_input, 'unknown option ' // option // '; ' // usage)
       if (len(option) > 1) then
         if (option(1:1) == '-') call fail(status_input, 'unknown option ' // option // '; ' // usage)
       end if
       if (len(option) == 0) call fail(status_input, 'an empty argument is not a scene; ' // usage)
       if (len(scene_path) > 0) call fail(status_input, 'one scene at a time; ' // usage)
       scene_path = option
-      i = i + 1
     end select
   end do
   if (len(scene_path) == 0) call fail(status_input, usage)
@@ -89,10 +128,10 @@ program impact1d_cli
   call prepare_scene(input, scene, error)
   if (allocated(error)) call fail(error%status, scene_path // ': ' // error%message)
 
-  if (len(out_path) == 0) then
-    call make_folder('output')
-    out_path = 'output/' // stem(scene_path) // '.dat'
-  end if
+  if (.not. out_given) out_path = 'output/' // stem(scene_path) // '.dat'
+  call refuse_to_overwrite_inputs(out_path)
+  call refuse_to_overwrite_inputs(events_path(out_path))
+  call make_parent_folders(out_path)
   call sink%open(out_path, input, error)
   if (allocated(error)) call fail(error%status, error%message)
   ! Progress only where a person watches: stderr a terminal (file descriptor 2).
@@ -111,7 +150,7 @@ contains
     write(output_unit, '(a)') '  scene     ' // scene_path // ' (method ' // scene%method // ', dt = ' // &
       fmt(scene%dt) // ' s, t_end = ' // fmt(scene%t_end) // ' s)'
     write(output_unit, '(a)') '  output    ' // out_path // ' (' // fmt(scene%n_samples) // ' rows every ' // &
-      fmt(scene%dt_out) // ' s) and its events file (' // fmt(sum(stats%events)) // ' events)'
+      fmt(scene%dt_out) // ' s) and ' // events_path(out_path) // ' (' // fmt(sum(stats%events)) // ' events)'
     line = ''
     do k = 1, n_event_kinds
       if (stats%events(k) > 0) line = line // ' ' // trim(event_names(k)) // ' ' // fmt(stats%events(k))
@@ -120,12 +159,22 @@ contains
     write(output_unit, '(a)') '  events   ' // line
     write(output_unit, '(a, 5(a, es12.5))') '  final    ', ' t =', stats%last_row(1), '  x1 =', stats%last_row(2), &
       '  v1 =', stats%last_row(3), '  x2 =', stats%last_row(4), '  v2 =', stats%last_row(5)
-    write(output_unit, '(a, es12.5, a)') '  energy     KE =', stats%last_row(6), ' J'
+    write(output_unit, '(a, es12.5, a)') '  energy    KE =', stats%last_row(6), ' J'
     write(output_unit, '(a, 3(a, es12.5), a, es9.2, a)') '  ledger   ', ' work =', stats%last_row(7), &
       '  friction loss =', stats%last_row(8), '  impact loss =', stats%last_row(9), &
       '  |residual| <=', stats%max_residual, ' J'
     write(output_unit, '(a)') '  steps     ' // fmt(stats%steps) // ' RK4 steps'
   end subroutine summary
+
+  !> Command-line argument i, whatever its length.
+  function argument_text(i) result(text)
+    integer, intent(in) :: i
+    character(len=:), allocatable :: text
+    integer :: length
+    call get_command_argument(i, length=length)
+    allocate(character(len=length) :: text)
+    if (length > 0) call get_command_argument(i, text)
+  end function argument_text
 
   !> Option k of --t-end, --dt, --dt-out takes the value just read.
   subroutine override(k)
@@ -134,12 +183,53 @@ contains
     overridden(k) = .true.
   end subroutine override
 
+  !> The whole text must be one number: a list-directed read alone would take '1e-3 junk'
+  !> (or '2*0.1', a repeat count) and ignore the rest.
   real(wp) function number(name, text)
     character(len=*), intent(in) :: name, text
     integer :: ios
-    read(text, *, iostat=ios) number
-    if (ios /= 0) call fail(status_input, name // ' ' // text // ': not a number')
+    ios = 1
+    number = 0.0_wp
+    if (len_trim(text) > 0) then
+      if (scan(trim(adjustl(text)), ' ,;/*' // achar(9)) == 0) read(text, *, iostat=ios) number
+    end if
+    if (ios /= 0) call fail(status_input, name // ' ''' // text // ''': not a number')
   end function number
+
+  !> The output replaces its target only when the run is done, so an output that is one of
+  !> the run's inputs (the scene, a force table) would silently destroy it.
+  subroutine refuse_to_overwrite_inputs(path)
+    character(len=*), intent(in) :: path
+    character(len=:), allocatable :: target
+    target = resolved(path)
+    if (len(target) == 0) return
+    if (target == resolved(scene_path)) call fail(status_input, 'cannot write output ' // path // &
+      ': it is the scene file ' // scene_path // ' (choose another -o)')
+    do k = i_f1_table, i_f2_table
+      if (len_trim(input%text(k)) == 0) cycle
+      if (target == resolved(trim(input%text(k)))) call fail(status_input, 'cannot write output ' // &
+        path // ': it is the force table ' // trim(input%text(k)) // ' (choose another -o)')
+    end do
+  end subroutine refuse_to_overwrite_inputs
+
+  !> The absolute path of an existing file with every link resolved, '' if it does not exist.
+  function resolved(path) result(absolute)
+    character(len=*), intent(in) :: path
+    character(len=:), allocatable :: absolute
+    character(kind=c_char, len=4097) :: buffer
+    absolute = ''
+    if (.not. c_associated(c_realpath(path // c_null_char, buffer))) return
+    absolute = buffer(:index(buffer, c_null_char) - 1)
+  end function resolved
+
+  !> -o out/run1/x.dat: create out and out/run1, as the default output/ is created.
+  subroutine make_parent_folders(path)
+    character(len=*), intent(in) :: path
+    integer :: slash
+    do slash = 2, len(path)
+      if (path(slash:slash) == '/' .and. path(slash - 1:slash - 1) /= '/') call make_folder(path(:slash - 1))
+    end do
+  end subroutine make_parent_folders
 
   !> File name without folder and extension: input/case3.nml -> case3.
   function stem(path) result(name)

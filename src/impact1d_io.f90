@@ -10,7 +10,7 @@ module impact1d_io
   use impact1d_forcing, only: table_type
   implicit none
   private
-  public :: read_scene_file, prepare_scene, read_table
+  public :: read_scene_file, prepare_scene, read_table, lower
 
   !> Marks a namelist variable the file did not set (no user writes the largest double).
   real(wp), parameter :: absent = huge(1.0_wp)
@@ -141,7 +141,7 @@ contains
     input%text(i_title) = given_text(title)
     input%text(i_f1_table) = beside(path, given_text(f1_table))
     input%text(i_f2_table) = beside(path, given_text(f2_table))
-    input%text(i_method) = given_text(method)
+    input%text(i_method) = lower(given_text(method))
   end subroutine read_namelist
 
   !> Which groups the file has; a misspelt group (&wall) is an error, not a silent absence.
@@ -208,6 +208,11 @@ contains
 
     call open_data_file(path, unit, error)
     if (allocated(error)) return
+    ! The tutorial's files open with a comment naming the case: that is the scene's title.
+    read(unit, '(a)', iostat=ios) line
+    line = adjustl(line)
+    if (ios == 0 .and. line(1:1) == '#') input%text(i_title) = adjustl(line(2:))
+    rewind(unit)
     n_read = 0
     line_number = 0
     do
@@ -361,6 +366,7 @@ contains
     if (text /= absent_text) given = trim(text)
   end function given_text
 
+  !> text in lower case (ASCII letters only): group and method names are case-insensitive.
   pure function lower(text) result(low)
     character(len=*), intent(in) :: text
     character(len=len(text)) :: low

@@ -49,7 +49,7 @@ contains
     end do
   end function holds
 
-  !> Solve the complementarity problem at one instant by enumeration (METHOD.md section 2).
+  !> Solve the complementarity problem at one instant by enumeration (docs/method.md section 2).
   !> candidate(k): contact k is closed with zero normal velocity; resting(i): body i is at
   !> rest with friction; moving_sign(i): sign of v_i for the other bodies with friction.
   !> f and df are the forces and their right derivative at that instant: a condition that

@@ -11,7 +11,7 @@ module impact1d_output
   private
   public :: sink_type, memory_sink, file_sink, n_columns, column_names, n_event_kinds, event_names
   public :: event_impact, event_rest, event_release, event_stick, event_slip, make_folder, run_stats
-  public :: emit_sample
+  public :: emit_sample, events_path
 
   integer, parameter :: n_columns = 10
   character(len=*), parameter :: column_names = &
@@ -216,14 +216,14 @@ contains
     open(newunit=self%unit, file=self%path // '.part', status='replace', action='write', &
       iostat=ios, iomsg=message)
     if (ios /= 0) then
-      call raise(error, status_input, 'cannot write output ' // path // ': ' // trim(message))
+      call raise(error, status_input, 'cannot write output ' // path // ': ' // reason(message))
       return
     end if
     open(newunit=self%event_unit, file=self%event_path // '.part', status='replace', action='write', &
       iostat=ios, iomsg=message)
     if (ios /= 0) then
       close(self%unit, status='delete')
-      call raise(error, status_input, 'cannot write output ' // self%event_path // ': ' // trim(message))
+      call raise(error, status_input, 'cannot write output ' // self%event_path // ': ' // reason(message))
       return
     end if
     self%is_open = .true.
@@ -283,20 +283,33 @@ contains
     if (status /= 0) call raise(error, status_input, 'cannot rename the finished output to ' // self%path)
   end subroutine file_close
 
-  !> NAME.dat -> NAME.events.dat (NAME -> NAME.events.dat without the extension).
+  !> The events file of an output: its extension, whatever it is, becomes .events.dat
+  !> (res.dat, res.txt and res all give res.events.dat).
   pure function events_path(path) result(events)
     character(len=*), intent(in) :: path
     character(len=:), allocatable :: events
-    integer :: n
-    n = len(path)
-    if (n > 4) then
-      if (path(n - 3:) == '.dat') then
-        events = path(:n - 4) // '.events.dat'
-        return
-      end if
+    integer :: slash, dot, name_start
+    slash = index(path, '/', back=.true.)
+    dot = index(path(slash + 1:), '.', back=.true.)
+    ! Leading dots name a hidden file, not an extension (as Python's os.path.splitext).
+    name_start = verify(path(slash + 1:), '.')
+    if (name_start > 0 .and. dot > name_start) then
+      events = path(:slash + dot - 1) // '.events.dat'
+    else
+      events = path // '.events.dat'
     end if
-    events = path // '.events.dat'
   end function events_path
+
+  !> The system's reason from an open's message, without the file name it quotes: that is
+  !> the temporary name, which means nothing to the user.
+  pure function reason(message) result(text)
+    character(len=*), intent(in) :: message
+    character(len=:), allocatable :: text
+    integer :: quote_end
+    quote_end = index(message, ''': ', back=.true.)
+    text = trim(message)
+    if (quote_end > 0) text = trim(message(quote_end + 3:))
+  end function reason
 
   !> True when path names an existing folder (opening path/. succeeds only then).
   logical function is_folder(path)

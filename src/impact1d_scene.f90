@@ -145,13 +145,12 @@ contains
         call raise(error, status_input, 'dt = ' // fmt(input%value(i_dt)) // ' must be positive')
         return
       end if
-      if (input%given(i_dt_out)) then
-        if (input%value(i_dt_out) < input%value(i_dt)) then
-          call raise(error, status_input, 'dt_out = ' // fmt(input%value(i_dt_out)) // &
-            ' is less than dt = ' // fmt(input%value(i_dt)) // &
-            ': output cannot be finer than the step (set dt_out too)')
-          return
-        end if
+    end if
+    ! dt_out < dt is fine: the run stops at every sample time whatever its step.
+    if (input%given(i_dt_out)) then
+      if (input%value(i_dt_out) <= 0.0_wp) then
+        call raise(error, status_input, 'dt_out = ' // fmt(input%value(i_dt_out)) // ' must be positive')
+        return
       end if
     end if
     if (input%given(i_t_end) .and. (input%given(i_dt) .or. input%given(i_dt_out))) then

@@ -1,4 +1,4 @@
-!> The `vissim` method (METHOD.md section 7): an imitation of the tutorial's block diagram,
+!> The `vissim` method (docs/method.md section 7): an imitation of the tutorial's block diagram,
 !> kept so that the speed/accuracy trade against the event method can be measured on the
 !> same scenes. Fixed-step RK4 with no event location; collisions are seen as sign changes
 !> of a gap at step ends and applied with the velocities of the step before (the diagram's

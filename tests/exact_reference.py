@@ -1,6 +1,6 @@
-"""An exact, independent event-driven reference solver for impact1d (METHOD.md sections 1-5).
+"""An exact, independent event-driven reference solver for impact1d (docs/method.md sections 1-5).
 
-Pure Python (numpy not even needed), written from the physics of METHOD.md and sharing
+Pure Python (numpy not even needed), written from the physics of docs/method.md and sharing
 no code with the Fortran engine, so that the tests can compare the engine with it.
 
 Scope: forces f_i(t) = constant + piecewise-linear table (held constant outside its
@@ -73,7 +73,7 @@ IMPACT_KINDS = CONTACTS
 DEFAULT_G = 9.80665
 
 # A bounce series whose remaining flights last less than this (s) is put to rest at its
-# accumulation time (METHOD.md 5); far below the 1e-9 s the tests ask for.
+# accumulation time (docs/method.md 5); far below the 1e-9 s the tests ask for.
 ZENO_TIME = 1e-13
 # Normal velocities below this (m/s) are zero: a rounding level for velocities of
 # order 1-10 m/s, and it ends the geometric impulse chains that a body pinned between
@@ -328,7 +328,7 @@ class Model:
         tol_rate = 1e3 * EPS * (abs(df[0]) + abs(df[1]))
         return tol, tol_rate
 
-    # --- the complementarity problem by enumeration (METHOD.md 2) ---
+    # --- the complementarity problem by enumeration (docs/method.md 2) ---
     def solve_mode(self, f, df, candidate, resting, moving_sign):
         """candidate: touching contacts with zero normal velocity; resting[i]: body i at
         rest with friction; moving_sign[i]: sign of v_i for sliding bodies with friction.

@@ -1,5 +1,5 @@
 """Gap of every constraint a scene has, at every sample of a result: shared by the tests
-that check no step ends inside a constraint (METHOD.md section 3)."""
+that check no step ends inside a constraint (docs/method.md section 3)."""
 
 
 def gaps(res, scene):

@@ -1,4 +1,4 @@
-"""The Python API: Scene, load_scene, simulate, Result, errors (DESIGN.md, API contract)."""
+"""The Python API: Scene, load_scene, simulate, Result, errors (docs/formats.md, the Python API)."""
 
 import dataclasses
 import subprocess

@@ -1,13 +1,16 @@
 """The `impact1d` command line: same numbers as the Python API, files numpy can read."""
 
-import shutil
+import os
 import subprocess
+import sys
+from importlib import metadata
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 import impact1d
+from tools import find_tool
 
 ROOT = Path(__file__).resolve().parents[1]
 INPUT = ROOT / "input"
@@ -27,10 +30,7 @@ COLUMNS = "t x1 v1 x2 v2 ke work friction_loss impact_loss residual"
 @pytest.fixture(scope="module")
 def cli():
     """The installed executable. A missing CLI is a failure, never a skip."""
-    exe = shutil.which("impact1d")
-    assert exe is not None, ("the impact1d CLI is not on PATH: install the package "
-                             "(pip install --no-build-isolation .) with its bin/ on PATH")
-    return exe
+    return find_tool("impact1d")
 
 
 def run_cli(cli, *args, cwd, check=True):
@@ -181,3 +181,207 @@ def test_no_progress_line_when_stderr_is_not_a_terminal(cli, tmp_path):
                      "&run t_end = 1.5e4, dt = 1.0e-3, dt_out = 1.0e4 /\n")
     done = run_cli(cli, scene, "-o", tmp_path / "long.dat", cwd=tmp_path)
     assert done.stderr == ""
+
+
+# --- what a new user meets first (issue 12) ----------------------------------------------
+
+# Case 3's motion between events is a polynomial RK4 reproduces exactly, so its event
+# times do not depend on dt: only the rounding of the located roots separates two steps
+# (measured 9e-16 s at dt = 0.1 against 1e-3; the clock is kept as a compensated sum).
+EVENT_TIME_ROUNDING = 1e-13
+
+
+def test_version_from_the_package_metadata(cli):
+    """One version: meson.build's project version, which the package metadata carries."""
+    want = metadata.version("impact1d")
+    assert run_cli(cli, "--version", cwd=ROOT).stdout.strip() == f"impact1d {want}"
+    plot = run_cli(find_tool("impact1d-plot"), "--version", cwd=ROOT)
+    assert plot.stdout.strip() == f"impact1d-plot {want}"
+    assert impact1d.__version__ == want
+
+
+def test_help_names_methods_dat_needs_and_exit_codes(cli):
+    text = run_cli(cli, "--help", cwd=ROOT).stdout
+    for word in ("event", "vissim", "--t-end", "--dt", "--dt-out", "--method", "-o",
+                 "--version", ".dat", "Exit status: 0", "1 bad input", "2 the run"):
+        assert word in text, word
+    dat_line = next(line for line in text.splitlines() if ".dat scenes" in line)
+    assert "--t-end" in dat_line and "--dt" in dat_line
+
+
+def test_gnu_style_option_values(cli, tmp_path):
+    """--dt=0.01 is --dt 0.01 (and so for every option with a value)."""
+    run_cli(cli, INPUT / "case3.nml", "--t-end", "0.5", "--dt", "0.01", "--method", "event",
+            "-o", tmp_path / "spaced.dat", cwd=tmp_path)
+    run_cli(cli, INPUT / "case3.nml", "--t-end=0.5", "--dt=0.01", "--method=event",
+            "-o", tmp_path / "joined.dat", cwd=tmp_path)
+    assert np.array_equal(np.loadtxt(tmp_path / "spaced.dat"), np.loadtxt(tmp_path / "joined.dat"))
+    assert (tmp_path / "joined.events.dat").read_text() == (tmp_path / "spaced.events.dat").read_text()
+
+
+def test_method_names_in_any_case(cli, tmp_path):
+    """'VisSim' on the command line, 'VISSIM' in a namelist, 'Vissim' from Python: all vissim."""
+    scene = impact1d.load_scene(INPUT / "case3.nml")
+    want = impact1d.simulate(scene, method="vissim", t_end=0.5)
+    assert_same_run(impact1d.simulate(scene, method="Vissim", t_end=0.5), want)
+    upper = tmp_path / "upper.nml"
+    upper.write_text((INPUT / "case3.nml").read_text().replace("'event'", "'VISSIM'"))
+    assert impact1d.load_scene(upper).method == "vissim"
+    run_cli(cli, INPUT / "case3.nml", "--method", "VisSim", "--t-end", "0.5",
+            "-o", tmp_path / "cli.dat", cwd=tmp_path)
+    got = impact1d.read_output(tmp_path / "cli.dat")
+    assert got.scene.method == "vissim"
+    assert_same_run(got, want)
+
+
+@pytest.mark.parametrize("value", ["1e-3 junk", "1e-3,2", "2*0.1", "", "0.1/"])
+def test_option_value_must_be_one_number(cli, tmp_path, value):
+    proc = run_cli(cli, INPUT / "case3.nml", "--dt", value, "-o", tmp_path / "x.dat",
+                   cwd=tmp_path, check=False)
+    assert proc.returncode == 1
+    _assert_fails_naming(proc, "--dt")
+    assert not (tmp_path / "x.dat").exists()
+
+
+@pytest.mark.parametrize("spelling", [("--method", ""), ("--method=",)])
+def test_empty_method_is_refused(cli, tmp_path, spelling):
+    proc = run_cli(cli, INPUT / "case1.nml", *spelling, "-o", tmp_path / "x.dat", cwd=tmp_path,
+                   check=False)
+    assert proc.returncode == 1
+    _assert_fails_naming(proc, "--method")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_empty_output_name_is_refused(cli, tmp_path):
+    """-o '' (an unset shell variable) is a mistake, not a request for the default."""
+    proc = run_cli(cli, INPUT / "case1.nml", "-o", "", cwd=tmp_path, check=False)
+    assert proc.returncode == 1
+    _assert_fails_naming(proc, "-o")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_output_folders_are_created(cli, tmp_path):
+    out = tmp_path / "runs" / "today" / "case3.dat"
+    run_cli(cli, INPUT / "case3.nml", "--t-end", "0.5", "-o", out, cwd=tmp_path)
+    assert out.is_file() and out.with_name("case3.events.dat").is_file()
+    # relative to the working folder, as a user types it
+    run_cli(cli, INPUT / "case3.nml", "--t-end", "0.5", "-o", "rel/x.dat", cwd=tmp_path)
+    assert (tmp_path / "rel" / "x.dat").is_file()
+
+
+def test_messages_never_show_the_temporary_name(cli, tmp_path):
+    (tmp_path / "a_file").write_text("a file, not a folder\n")
+    proc = run_cli(cli, INPUT / "case3.nml", "-o", tmp_path / "a_file" / "x.dat",
+                   cwd=tmp_path, check=False)
+    _assert_fails_naming(proc, "a_file/x.dat")
+    assert ".part" not in proc.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a_file"]
+
+
+@pytest.mark.parametrize("name", ["res.txt", "res", "res.dat"])
+def test_events_file_name_rule(cli, tmp_path, name):
+    """The output's extension, whatever it is, becomes .events.dat; read_output agrees."""
+    run_cli(cli, INPUT / "case3.nml", "--t-end", "0.5", "-o", tmp_path / name, cwd=tmp_path)
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted([name, "res.events.dat"])
+    assert len(impact1d.read_output(tmp_path / name).events) > 0
+
+
+def _copy_of(path, folder, name):
+    copy = folder / name
+    copy.write_bytes(path.read_bytes())
+    return copy
+
+
+@pytest.mark.parametrize("how", ["same", "dot-slash", "link"])
+def test_output_that_is_the_scene_is_refused(cli, tmp_path, how):
+    scene = _copy_of(INPUT / "input5.dat", tmp_path, "copy5.dat")
+    before = scene.read_bytes()
+    if how == "link":
+        (tmp_path / "link.dat").symlink_to(scene)
+    out = {"same": "copy5.dat", "dot-slash": "./copy5.dat", "link": "link.dat"}[how]
+    proc = run_cli(cli, "copy5.dat", "--t-end", "3.2", "--dt", "1e-3", "-o", out,
+                   cwd=tmp_path, check=False)
+    assert proc.returncode == 1
+    _assert_fails_naming(proc, "scene")
+    assert scene.read_bytes() == before
+    assert not (tmp_path / "copy5.events.dat").exists()
+
+
+def test_output_that_is_a_force_table_or_the_scene_as_events_file_is_refused(cli, tmp_path):
+    scene = _copy_of(INPUT / "case6.nml", tmp_path, "case6.nml")
+    table = _copy_of(INPUT / "triangle.dat", tmp_path, "triangle.dat")
+    before = table.read_bytes()
+    proc = run_cli(cli, scene, "-o", table, cwd=tmp_path, check=False)
+    assert proc.returncode == 1
+    _assert_fails_naming(proc, "force table")
+    assert table.read_bytes() == before
+    # The events file the run would write is checked too: run.events.dat as the scene
+    # (a .dat parameter file) and -o run.txt, whose events file is run.events.dat.
+    dat = _copy_of(INPUT / "input3.dat", tmp_path, "run.events.dat")
+    proc = run_cli(cli, dat, "--t-end", "1", "--dt", "1e-3", "-o", "run.txt", cwd=tmp_path,
+                   check=False)
+    assert proc.returncode == 1
+    _assert_fails_naming(proc, "scene")
+    assert dat.read_bytes() == (INPUT / "input3.dat").read_bytes()
+    assert not (tmp_path / "run.txt").exists()
+
+
+def test_coarse_step_alone_is_accepted(cli, tmp_path):
+    """--dt 0.1 with the scene's dt_out = 1e-3: samples every 1e-3 s as the scene asks."""
+    proc = run_cli(cli, INPUT / "case3.nml", "--dt", "0.1", "-o", tmp_path / "c.dat", cwd=tmp_path)
+    assert "dt = 0.1 s" in proc.stdout
+    assert np.loadtxt(tmp_path / "c.dat").shape == (6001, 10)
+
+
+def test_event_times_do_not_depend_on_the_step():
+    """The README's claim: case 3's 41 events at dt = 0.1 (steps really 0.1 s: dt_out too)
+    are those at dt = 1e-3, to rounding."""
+    scene = impact1d.load_scene(INPUT / "case3.nml")
+    fine = impact1d.simulate(scene)
+    coarse = impact1d.simulate(scene, dt=0.1, dt_out=0.1)
+    assert coarse.steps < fine.steps / 50
+    assert list(coarse.events["kind"]) == list(fine.events["kind"]) and len(fine.events) == 41
+    np.testing.assert_allclose(coarse.events["t"], fine.events["t"], rtol=0,
+                               atol=EVENT_TIME_ROUNDING)
+
+
+def test_readme_step_independence_command_runs():
+    """The README shows the claim above as one command: it runs and prints a rounding-level
+    difference."""
+    readme = (ROOT / "README.md").read_text()
+    command = next(line.strip() for line in readme.splitlines()
+                   if line.strip().startswith("python -c") and "dt=0.1" in line)
+    code = command[len("python -c "):].strip().strip('"')
+    done = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True,
+                          text=True, timeout=CLI_TIMEOUT, check=True)
+    assert float(done.stdout.split()[-1]) <= EVENT_TIME_ROUNDING
+
+
+@pytest.mark.parametrize("method", ["event", "vissim"])
+def test_samples_finer_than_the_step(method):
+    """dt_out < dt: both methods stop at every sample time (their step is then at most
+    dt_out), so the samples are exactly where dt_out puts them."""
+    scene = impact1d.load_scene(INPUT / "case3.nml")
+    res = impact1d.simulate(scene, method=method, t_end=1.0, dt=0.1, dt_out=0.01)
+    np.testing.assert_array_equal(res.t, np.arange(101) * 0.01)
+    assert res.steps >= 100
+
+
+def test_dat_scene_title_is_its_first_comment(cli, tmp_path):
+    title = "Test case 5: wall collisions with rattling stop"
+    assert impact1d.load_scene(INPUT / "input5.dat").title == title
+    proc = run_cli(cli, INPUT / "input5.dat", "--t-end", "0.5", "--dt", "1e-3",
+                   "-o", tmp_path / "i5.dat", cwd=tmp_path)
+    assert proc.stdout.splitlines()[0] == f"impact1d: {title}"
+    assert f"# title = {title}" in comment_lines(tmp_path / "i5.dat")
+
+
+def test_summary_values_line_up(cli, tmp_path):
+    """Every summary line after the title has its values from one column."""
+    proc = run_cli(cli, INPUT / "case3.nml", "-o", tmp_path / "c.dat", cwd=tmp_path)
+    lines = proc.stdout.splitlines()[1:]
+    assert [line.split()[0] for line in lines] == ["scene", "output", "events", "final",
+                                                   "energy", "ledger", "steps"]
+    column = len("  scene     ")
+    for line in lines:
+        assert line[column - 1] == " " and line[column] != " ", line

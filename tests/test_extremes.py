@@ -36,7 +36,7 @@ EVENT_TIME_TOL = 1e-9
 STATE_TOL = 1e-9
 # Impact resets are one formula evaluated once: a few ulps of the velocity scale.
 RESET_RTOL = 1e-12
-# No step may end with a gap below zero (METHOD.md 3); only rounding of x2 - x1 at
+# No step may end with a gap below zero (docs/method.md 3); only rounding of x2 - x1 at
 # |x| <= 10 (~2e-15) is allowed: the issue's -1e-12.
 GAP_TOL = 1e-12
 # Kinetic energy that must be conserved (r = 1, mu = 0, no force), relative to KE0:
@@ -511,7 +511,7 @@ def test_plastic_slot_hit_then_friction_stop_with_tiny_d_min(d_min):
 @pytest.mark.parametrize("light", [1, 2])
 def test_slot_impact_mass_ratios(ratio, light, r):
     """One slot impact between masses 1 and `ratio` (both ways round): the tutorial's
-    formulas (METHOD.md 4), momentum, and KE for r = 1."""
+    formulas (docs/method.md 4), momentum, and KE for r = 1."""
     m1, m2 = (1.0, ratio) if light == 2 else (ratio, 1.0)
     v1, v2 = 1.0, -0.5
     scene = S(m1=m1, m2=m2, x1=0.0, v1=v1, x2=2.0, v2=v2, d_min=1.0, r_min=r,

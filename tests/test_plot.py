@@ -24,6 +24,7 @@ import matplotlib
 matplotlib.use("Agg")
 from matplotlib.backends.backend_agg import FigureCanvasAgg  # noqa: E402
 from matplotlib.collections import PolyCollection  # noqa: E402
+from tools import find_tool  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 SEED_CASES = [f"case{i}" for i in range(1, 7)]
@@ -602,11 +603,11 @@ def test_cli_unreadable_file(tmp_path, cli, capsys):
 def test_console_script(tmp_path):
     out = tmp_path / "case5.dat"
     write_cli_output(case5_like(), out)
-    done = subprocess.run(["impact1d-plot", str(out)], capture_output=True, text=True,
+    done = subprocess.run([find_tool("impact1d-plot"), str(out)], capture_output=True, text=True,
                           env={**os.environ, "MPLBACKEND": "Agg"})
     assert done.returncode == 0, done.stderr
     assert is_png(tmp_path / "case5.png")
-    done = subprocess.run(["impact1d-plot", str(tmp_path / "nope.dat")], capture_output=True,
+    done = subprocess.run([find_tool("impact1d-plot"), str(tmp_path / "nope.dat")], capture_output=True,
                           text=True)
     assert done.returncode == 1 and done.stderr.count("\n") == 1
 
@@ -628,10 +629,10 @@ def test_seed_case_figures(case, tmp_path):
 def test_seed_case5_through_both_commands(tmp_path):
     """impact1d writes case 5, impact1d-plot draws it; the file's data are what is drawn."""
     out = tmp_path / "case5.dat"
-    run = subprocess.run(["impact1d", str(ROOT / "input" / "case5.nml"), "-o", str(out)],
+    run = subprocess.run([find_tool("impact1d"), str(ROOT / "input" / "case5.nml"), "-o", str(out)],
                          capture_output=True, text=True)
     assert run.returncode == 0, run.stderr
-    done = subprocess.run(["impact1d-plot", str(out)], capture_output=True, text=True,
+    done = subprocess.run([find_tool("impact1d-plot"), str(out)], capture_output=True, text=True,
                           env={**os.environ, "MPLBACKEND": "Agg"})
     assert done.returncode == 0, done.stderr
     assert is_png(tmp_path / "case5.png")
@@ -642,3 +643,13 @@ def test_seed_case5_through_both_commands(tmp_path):
     assert fig._suptitle.get_text() == "Test case 5: wall collisions with rattling stop"
     bars = rest_bars(axes_by_label(fig)["impacts"], "left")  # rattled to rest, stays there
     assert len(bars) == 1 and bars[0][1] == res.t[-1] and abs(bars[0][0] - 3.0) < 1e-3
+
+
+def test_slot_limit_beyond_the_walls_is_not_drawn():
+    """Case 5's d_max = 50 m is never nearer than the right wall: a band up to it would
+    only shade the whole panel above x1, so only the limit that can bind (d_min) is drawn."""
+    res = case5_like()
+    pos = axes_by_label(plot.figure(res))["positions"]
+    assert maybe_artist(pos, "slot_band") is None and maybe_artist(pos, "slot:max") is None
+    np.testing.assert_allclose(artist(pos, "slot:min").get_ydata(),
+                               np.clip(res.x1 + res.scene.d_min, 0.0, 10.0))

@@ -1,10 +1,10 @@
 """The engine against the exact event-driven reference (tests/exact_reference.py).
 
-exact_reference solves METHOD.md sections 1-5 for constant and piecewise-linear forces
+exact_reference solves docs/method.md sections 1-5 for constant and piecewise-linear forces
 from the polynomials of each phase (no integrator, no dense output: roots of the
 phase's own polynomials), so it shares no code path with the engine.  For those
 forces the engine's event times and states are exact to rounding whatever dt is
-(METHOD.md 3): here it runs at dt = 1e-2 with dt_out = t_end / 100, so that several
+(docs/method.md 3): here it runs at dt = 1e-2 with dt_out = t_end / 100, so that several
 events fall inside one step, and must agree with the reference on
   - every impact: kind and time to EVENT_TIME_TOL, velocities before/after;
   - every other event (rest_*, release_*, stick*, slip*): kind and time;
@@ -38,7 +38,7 @@ EVENT_TIME_TOL = 1e-9    # s, every event time
 STATE_TOL = 1e-8         # final x1, v1, x2, v2
 VELOCITY_TOL = 1e-8      # impact velocities before/after
 # Convention difference 1 (reported): the engine ends a bounce series when a flight is
-# lower than 256 eps |position| (METHOD.md 5: "below what the state can resolve"), so it
+# lower than 256 eps |position| (docs/method.md 5: "below what the state can resolve"), so it
 # skips the last impacts of a series, those with a normal speed of a few um/s at most,
 # within microseconds of the accumulation time; the reference follows the series until
 # its remaining time is below 1e-13 s.  Such impacts of the contact that rests may be

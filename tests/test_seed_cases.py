@@ -2,7 +2,7 @@
 
 With constant (or piecewise-linear) forces the motion between events is a polynomial
 that RK4 reproduces exactly, so the event-driven engine should match closed forms to
-rounding level whatever dt is (METHOD.md section 3).  Every expected number below is
+rounding level whatever dt is (docs/method.md section 3).  Every expected number below is
 worked out from the physics in the comments next to it.
 """
 
@@ -36,7 +36,7 @@ ISSUE_ROUNDING = 5e-7
 # A body that friction holds has zero acceleration, so it must not drift at all
 # beyond rounding of its (unchanged) position.
 AT_REST_TOL = 1e-12
-# No step may end with a gap below zero (METHOD.md 3); allow only the rounding of
+# No step may end with a gap below zero (docs/method.md 3); allow only the rounding of
 # x2 - x1 at |x| <= 10 (~2e-15).
 GAP_TOL = 1e-12
 # Velocities jump at impacts; whether a sample exactly at an impact time shows the

@@ -13,9 +13,9 @@ __all__ = ["read_output", "events_path"]
 
 
 def events_path(path) -> str:
-    """The events file that goes with an output file: OUT minus .dat plus .events.dat."""
-    path = os.fspath(path)
-    stem = path[:-4] if path.endswith(".dat") else path
+    """The events file that goes with an output file, as the CLI names it: the output's
+    extension, whatever it is, becomes .events.dat (res.dat, res.txt, res: res.events.dat)."""
+    stem, _ = os.path.splitext(os.fspath(path))
     return stem + ".events.dat"
 
 

@@ -51,7 +51,7 @@ class Scene:
     """A scene: fields named as the namelist variables; None means absent.
 
     Absent constraints do not exist; absent optional values take the engine's
-    defaults (DESIGN.md).  `source` is the file the scene came from (for titles).
+    defaults (docs/formats.md).  `source` is the file the scene came from (for titles).
     Table paths from load_scene are already resolved against the scene's folder.
     """
 

@@ -101,6 +101,7 @@ def simulate(scene: Scene, *, progress: bool = False, **overrides) -> Result:
     changed = object.__new__(Scene)
     vars(changed).update(vars(scene), **overrides)
     scene = changed
+    if isinstance(scene.method, str): scene.method = scene.method.lower()  # as the CLI and namelists
     values, given, title, f1_table, f2_table, method = to_core(scene)
 
     (n_samples, n_events, steps, energy_residual,

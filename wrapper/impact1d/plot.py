@@ -218,10 +218,21 @@ def _draw_positions(ax, result, events):
     pad = 0.06 * (hi - lo) if hi > lo else 0.5
     ylim = (lo - pad, hi + pad)
 
+    wall_lo = -np.inf if x_left is None else x_left
+    wall_hi = np.inf if x_right is None else x_right
+
     def inside_walls(y):
         # x2 cannot pass a wall, so neither does the band that says where it may be.
-        return np.clip(y, -np.inf if x_left is None else x_left,
-                       np.inf if x_right is None else x_right)
+        return np.clip(y, wall_lo, wall_hi)
+
+    # A slot limit that stays beyond the walls (or out of view) all run never binds before
+    # a wall does: drawn, it would only shade the panel (case 5: d_max = 50 m, walls 10 m
+    # apart). Such a limit is left out.
+    view_lo, view_hi = max(wall_lo, ylim[0]), min(wall_hi, ylim[1])
+    if d_min is not None and not np.any(x1 + d_min > view_lo):
+        d_min = None
+    if d_max is not None and not np.any(x1 + d_max < view_hi):
+        d_max = None
 
     if d_min is not None and d_max is not None:
         ax.fill_between(t, inside_walls(x1 + d_min), inside_walls(x1 + d_max), color=_BODY_COLOR[2], alpha=0.10,

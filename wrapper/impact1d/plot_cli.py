@@ -1,7 +1,7 @@
 """``impact1d-plot OUTPUT.dat [-o PNG] [--separate] [--show]``: plot a run written by the CLI.
 
-Reads OUTPUT.dat (and OUTPUT.events.dat next to it, if present) and writes
-OUTPUT.png next to it, or one PNG per panel with ``--separate``
+Reads OUTPUT.dat (and OUTPUT.events.dat next to it, if present: the output's
+extension replaced by .events.dat) and writes OUTPUT.png next to it, or one PNG per panel with ``--separate``
 (OUTPUT_positions.png, ...).  ``--show`` also opens the figures in a window.
 Any error gives a one-line message on stderr and exit status 1.
 """
@@ -20,6 +20,8 @@ def _parser():
         prog=PROG,
         description="Plot an impact1d output file: positions with walls and slot, "
         "velocities, kinetic energy, impacts per constraint, energy ledger.",
+        epilog="exit status: 0 done; 1 the output could not be read or the image written; "
+        "2 a bad command line.",
     )
     p.add_argument("output", metavar="OUTPUT.dat", help="output file written by impact1d "
                    "(its OUTPUT.events.dat is read too when present)")
@@ -28,12 +30,24 @@ def _parser():
     p.add_argument("--separate", action="store_true",
                    help="one PNG per panel: PNG stem + _positions, _velocities, ...")
     p.add_argument("--show", action="store_true", help="also open the figures in a window")
+    p.add_argument("--version", action="version", version=f"{PROG} {_version()}")
     return p
 
 
+def _version():
+    # From the installed package's metadata (meson.build's project version), without
+    # importing impact1d and its compiled core.
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("impact1d")
+    except PackageNotFoundError:
+        return "(not installed)"
+
+
 def _default_png(output):
-    stem = output[:-4] if output.endswith(".dat") else output
-    return stem + ".png"
+    # The CLI's rule for its events file: the extension, whatever it is, is replaced.
+    return os.path.splitext(output)[0] + ".png"
 
 
 def _read(path):

@@ -1,0 +1,38 @@
+"""Where the tests find the command-line tools: beside the running interpreter first, so
+that `.venv/bin/python -m pytest tests` tests that environment's install without an
+activated venv (or a PATH that leads elsewhere)."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import sys
+import sysconfig
+from importlib import metadata
+from pathlib import Path
+
+
+def find_tool(name: str) -> str:
+    """Absolute path of the installed executable `name` (impact1d, impact1d-plot).
+    Looks in the interpreter's scripts folder, the folder of sys.executable (not resolved:
+    a venv's python is a link to the system one), the files the installed impact1d package
+    recorded, then PATH. A missing tool is an AssertionError (a failure, never a skip)."""
+    exe = name + (".exe" if os.name == "nt" else "")
+    folders = [sysconfig.get_path("scripts"), os.path.dirname(sys.executable)]
+    for folder in folders:
+        candidate = Path(folder) / exe
+        if candidate.is_file() and os.access(candidate, os.X_OK):
+            return str(candidate)
+    try:
+        for entry in metadata.distribution("impact1d").files or ():
+            if Path(entry).name == exe:
+                candidate = Path(entry.locate()).resolve()
+                if candidate.is_file() and os.access(candidate, os.X_OK):
+                    return str(candidate)
+    except metadata.PackageNotFoundError:
+        pass
+    found = shutil.which(name)
+    assert found is not None, (
+        f"the {name} executable is neither beside {sys.executable} nor recorded by the "
+        f"installed impact1d package nor on PATH: install the package (make setup)")
+    return found
