@@ -16,13 +16,19 @@ Every function returns a `Reference`: `.events` (list of `Event`: t, kind, x, v_
 v_after, as tuples over the bodies), `.phases` (list of `Phase`) and
 `.state(t) -> (x, v)` tuples; `.times(kind)` lists event times.  Event kinds follow the
 engine's log: `left`, `right`, `slot_min` (the bodies meet at x2 = x1), `rest_left`,
-`rest_right`, `stick1`, `slip1`.
+`rest_right`, `stick1` (a sliding body stops and holds), `slip1` (a body at rest
+breaks away), with the engine's conventions (tests/exact_reference.py): nothing is
+logged at t = 0, and a stop that does not hold is not a stick.  Two kinds the engine
+does not log mark those stops here: `reverse1` (the velocity crosses zero and the body
+slides back at once) and `graze1` (the velocity touches zero tangentially and the body
+goes on the same way: mus = mu in the stick-slip cycle).  Filter by kind to compare.
 
 Physics (METHOD.md section 8).  Gravity g, normal force m g; kinetic bound c = mu m g,
 static bound cs = mus m g >= c.  A sliding body feels -c sign(v).  A body at rest
 with holding force H (every other force on it) stays while |H| <= cs; when |H| reaches
 cs it breaks away (`slip1`) and slides in the direction of H.  A sliding body whose
-velocity reaches zero (`stick1`) holds if |H| <= cs there, else it reverses at once.
+velocity reaches zero holds (`stick1`) if |H| <= cs there, else it slides on in the
+direction of H at once (`reverse1` / `graze1`).
 A spring to the ground pulls with -k (x - x_rest).
 
 1. friction_block: one body, force f(t) = f0 + rate t, no walls.  Phases are
@@ -76,7 +82,8 @@ A spring to the ground pulls with -k (x - x_rest).
    at most a few arcs until the first stick; from then on the cycle is exact.
    mus = mu (Delta = 0): T_stick = 0 and the slip lasts a full period with v touching
    zero tangentially (v = V (1 - cos w tau) >= 0): a grazing stop, logged here as
-   `stick1` and `slip1` at the same instant; an engine may see no stop at all there.
+   `graze1` (H = mu m g = cs there and growing: no hold); an engine sees no sign change
+   of v and should log nothing: the motion is one smooth slide.
 
 4. damped_pair: two bodies, no walls, spring k12 and damper c12 between them.  With
    d = x2 - x1, e = d - d_rest, reduced mass mr = m1 m2 / (m1 + m2):
@@ -204,6 +211,19 @@ def _sign(value):
     return 1 if value > 0 else (-1 if value < 0 else 0)
 
 
+def _at_bound(h, cs):
+    """|h| = cs to the working precision (a rounding either way must not decide)."""
+    return abs(abs(h) - cs) <= TOUCH * cs
+
+
+def _holds(h, rate, cs):
+    """Static friction holds the holding force h (changing at `rate`): inside the bound,
+    or on it and moving inward (or not moving)."""
+    if _at_bound(h, cs):
+        return _sign(rate) != _sign(h)
+    return abs(h) < cs
+
+
 # --------------------------------------------------------------------------------------
 # 1. static friction, one body under a force ramp
 
@@ -211,7 +231,7 @@ def _sign(value):
 def friction_block(m, mu, mus, f0, rate, t_end, x0=0.0, v0=0.0, g=DEFAULT_G):
     """One body with kinetic mu, static mus >= mu, force f(t) = f0 + rate t, from (x0, v0).
 
-    Events `stick1` / `slip1` (none at t = 0: the initial mode is chosen, not logged);
+    Events `stick1`, `slip1`, `reverse1`, `graze1` (none at t = 0);
     phases carry `poly` = [x coefficients in tau] (cubic)."""
     with mp.workdps(DPS):
         m, mu, mus, f0, rate, g = map(_mp, (m, mu, mus, f0, rate, g))
@@ -226,8 +246,7 @@ def friction_block(m, mu, mus, f0, rate, t_end, x0=0.0, v0=0.0, g=DEFAULT_G):
             return f0 + rate * time
 
         def held(time):
-            h = force(time)
-            return abs(h) < cs or (abs(h) == cs and _sign(rate) != _sign(h))
+            return _holds(force(time), rate, cs)
 
         sigma = _sign(v) if v != 0 else (0 if held(t) else _sign(force(t)))
         while t < t_end and len(ref.events) < MAX_EVENTS:
@@ -259,12 +278,13 @@ def friction_block(m, mu, mus, f0, rate, t_end, x0=0.0, v0=0.0, g=DEFAULT_G):
             v_before = _poly_eval(_poly_derivative(poly), tau)
             t = t1
             v = mpf(0)
-            ref.events.append(Event(t, "stick1", (x,), (v_before,), (mpf(0),)))
             if held(t):
+                ref.events.append(Event(t, "stick1", (x,), (v_before,), (mpf(0),)))
                 sigma = 0
             else:
+                kind = "graze1" if _sign(force(t)) == sigma else "reverse1"
                 sigma = _sign(force(t))
-                ref.events.append(Event(t, "slip1", (x,), (mpf(0),), (mpf(0),)))
+                ref.events.append(Event(t, kind, (x,), (v_before,), (mpf(0),)))
         return ref
 
 
@@ -388,7 +408,7 @@ def stick_slip(m, k, x_rest, pull_rate, mu, mus, x0, v0, t_end, f0=0.0, g=DEFAUL
     """Block on a spring (k, x_rest) to the ground, force f0 + pull_rate t (the anchor's
     pull: pull_rate = k V, given as the engine's ramp table has it, so that both use the
     same binary number), kinetic mu, static mus, from (x0, v0) at t = 0, until t_end.
-    Events `stick1`, `slip1`."""
+    Events `stick1`, `slip1`, `reverse1`, `graze1`."""
     with mp.workdps(DPS):
         m, k, x_rest, pull_rate, mu, mus, f0, g = map(
             _mp, (m, k, x_rest, pull_rate, mu, mus, f0, g))
@@ -406,8 +426,7 @@ def stick_slip(m, k, x_rest, pull_rate, mu, mus, x0, v0, t_end, f0=0.0, g=DEFAUL
             return f0 + pull_rate * time - k * (pos - x_rest)
 
         def held(time, pos):
-            h = holding(time, pos)
-            return abs(h) < cs or (abs(h) == cs and _sign(V) != _sign(h))
+            return _holds(holding(time, pos), pull_rate, cs)
 
         sigma = _sign(v) if v != 0 else (0 if held(t, x) else _sign(holding(t, x)))
         q0 = None  # exact q at a break-away (kept exact: the grazing case mus = mu)
@@ -440,14 +459,15 @@ def stick_slip(m, k, x_rest, pull_rate, mu, mus, x0, v0, t_end, f0=0.0, g=DEFAUL
             (x,), (v_before,) = motion(tau)
             t = t + tau
             v, q0 = mpf(0), None
-            ref.events.append(Event(t, "stick1", (x,), (v_before,), (v,)))
             if held(t, x):
+                ref.events.append(Event(t, "stick1", (x,), (v_before,), (v,)))
                 sigma = 0
             else:
+                kind = "graze1" if _sign(holding(t, x)) == sigma else "reverse1"
                 sigma = _sign(holding(t, x))
-                if abs(holding(t, x)) == cs:
-                    q0 = -sigma * delta
-                ref.events.append(Event(t, "slip1", (x,), (v,), (v,)))
+                if _at_bound(holding(t, x), cs):
+                    q0 = -sigma * delta  # exactly at the bound: keep the arc exact
+                ref.events.append(Event(t, kind, (x,), (v_before,), (v,)))
         return ref
 
 
@@ -681,14 +701,12 @@ def constant_force_bodies(masses, forces, x0, v0, t_end, x_left=None, x_right=No
                 into = acc[0] if name == "right" else -acc[0]
                 u = abs(v[0])
                 if into > 0 and 2 * u / into < ZENO_GAP * (1 - r):
-                    other = x_right if name == "left" else x_left
                     t_acc = t + 2 * u / (into * (1 - r))
                     ref.phases.append(Phase(t, t_acc, "rattle", _const_motion(x, [mpf(0)])))
                     t = t_acc
                     v = [mpf(0)]
                     ref.events.append(Event(t, "rest_" + name, tuple(x), (mpf(0),), (mpf(0),)))
                     ref.phases.append(Phase(t, t_end, "rest", _const_motion(x, v)))
-                    del other
                     return ref
         return ref
 
