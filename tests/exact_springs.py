@@ -392,6 +392,8 @@ def equilibrium_wall_impact_times(m, k, x_left, x0, v0, n):
         m, k, x_left, x0, v0 = map(_mp, (m, k, x_left, x0, v0))
         w = mpmath.sqrt(k / m)
         u, p = x0 - x_left, v0 / w
+        if u == 0 and p == 0:
+            raise ValueError("at rest at the equilibrium on the wall: no impact ever")
         # u = A cos(w t - alpha) reaches 0 moving left at w t - alpha = pi/2 (mod 2 pi)
         alpha = mpmath.atan2(p, u)
         theta = (alpha + mpmath.pi / 2) % (2 * mpmath.pi)
