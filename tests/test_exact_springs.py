@@ -342,22 +342,24 @@ def assert_state_agrees(ref, num, tol=AGREE):
 # --- 1. static friction ------------------------------------------------------------
 
 
-def test_ramp_breaks_away_at_the_static_bound_then_follows_the_cubic():
-    m, mu, mus, f0, rate = 2.0, 0.3, 0.5, 1.0, 4.0
+@pytest.mark.parametrize("f0, rate", [(1.0, 4.0), (2.0, -3.0)])
+def test_ramp_breaks_away_at_the_static_bound_then_follows_the_cubic(f0, rate):
+    m, mu, mus = 2.0, 0.3, 0.5
     ref = ex.friction_block(m, mu, mus, f0, rate, t_end=5.0)
     t_b = ex.ramp_breakaway_time(m, mus, f0, rate)
     assert [e.kind for e in ref.events] == ["slip1"]
     assert abs(ref.events[0].t - t_b) < EXACT
     with mp.workdps(ex.DPS):
-        assert abs(f0 + rate * t_b - mpf(mus) * mpf(m) * mpf(ex.DEFAULT_G)) < EXACT
+        assert abs(abs(f0 + rate * t_b) - mpf(mus) * mpf(m) * mpf(ex.DEFAULT_G)) < EXACT
     num = integrate(Scene([m], mu=[mu], mus=[mus], f0=[f0], rate=[rate]), [0.0], [0.0], 5.0)
     assert_events_agree(ref, num)
     assert_state_agrees(ref, num)
     # the sliding phase's cubic: a = (f - mu m g)/m, from rest at t_b
     slide = ref.phases[-1]
-    assert slide.label == "slide+" and abs(slide.t0 - t_b) < EXACT
+    sigma = 1 if rate > 0 else -1
+    assert slide.label == ("slide+" if sigma > 0 else "slide-") and abs(slide.t0 - t_b) < EXACT
     with mp.workdps(ex.DPS):
-        a0 = (mpf(f0) + mpf(rate) * t_b - mpf(mu) * mpf(m) * mpf(ex.DEFAULT_G)) / mpf(m)
+        a0 = (mpf(f0) + mpf(rate) * t_b - sigma * mpf(mu) * mpf(m) * mpf(ex.DEFAULT_G)) / mpf(m)
         assert abs(slide.poly[0][1]) < EXACT and abs(slide.poly[0][2] - a0 / 2) < EXACT
         assert abs(slide.poly[0][3] - mpf(rate) / (6 * mpf(m))) < EXACT
 
@@ -437,18 +439,20 @@ def test_spring_pressing_into_the_wall_rattles_to_rest_at_the_summed_series():
 STICK_SLIP = dict(m=1.0, k=50.0, x_rest=0.0, pull_rate=10.0, mu=0.3, mus=0.5)  # V = 0.2 m/s
 
 
-@pytest.mark.parametrize("x0, v0, mu", [(0.0, 0.0, 0.3), (-0.3, 1.5, 0.3), (0.1, 0.0, 0.1)])
-def test_stick_slip_instants_over_twenty_cycles(x0, v0, mu):
+@pytest.mark.parametrize("x0, v0, mu, x_rest, f0", [
+    (0.0, 0.0, 0.3, 0.0, 0.0), (-0.3, 1.5, 0.3, 0.0, 0.0), (0.1, 0.0, 0.1, 0.0, 0.0),
+    (0.5, -0.4, 0.3, 0.2, -1.0)])
+def test_stick_slip_instants_over_twenty_cycles(x0, v0, mu, x_rest, f0):
     # mu = 0.1 < mus / 3: the block stops with the spring pushing it back harder than
     # kinetic friction could hold ((2 mu - mus) m g = -0.3 m g): only static holds it
-    p = dict(STICK_SLIP, mu=mu)
+    p = dict(STICK_SLIP, mu=mu, x_rest=x_rest)
     cycle = ex.stick_slip_cycle(p["m"], p["k"], p["pull_rate"], p["mu"], p["mus"])
     t_end = float(22 * cycle["period"] + 1)
-    ref = ex.stick_slip(**p, x0=x0, v0=v0, t_end=t_end)
+    ref = ex.stick_slip(**p, x0=x0, v0=v0, t_end=t_end, f0=f0)
     sticks = ref.times("stick1")
     assert len(sticks) >= 20
     num = integrate(Scene([p["m"]], mu=[p["mu"]], mus=[p["mus"]], k=[p["k"]], x_rest=[p["x_rest"]],
-                          rate=[p["pull_rate"]]), [x0], [v0], t_end)
+                          f0=[f0], rate=[p["pull_rate"]]), [x0], [v0], t_end)
     assert_events_agree(ref, num)
     assert_state_agrees(ref, num)
     # after the first break-away from rest the motion is the closed-form cycle
