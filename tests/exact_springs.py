@@ -12,7 +12,8 @@ Inputs are floats (or anything mpmath.mpf accepts): a float is converted exactly
 reference built from the same binary numbers as an engine scene is exact for that scene.
 Times and states come back as mpf; `float(...)` them for comparisons with the engine.
 
-Every function returns a `Reference`: `.events` (list of `Event`: t, kind, x, v_before,
+The event-driven functions (friction_block, impact_oscillator, stick_slip,
+constant_force_bodies) return a `Reference`: `.events` (list of `Event`: t, kind, x, v_before,
 v_after, as tuples over the bodies), `.phases` (list of `Phase`) and
 `.state(t) -> (x, v)` tuples; `.times(kind)` lists event times.  Event kinds follow the
 engine's log: `left`, `right`, `slot_min` (the bodies meet at x2 = x1), `rest_left`,
@@ -22,8 +23,11 @@ logged at t = 0, and a stop that does not hold is not a stick.  Two kinds the en
 does not log mark those stops here: `reverse1` (the velocity crosses zero and the body
 slides back at once) and `graze1` (the velocity touches zero tangentially and the body
 goes on the same way: mus = mu in the stick-slip cycle).  Filter by kind to compare.
+damped_pair returns a `DampedPair` (state, ke, pe, damping_loss, energy_residual as
+functions of t); stick_slip_cycle a dict of the cycle's closed-form numbers;
+ramp_breakaway_time, equilibrium_wall_impact_times and rattle_time single formulas.
 
-Physics (METHOD.md section 8).  Gravity g, normal force m g; kinetic bound c = mu m g,
+Physics (the model of issue 10, written out here).  Gravity g, normal force m g; kinetic bound c = mu m g,
 static bound cs = mus m g >= c.  A sliding body feels -c sign(v).  A body at rest
 with holding force H (every other force on it) stays while |H| <= cs; when |H| reaches
 cs it breaks away (`slip1`) and slides in the direction of H.  A sliding body whose

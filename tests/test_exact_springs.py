@@ -1,7 +1,7 @@
 """tests/exact_springs.py against an independent high-precision integrator.
 
 The integrator here knows nothing of the closed forms: it integrates the generic
-equations of METHOD.md section 8 (bodies, springs to the ground and between the bodies,
+equations of the issue-10 model (bodies, springs to the ground and between the bodies,
 dampers, kinetic/static friction, walls, the meeting contact, linear-in-time forces)
 with a Taylor series method at NUMERIC_DPS digits, and applies the generic event rules
 (impact: Newton's law; stop: hold if |H| <= mus m g, else reverse; break-away when
