@@ -6,7 +6,7 @@ module impact1d_impacts
   implicit none
   private
   public :: normal_velocity, impulse, most_approaching, restitution_of, kinetic_energy, &
-    all_inelastic, inelastic_projection
+    joint_inelastic, inelastic_projection
 
 contains
 
@@ -68,17 +68,19 @@ contains
       restitution_of = 0.0_wp
   end function restitution_of
 
-  !> Whether every closed contact is perfectly inelastic (as restitution_of sees it): then
-  !> the impact at this instant is one projection (inelastic_projection), not a sequence.
-  pure logical function all_inelastic(scene, closed)
+  !> Whether the impact at this instant is one joint projection (inelastic_projection) rather
+  !> than a sequence of impulses: two or more contacts are closed and every one of them is
+  !> perfectly inelastic (as restitution_of sees it). A rigid link's two limits are one
+  !> constraint, which a single impulse already resolves exactly: they keep that path.
+  pure logical function joint_inelastic(scene, closed)
     type(scene_type), intent(in) :: scene
     logical, intent(in) :: closed(n_contacts)
     integer :: k
-    all_inelastic = .true.
+    joint_inelastic = count(closed) > 1 .and. .not. (closed(i_slot_min) .and. closed(i_slot_max))
     do k = 1, n_contacts
-      if (closed(k)) all_inelastic = all_inelastic .and. restitution_of(scene, k, closed) == 0.0_wp
+      if (closed(k)) joint_inelastic = joint_inelastic .and. restitution_of(scene, k, closed) == 0.0_wp
     end do
-  end function all_inelastic
+  end function joint_inelastic
 
   !> A simultaneous, perfectly inelastic impact on the closed contacts, solved jointly: the
   !> velocity after is the point of {w : n_k . w >= 0 for every closed k} nearest to v in the

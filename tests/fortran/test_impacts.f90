@@ -4,7 +4,7 @@ program test_impacts
   use impact1d_kinds, only: wp
   use impact1d_scene, only: scene_type, i_left, i_right, i_slot_min, i_slot_max
   use impact1d_impacts, only: impulse, normal_velocity, most_approaching, restitution_of, &
-    all_inelastic, inelastic_projection
+    joint_inelastic, inelastic_projection
   use testing, only: check, finish
   implicit none
   ! One impulse is a handful of flops on O(10) numbers: a few ulps of them.
@@ -49,7 +49,7 @@ program test_impacts
   ! joint impact stops both at once (sequential impulses only approach it geometrically).
   scene%restitution = 0.0_wp
   closed = [.true., .false., .true., .false.]
-  call check(all_inelastic(scene, closed), 'r = 0 everywhere: one joint inelastic impact')
+  call check(joint_inelastic(scene, closed), 'r = 0 everywhere: one joint inelastic impact')
   call inelastic_projection(scene, closed, [0.0_wp, -5.0_wp], no_tol, v_after, pushed)
   call check(all(v_after == 0.0_wp) .and. all(pushed .eqv. closed), &
     'pinned body: both at rest, impulses on the wall and the slot')
@@ -71,7 +71,11 @@ program test_impacts
   call inelastic_projection(scene, closed, [1.0_wp, 1.0_wp], no_tol, v_after, pushed)
   call check(all(v_after == 1.0_wp) .and. .not. any(pushed), 'separating contacts: no impulse')
   scene%restitution(i_left) = 0.5_wp
-  call check(.not. all_inelastic(scene, closed), 'an elastic closed contact: no joint projection')
+  closed = [.true., .false., .true., .false.]
+  call check(.not. joint_inelastic(scene, closed), 'an elastic closed contact: no joint projection')
+  scene%restitution = 0.0_wp
+  call check(.not. joint_inelastic(scene, [.false., .false., .true., .false.]), 'one closed contact: one impulse')
+  call check(.not. joint_inelastic(scene, [.false., .false., .true., .true.]), 'a rigid link alone: one impulse')
 
   call finish('test_impacts')
 
