@@ -7,6 +7,8 @@ onto the velocities no closed contact lets approach; for a pinned body that is r
 Expected numbers are closed forms worked out beside each test.
 """
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -15,6 +17,8 @@ import impact1d
 # Times of a few tenths of a second from quotients of short decimals: rounding is ~1e-16;
 # the bound is far below any real error (a missed or extra flight is >= 1e-3 s).
 TIME_TOL = 1e-14
+
+INPUT = Path(__file__).resolve().parents[1] / "input"
 
 
 def pinned_scene(m1, m2, v2=-5.0):
@@ -54,7 +58,7 @@ def test_case3_perfectly_inelastic():
     until the slot closes to d_min = 1 at t = 2/7 + 1 / (7/3) = 5/7: body 2 pinned, both
     at rest, all 41.5 J lost.
     """
-    scene = impact1d.load_scene("input/case3.nml")
+    scene = impact1d.load_scene(INPUT / "case3.nml")
     res = impact1d.simulate(scene, r_left=0.0, r_right=0.0, r_min=0.0, r_max=0.0)
     ev = res.events
     first = {k: ev["t"][ev["kind"] == k][0] for k in ("slot_max", "slot_min")}
