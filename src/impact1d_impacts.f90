@@ -5,7 +5,8 @@ module impact1d_impacts
   use impact1d_scene, only: scene_type, n_contacts, normal, i_left, i_right, i_slot_min, i_slot_max
   implicit none
   private
-  public :: normal_velocity, impulse, most_approaching, restitution_of, kinetic_energy
+  public :: normal_velocity, impulse, most_approaching, restitution_of, kinetic_energy, &
+    joint_inelastic, inelastic_projection
 
 contains
 
@@ -66,6 +67,67 @@ contains
     if ((k == i_slot_min .or. k == i_slot_max) .and. closed(i_slot_min) .and. closed(i_slot_max)) &
       restitution_of = 0.0_wp
   end function restitution_of
+
+  !> Whether the impact at this instant is one joint projection (inelastic_projection) rather
+  !> than a sequence of impulses: two or more contacts are closed and every one of them is
+  !> perfectly inelastic (as restitution_of sees it). A rigid link's two limits are one
+  !> constraint, which a single impulse already resolves exactly: they keep that path.
+  pure logical function joint_inelastic(scene, closed)
+    type(scene_type), intent(in) :: scene
+    logical, intent(in) :: closed(n_contacts)
+    integer :: k
+    joint_inelastic = count(closed) > 1 .and. .not. (closed(i_slot_min) .and. closed(i_slot_max))
+    do k = 1, n_contacts
+      if (closed(k)) joint_inelastic = joint_inelastic .and. restitution_of(scene, k, closed) == 0.0_wp
+    end do
+  end function joint_inelastic
+
+  !> A simultaneous, perfectly inelastic impact on the closed contacts, solved jointly: the
+  !> velocity after is the point of {w : n_k . w >= 0 for every closed k} nearest to v in the
+  !> kinetic-energy metric (METHOD: Moreau's impact law with r = 0). Sequential impulses only
+  !> approach it geometrically (a body pinned between a wall and a heavier body). In two
+  !> dimensions the nearest point has at most two independent active faces, so it is one of:
+  !> v itself, v projected onto one face, or the vertex of two independent faces, which is
+  !> w = 0. The nearest feasible candidate is the projection (any feasible point is at least
+  !> as far as the projection, and the projection is among the candidates).
+  !> tol: rounding level of each contact's normal velocity (feasibility within it).
+  !> pushed: the contacts whose face the projection lies on (they take an impulse).
+  pure subroutine inelastic_projection(scene, closed, v, tol, v_after, pushed)
+    type(scene_type), intent(in) :: scene
+    logical, intent(in) :: closed(n_contacts)
+    real(wp), intent(in) :: v(2), tol(n_contacts)
+    real(wp), intent(out) :: v_after(2)
+    logical, intent(out) :: pushed(n_contacts)
+    real(wp) :: candidate(2), distance, best_distance
+    integer :: j, k
+
+    v_after = v
+    pushed = .false.
+    if (most_approaching(closed, v, tol) == 0) return
+    best_distance = huge(1.0_wp)
+    do k = 1, n_contacts
+      if (.not. closed(k)) cycle
+      do j = k, n_contacts
+        if (.not. closed(j)) cycle
+        if (j == k) then
+          ! The single-face projection is the r = 0 impulse (exact for a wall: its body stops).
+          candidate = impulse(scene, k, 0.0_wp, v)
+        else
+          ! Opposite normals (a rigid link's two limits) span one line only: no vertex.
+          if (normal(1, j) * normal(2, k) - normal(2, j) * normal(1, k) == 0.0_wp) cycle
+          candidate = 0.0_wp
+        end if
+        if (most_approaching(closed, candidate, tol) /= 0) cycle
+        distance = dot_product(scene%mass, (candidate - v)**2)
+        if (distance >= best_distance) cycle
+        best_distance = distance
+        v_after = candidate
+        pushed = .false.
+        pushed(k) = .true.
+        pushed(j) = .true.
+      end do
+    end do
+  end subroutine inelastic_projection
 
   pure real(wp) function kinetic_energy(scene, v)
     type(scene_type), intent(in) :: scene

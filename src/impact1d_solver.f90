@@ -10,7 +10,7 @@ module impact1d_solver
   use impact1d_modes, only: mode_type, solve_mode, max_holds
   use impact1d_events, only: hermite, earliest_crossing
   use impact1d_impacts, only: normal_velocity, impulse, most_approaching, restitution_of, &
-    kinetic_energy
+    kinetic_energy, joint_inelastic, inelastic_projection
   use impact1d_output, only: sink_type, run_stats, emit_sample, event_impact, event_rest, &
     event_release, event_stick, event_slip
   use impact1d_vissim, only: run_vissim
@@ -644,6 +644,7 @@ contains
       logical, intent(in) :: initial
       integer, intent(in) :: which
       logical :: closed(n_contacts), candidate(n_contacts), resting(2), found, leaving, resting_now
+      logical :: pushed(n_contacts)
       real(wp) :: f(2), df(2), v_before(2), v_after(2), moving_sign(2), acc(2), tol_a(2), acc_rate(2)
       integer :: k, i, n_impulses
       type(mode_type) :: new_mode
@@ -679,6 +680,19 @@ contains
           call zero_velocity(i)
       end do
 
+      ! Perfectly inelastic contacts closed together take one joint impact: sequential
+      ! impulses would only approach it geometrically (a body pinned by a heavier one).
+      if (joint_inelastic(scene, closed)) then
+        v_before = s%v
+        call inelastic_projection(scene, closed, s%v, u_tolerances(), v_after, pushed)
+        if (any(pushed)) then
+          call apply(v_after)
+          if (any(pushed .and. [.false., .false., .true., .true.])) entry_scale = maxval(entry_scale)
+          do k = 1, n_contacts
+            if (pushed(k)) call log_event(event_impact + k, v_before, v_after)
+          end do
+        end if
+      end if
       n_impulses = 0
       do
         k = most_approaching(closed, s%v, u_tolerances())

@@ -3,14 +3,18 @@
 program test_impacts
   use impact1d_kinds, only: wp
   use impact1d_scene, only: scene_type, i_left, i_right, i_slot_min, i_slot_max
-  use impact1d_impacts, only: impulse, normal_velocity, most_approaching, restitution_of
+  use impact1d_impacts, only: impulse, normal_velocity, most_approaching, restitution_of, &
+    joint_inelastic, inelastic_projection
   use testing, only: check, finish
   implicit none
   ! One impulse is a handful of flops on O(10) numbers: a few ulps of them.
   real(wp), parameter :: tol = 1.0e-13_wp
   type(scene_type) :: scene
   real(wp) :: v(2), v_after(2), r, expected(2)
-  logical :: closed(4)
+  logical :: closed(4), pushed(4)
+  real(wp), parameter :: no_tol(4) = 0.0_wp
+  ! The solver's rounding level of a normal velocity of about 8 m/s (64 ulps of it).
+  real(wp), parameter :: u_rounding(4) = 64.0_wp * epsilon(1.0_wp) * 8.0_wp
 
   scene%mass = [1.0_wp, 2.0_wp]
   v = [-9.0_wp, 1.0_wp]
@@ -40,6 +44,38 @@ program test_impacts
   scene%restitution = 1.0_wp
   closed = [.false., .false., .true., .true.]
   call check(restitution_of(scene, i_slot_min, closed) == 0.0_wp, 'a rigid link (both slot limits closed) does not rebound')
+
+  ! A body pinned between a wall and a heavier body, every contact perfectly inelastic: the
+  ! joint impact stops both at once (sequential impulses only approach it geometrically).
+  scene%restitution = 0.0_wp
+  closed = [.true., .false., .true., .false.]
+  call check(joint_inelastic(scene, closed), 'r = 0 everywhere: one joint inelastic impact')
+  call inelastic_projection(scene, closed, [0.0_wp, -5.0_wp], no_tol, v_after, pushed)
+  call check(all(v_after == 0.0_wp) .and. all(pushed .eqv. closed), &
+    'pinned body: both at rest, impulses on the wall and the slot')
+  ! The same contacts, body 2 leaving: only the wall acts, body 2 keeps its velocity.
+  call inelastic_projection(scene, closed, [-1.0_wp, 3.0_wp], no_tol, v_after, pushed)
+  call check(all(v_after == [0.0_wp, 3.0_wp]) .and. all(pushed .eqv. [.true., .false., .false., .false.]), &
+    'a leaving body is not held back')
+  ! Body 1 slower toward the wall than body 2 follows it: the nearest admissible velocity
+  ! in the kinetic-energy metric is the common one (the slot face), not the vertex.
+  closed = [.false., .false., .true., .false.]
+  call inelastic_projection(scene, closed, [8.0_wp, 0.0_wp], u_rounding, v_after, pushed)
+  call check(all(v_after == impulse(scene, i_slot_min, 0.0_wp, [8.0_wp, 0.0_wp])), &
+    'one closed contact: the projection is the r = 0 impulse')
+  ! A rigid link (both slot limits closed) driven into the left wall: the pair stops as one.
+  closed = [.true., .false., .true., .true.]
+  call inelastic_projection(scene, closed, [-2.0_wp, -2.0_wp], no_tol, v_after, pushed)
+  call check(all(v_after == 0.0_wp) .and. pushed(i_left), 'a rigid pair against a wall stops as one body')
+  ! Nothing approaches: nothing changes.
+  call inelastic_projection(scene, closed, [1.0_wp, 1.0_wp], no_tol, v_after, pushed)
+  call check(all(v_after == 1.0_wp) .and. .not. any(pushed), 'separating contacts: no impulse')
+  scene%restitution(i_left) = 0.5_wp
+  closed = [.true., .false., .true., .false.]
+  call check(.not. joint_inelastic(scene, closed), 'an elastic closed contact: no joint projection')
+  scene%restitution = 0.0_wp
+  call check(.not. joint_inelastic(scene, [.false., .false., .true., .false.]), 'one closed contact: one impulse')
+  call check(.not. joint_inelastic(scene, [.false., .false., .true., .true.]), 'a rigid link alone: one impulse')
 
   call finish('test_impacts')
 
