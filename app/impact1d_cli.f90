@@ -19,6 +19,15 @@ program impact1d_cli
       import :: c_int
       integer(c_int), value :: status
     end subroutine c_exit
+    !> app/impact1d_signals.c: an interrupted run removes its temporary files.
+    subroutine guard_temporaries(first, second) bind(C, name='impact1d_guard_temporaries')
+      import :: c_char
+      character(kind=c_char), intent(in) :: first(*), second(*)
+    end subroutine guard_temporaries
+    subroutine hold_signals() bind(C, name='impact1d_hold_signals')
+    end subroutine hold_signals
+    subroutine release_signals() bind(C, name='impact1d_release_signals')
+    end subroutine release_signals
     integer(c_int) function c_isatty(fd) bind(C, name='isatty')
       import :: c_int
       integer(c_int), value :: fd
@@ -134,10 +143,13 @@ program impact1d_cli
   call make_parent_folders(out_path)
   call sink%open(out_path, input, error)
   if (allocated(error)) call fail(error%status, error%message)
+  call guard_temporaries(out_path // '.part' // c_null_char, events_path(out_path) // '.part' // c_null_char)
   ! Progress only where a person watches: stderr a terminal (file descriptor 2).
   sink%show_progress = c_isatty(2_c_int) == 1
   call run(scene, sink, stats, error)
+  call hold_signals()
   call sink%close(.not. allocated(error), close_error)
+  call release_signals()
   if (allocated(error)) call fail(error%status, scene_path // ': ' // error%message)
   if (allocated(close_error)) call fail(close_error%status, close_error%message)
   call summary()

@@ -4,7 +4,7 @@ module impact1d_output
   use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char
   use, intrinsic :: iso_fortran_env, only: error_unit, int64
   use impact1d_kinds, only: wp
-  use impact1d_error, only: error_type, raise, status_input, fmt
+  use impact1d_error, only: error_type, raise, status_input, status_simulation, fmt
   use impact1d_scene, only: scene_input, real_names, n_real, i_title, i_method, i_g, i_dt_out, &
     i_dt, default_gravity
   implicit none
@@ -78,16 +78,26 @@ module impact1d_output
   end type memory_sink
 
   !> Streams rows to NAME.dat and NAME.events.dat, written under temporary names and renamed
-  !> only when the run succeeds: a failed run never leaves a truncated file under the final name.
+  !> only when the run succeeds and every write, flush and close did: a failed run or a full
+  !> disk never leaves a truncated file under the final name, and the previous pair stays.
   type, extends(sink_type) :: file_sink
     integer :: unit = 0, event_unit = 0
     logical :: is_open = .false.
     character(len=:), allocatable :: path, event_path
+    !> The first failed write ('file: reason'); nothing more is written after it.
+    character(len=:), allocatable :: write_failure
+    !> Bytes written to each file, and the fixed length of a sample and an event line: the
+    !> Fortran runtime may drop a full disk's error (gfortran 12 does, on write, flush and
+    !> close alike), so a file is only trusted once its size on disk is what was written.
+    integer(int64) :: bytes(2) = 0
+    integer :: sample_bytes = 0, event_bytes = 0
   contains
     procedure :: put_sample => file_put_sample
     procedure :: put_event => file_put_event
     procedure :: open => file_open
     procedure :: close => file_close
+    procedure, private :: put_line
+    procedure, private :: finish_file
   end type file_sink
 
   interface
@@ -95,6 +105,14 @@ module impact1d_output
       import :: c_int, c_char
       character(kind=c_char), intent(in) :: old(*), new(*)
     end function c_rename
+    integer(c_int) function c_link(old, new) bind(C, name='link')
+      import :: c_int, c_char
+      character(kind=c_char), intent(in) :: old(*), new(*)
+    end function c_link
+    integer(c_int) function c_unlink(path) bind(C, name='unlink')
+      import :: c_int, c_char
+      character(kind=c_char), intent(in) :: path(*)
+    end function c_unlink
     integer(c_int) function c_mkdir(path, mode) bind(C, name='mkdir')
       import :: c_int, c_char
       character(kind=c_char), intent(in) :: path(*)
@@ -103,6 +121,7 @@ module impact1d_output
   end interface
 
   character(len=*), parameter :: row_format = '(*(es25.16e3))'
+  character(len=*), parameter :: event_format = '(es25.16e3, 1x, a17, 4es25.16e3)'
 
 contains
 
@@ -227,61 +246,191 @@ contains
       return
     end if
     self%is_open = .true.
-    write(self%unit, '(a)') '# impact1d output'
-    write(self%unit, '(a)') '# title = ' // trim(input%text(i_title))
-    if (allocated(input%source)) write(self%unit, '(a)') '# scene = ' // input%source
+    self%bytes = 0
+    self%sample_bytes = line_bytes(row_format, 0.0_wp)
+    self%event_bytes = line_bytes(event_format, 0.0_wp, event_names(1))
+    call self%put_line(self%unit, '# impact1d output')
+    call self%put_line(self%unit, '# title = ' // trim(input%text(i_title)))
+    if (allocated(input%source)) call self%put_line(self%unit, '# scene = ' // input%source)
     if (len_trim(input%text(i_method)) > 0) then
-      write(self%unit, '(a)') '# method = ' // trim(input%text(i_method))
+      call self%put_line(self%unit, '# method = ' // trim(input%text(i_method)))
     else
-      write(self%unit, '(a)') '# method = event'
+      call self%put_line(self%unit, '# method = event')
     end if
     do k = 1, n_real
       if (input%given(k)) then
-        write(self%unit, '(a)') '# ' // trim(real_names(k)) // ' = ' // fmt(input%value(k))
+        call self%put_line(self%unit, '# ' // trim(real_names(k)) // ' = ' // fmt(input%value(k)))
       else if (k == i_g) then
-        write(self%unit, '(a)') '# g = ' // fmt(default_gravity)
+        call self%put_line(self%unit, '# g = ' // fmt(default_gravity))
       else if (k == i_dt_out) then
-        write(self%unit, '(a)') '# dt_out = ' // fmt(input%value(i_dt))
+        call self%put_line(self%unit, '# dt_out = ' // fmt(input%value(i_dt)))
       end if
     end do
-    write(self%unit, '(a)') '# ' // column_names
-    write(self%event_unit, '(a)') '# impact1d events'
-    write(self%event_unit, '(a)') '# t kind v1_before v2_before v1_after v2_after'
+    call self%put_line(self%unit, '# ' // column_names)
+    call self%put_line(self%event_unit, '# impact1d events')
+    call self%put_line(self%event_unit, '# t kind v1_before v2_before v1_after v2_after')
   end subroutine file_open
 
   subroutine file_put_sample(self, row)
     class(file_sink), intent(inout) :: self
     real(wp), intent(in) :: row(n_columns)
-    write(self%unit, row_format) row
+    integer :: ios
+    character(len=512) :: message
+    if (allocated(self%write_failure)) return
+    write(self%unit, row_format, iostat=ios, iomsg=message) row
+    if (ios /= 0) self%write_failure = self%path // ': ' // reason(message)
+    self%bytes(1) = self%bytes(1) + self%sample_bytes
   end subroutine file_put_sample
 
   subroutine file_put_event(self, t, kind, v_before, v_after)
     class(file_sink), intent(inout) :: self
     real(wp), intent(in) :: t, v_before(2), v_after(2)
     integer, intent(in) :: kind
-    write(self%event_unit, '(es25.16e3, 1x, a17, 4es25.16e3)') t, event_names(kind), v_before, v_after
+    integer :: ios
+    character(len=512) :: message
+    if (allocated(self%write_failure)) return
+    write(self%event_unit, event_format, iostat=ios, iomsg=message) t, event_names(kind), v_before, v_after
+    if (ios /= 0) self%write_failure = self%event_path // ': ' // reason(message)
+    self%bytes(2) = self%bytes(2) + self%event_bytes
   end subroutine file_put_event
 
-  !> Close the files; keep them under their final names only if the run succeeded.
+  !> A header line, checked like every row.
+  subroutine put_line(self, unit, text)
+    class(file_sink), intent(inout) :: self
+    integer, intent(in) :: unit
+    character(len=*), intent(in) :: text
+    integer :: ios
+    character(len=512) :: message
+    if (allocated(self%write_failure)) return
+    write(unit, '(a)', iostat=ios, iomsg=message) text
+    if (ios /= 0 .and. unit == self%unit) self%write_failure = self%path // ': ' // reason(message)
+    if (ios /= 0 .and. unit /= self%unit) self%write_failure = self%event_path // ': ' // reason(message)
+    if (unit == self%unit) self%bytes(1) = self%bytes(1) + len(text) + 1
+    if (unit /= self%unit) self%bytes(2) = self%bytes(2) + len(text) + 1
+  end subroutine put_line
+
+  !> Close the files. Only if the run succeeded and every write, flush and close did, the new
+  !> pair replaces the previous one (replace_pair); otherwise the temporary files are removed
+  !> and a failed write is reported (status 2: the run could not deliver its output).
   subroutine file_close(self, keep, error)
     class(file_sink), intent(inout) :: self
     logical, intent(in) :: keep
     type(error_type), allocatable, intent(out) :: error
-    integer(c_int) :: status
+    integer :: ios
     call self%end_progress()
     if (.not. self%is_open) return
     self%is_open = .false.
-    if (.not. keep) then
-      close(self%unit, status='delete')
-      close(self%event_unit, status='delete')
+    if (keep) then
+      call self%finish_file(self%unit, self%path)
+      call self%finish_file(self%event_unit, self%event_path)
+    else
+      close(self%unit, iostat=ios)
+      close(self%event_unit, iostat=ios)
+    end if
+    if (keep .and. .not. allocated(self%write_failure)) then
+      call replace_pair(self%path, self%event_path, error)
+      if (.not. allocated(error)) return
+    end if
+    call remove_file(self%path // '.part')
+    call remove_file(self%event_path // '.part')
+    if (keep .and. allocated(self%write_failure)) &
+      call raise(error, status_simulation, 'cannot write output ' // self%write_failure)
+  end subroutine file_close
+
+  !> Flush and close one file, recording the first failure (a full disk often shows only here,
+  !> when the last buffer goes out).
+  subroutine finish_file(self, unit, path)
+    class(file_sink), intent(inout) :: self
+    integer, intent(in) :: unit
+    character(len=*), intent(in) :: path
+    integer :: ios
+    integer(int64) :: on_disk, written
+    character(len=512) :: message
+    if (.not. allocated(self%write_failure)) then
+      flush(unit, iostat=ios, iomsg=message)
+      if (ios /= 0) self%write_failure = path // ': ' // reason(message)
+    end if
+    if (allocated(self%write_failure)) then
+      close(unit, iostat=ios)
       return
     end if
-    close(self%unit)
-    close(self%event_unit)
-    status = c_rename(self%path // '.part' // c_null_char, self%path // c_null_char)
-    if (status == 0) status = c_rename(self%event_path // '.part' // c_null_char, self%event_path // c_null_char)
-    if (status /= 0) call raise(error, status_input, 'cannot rename the finished output to ' // self%path)
-  end subroutine file_close
+    close(unit, iostat=ios, iomsg=message)
+    if (ios /= 0) self%write_failure = path // ': ' // reason(message)
+    if (allocated(self%write_failure)) return
+    written = self%bytes(merge(1, 2, unit == self%unit))
+    inquire(file=path // '.part', size=on_disk)
+    if (on_disk /= written) self%write_failure = path // ': only ' // fmt(on_disk) // ' of ' // &
+      fmt(written) // ' bytes reached the disk (is it full?)'
+  end subroutine finish_file
+
+  !> Length in bytes (with its newline) of a line written with a fixed-width format.
+  integer function line_bytes(format, value, name)
+    character(len=*), intent(in) :: format
+    real(wp), intent(in) :: value
+    character(len=*), intent(in), optional :: name
+    character(len=1024) :: line
+    real(wp) :: values(n_columns)
+    values = value
+    if (present(name)) then
+      write(line, format) value, name, values(:4)
+    else
+      write(line, format) values
+    end if
+    line_bytes = len_trim(line) + 1
+  end function line_bytes
+
+  !> Put the finished PATH.part and EVENTS.part under their final names as a pair: either
+  !> both new files end up there, or (a rename failed) both previous ones stay. The previous
+  !> files are kept as hard links (or, where links are not supported, moved aside) until
+  !> both renames have succeeded.
+  subroutine replace_pair(path, event_path, error)
+    character(len=*), intent(in) :: path, event_path
+    type(error_type), allocatable, intent(out) :: error
+    character(len=*), parameter :: aside = '.previous'
+    logical :: kept(2), placed(2)
+    character(len=:), allocatable :: final(:)
+    integer :: k
+    integer(c_int) :: status, undone
+
+    final = [character(len=max(len(path), len(event_path))) :: path, event_path]
+    kept = .false.
+    placed = .false.
+    do k = 1, 2
+      if (.not. exists(trim(final(k)))) cycle
+      call remove_file(trim(final(k)) // aside)
+      kept(k) = c_link(trim(final(k)) // c_null_char, trim(final(k)) // aside // c_null_char) == 0
+      if (.not. kept(k)) kept(k) = &
+        c_rename(trim(final(k)) // c_null_char, trim(final(k)) // aside // c_null_char) == 0
+    end do
+    status = 0
+    do k = 2, 1, -1
+      status = c_rename(trim(final(k)) // '.part' // c_null_char, trim(final(k)) // c_null_char)
+      if (status /= 0) exit
+      placed(k) = .true.
+    end do
+    do k = 1, 2
+      if (status /= 0) then
+        ! Undo: the previous file back under its name (or no file, if there was none).
+        if (placed(k) .and. .not. kept(k)) call remove_file(trim(final(k)))
+        if (kept(k)) undone = c_rename(trim(final(k)) // aside // c_null_char, trim(final(k)) // c_null_char)
+      else if (kept(k)) then
+        call remove_file(trim(final(k)) // aside)
+      end if
+    end do
+    if (status /= 0) call raise(error, status_simulation, 'cannot put the finished output in place as ' // path)
+  end subroutine replace_pair
+
+  logical function exists(path)
+    character(len=*), intent(in) :: path
+    inquire(file=path, exist=exists)
+  end function exists
+
+  !> Remove a file if it is there (a missing one is fine).
+  subroutine remove_file(path)
+    character(len=*), intent(in) :: path
+    integer(c_int) :: status
+    status = c_unlink(path // c_null_char)
+  end subroutine remove_file
 
   !> The events file of an output: its extension, whatever it is, becomes .events.dat
   !> (res.dat, res.txt and res all give res.events.dat).

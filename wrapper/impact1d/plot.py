@@ -482,5 +482,19 @@ def save(result, path, separate=False, *, dpi=100, figure_factory=None):
     folder = os.path.dirname(os.path.abspath(path))
     os.makedirs(folder, exist_ok=True)
     for fig, p in zip(figs, paths):
-        fig.savefig(p, dpi=dpi)
+        _save_whole(fig, p, dpi)
     return paths
+
+
+def _save_whole(fig, path, dpi):
+    """Save under a temporary name and rename: a full disk or an interrupt leaves the
+    previous image (or none), never a truncated one."""
+    root, ext = os.path.splitext(path)
+    temporary = f"{root}.part{ext}"      # the extension tells matplotlib the format
+    try:
+        fig.savefig(temporary, dpi=dpi)
+        os.replace(temporary, path)
+    except BaseException:
+        if os.path.exists(temporary):
+            os.remove(temporary)
+        raise
