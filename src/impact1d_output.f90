@@ -126,15 +126,23 @@ module impact1d_output
 contains
 
   !> Send one sample (t, x, v and the energy ledger) to a sink, keeping the run's statistics:
-  !> both methods report through here, so their columns cannot drift apart.
-  subroutine emit_sample(sink, stats, t, x, v, mass, ke0, work, friction_loss, impact_loss)
+  !> both methods report through here, so their columns cannot drift apart. A row that is not
+  !> finite (v = 1e300 squares to an infinite KE, and the residual becomes NaN) is an error,
+  !> never a result: a NaN would also slip through the max of the residuals.
+  subroutine emit_sample(sink, stats, t, x, v, mass, ke0, work, friction_loss, impact_loss, error)
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
     real(wp), intent(in) :: t, x(2), v(2), mass(2), ke0, work, friction_loss, impact_loss
+    type(error_type), allocatable, intent(out) :: error
     real(wp) :: row(n_columns), ke
     ke = 0.5_wp * dot_product(mass, v**2)
     row = [t, x(1), v(1), x(2), v(2), ke, work, friction_loss, impact_loss, &
       ke - ke0 - work + friction_loss + impact_loss]
+    if (.not. all(abs(row) <= huge(1.0_wp))) then
+      call raise(error, status_simulation, 'at t = ' // fmt(t) // ': the kinetic energy or the ' // &
+        'energy ledger is no longer finite (KE = ' // fmt(ke) // ', KE0 = ' // fmt(ke0) // ' J)')
+      return
+    end if
     stats%max_residual = max(stats%max_residual, abs(row(n_columns)))
     stats%last_row = row
     call sink%put_sample(row)

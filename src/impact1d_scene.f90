@@ -43,6 +43,8 @@ module impact1d_scene
   real(wp), parameter :: default_zero_velocity = 0.005_wp
   !> Output rows a run may produce: beyond this the user almost surely meant a larger dt_out.
   integer, parameter :: max_samples = 10000000
+  !> The smallest step, in units of the clock's spacing at t_end.
+  real(wp), parameter :: clock_resolution_ulps = 8.0_wp
 
   !> A scene as written: values and texts, each given or absent.
   type :: scene_input
@@ -143,6 +145,16 @@ contains
     if (input%given(i_dt)) then
       if (input%value(i_dt) <= 0.0_wp) then
         call raise(error, status_input, 'dt = ' // fmt(input%value(i_dt)) // ' must be positive')
+        return
+      end if
+    end if
+    ! A step the clock cannot resolve near t_end never advances the run (dt = 1e-320 ran for
+    ! minutes): at least 8 ulps of t_end, so that t + dt moves the clock by dt to 1 part in 8.
+    if (input%given(i_dt) .and. input%given(i_t_end)) then
+      if (input%value(i_dt) < clock_resolution_ulps * spacing(abs(input%value(i_t_end)))) then
+        call raise(error, status_input, 'dt = ' // fmt(input%value(i_dt)) // ' is below the clock''s ' // &
+          'resolution at t_end = ' // fmt(input%value(i_t_end)) // ' (' // &
+          fmt(clock_resolution_ulps * spacing(abs(input%value(i_t_end)))) // ' s): the run could not advance')
         return
       end if
     end if

@@ -39,6 +39,7 @@ contains
     ke0 = kinetic_energy(scene, threshold(v))
     j_sample = 0
     call emit()
+    if (allocated(error)) return
     do while (j_sample < scene%n_samples)
       t_sample = sample_time(scene, j_sample)
       h = min(scene%dt, t_sample - t)
@@ -75,14 +76,17 @@ contains
           call sink%put_event(t, event_impact + c, v_hit, threshold(v))
         end associate
       end do
-      if (t == t_sample) call emit()
+      if (t == t_sample) then
+        call emit()
+        if (allocated(error)) return
+      end if
     end do
     call sink%end_progress()
 
   contains
 
     subroutine emit()
-      call emit_sample(sink, stats, t, x, threshold(v), scene%mass, ke0, work, friction_loss, impact_loss)
+      call emit_sample(sink, stats, t, x, threshold(v), scene%mass, ke0, work, friction_loss, impact_loss, error)
       j_sample = j_sample + 1
     end subroutine emit
 

@@ -475,7 +475,8 @@ def test_plastic_pile_up_against_a_wall(r_left, r_min):
 @pytest.mark.parametrize("r_left", [0.5, pytest.param(0.99999, marks=pytest.mark.xfail(
     strict=True, reason="engine limitation: with a near-elastic wall the lower body rattles "
     "between the wall and the upper one ever faster; the per-contact bounce-series test does "
-    "not see this two-contact collapse, and the run stops with the 2e6-event SimulationError"))])
+    "not see this two-contact collapse, and the run stops with the events-within-one-step "
+    "SimulationError"))])
 def test_stack_pressed_onto_a_wall_comes_to_rest(r_left):
     """m1 on the wall, m2 falls onto it from 1 m (both pushed by -1 N, r_min = 0.5): the
     inner collisions dissipate, the stack rattles to rest and stays: at t = 10 both
