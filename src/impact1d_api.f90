@@ -1,7 +1,8 @@
 !> Flat interface for f2py (and a future C API): scalars, explicit-shape arrays, a status
 !> code and a message; derived types stay inside. Status 0 ok, 1 input error, 2 simulation
-!> error. The last run's samples and events stay here until the next simulate call, so
-!> Python can size its arrays before copying them out.
+!> error, 3 the caller's arrays were too small (see simulate). No state is kept between calls:
+!> everything a run produced comes back from the call that ran it, so threads may run scenes
+!> at once (the long calls are `threadsafe` for f2py: they release the GIL).
 module impact1d_api
   use, intrinsic :: iso_c_binding, only: c_double, c_int
   use impact1d_kinds, only: wp
@@ -13,9 +14,9 @@ module impact1d_api
   use impact1d_solver, only: run, run_stats
   implicit none
   private
-  public :: field_names, column_names, event_kind_names, read_scene, simulate, get_samples, get_events
+  public :: field_names, column_names, event_kind_names, read_scene, simulate
 
-  type(memory_sink), save :: last_run
+  integer(c_int), parameter :: status_too_small = 3   !< arrays too small: sizes needed returned
 
 contains
 
@@ -54,6 +55,7 @@ contains
 
   !> Read and check a scene file ('.dat': VisSim-style parameters; else a namelist).
   subroutine read_scene(path, n, values, given, title, f1_table, f2_table, method, status, message)
+    !f2py threadsafe
     character(len=*), intent(in) :: path
     integer(c_int), intent(in) :: n
     real(c_double), intent(out) :: values(n)
@@ -81,14 +83,23 @@ contains
     method = input%text(i_method)
   end subroutine read_scene
 
-  !> Check and run a scene given as flat fields; keep its samples and events for get_*.
-  subroutine simulate(n, values, given, title, f1_table, f2_table, method, progress, n_samples, &
-      n_events, steps, energy_residual, status, message)
+  !> Check and run a scene given as flat fields. The samples fill samples(:n_samples, :) and
+  !> the events the event arrays up to n_events; when either needs more room than the caller
+  !> gave (max_samples, max_events), status is 3 and n_samples, n_events are the sizes needed:
+  !> call again with them.
+  subroutine simulate(n, values, given, title, f1_table, f2_table, method, progress, max_samples, &
+      n_cols, max_events, samples, event_t, event_kind, event_v, n_samples, n_events, steps, &
+      energy_residual, status, message)
+    !f2py threadsafe
     integer(c_int), intent(in) :: n
     real(c_double), intent(in) :: values(n)
     integer(c_int), intent(in) :: given(n)
     character(len=*), intent(in) :: title, f1_table, f2_table, method
     integer(c_int), intent(in) :: progress    !< non-zero: show progress on stderr after 1 s
+    integer(c_int), intent(in) :: max_samples, n_cols, max_events
+    real(c_double), intent(out) :: samples(max_samples, n_cols)
+    real(c_double), intent(out) :: event_t(max_events), event_v(4, max_events)
+    integer(c_int), intent(out) :: event_kind(max_events)
     integer(c_int), intent(out) :: n_samples, n_events, steps
     real(c_double), intent(out) :: energy_residual
     integer(c_int), intent(out) :: status
@@ -96,6 +107,7 @@ contains
     type(scene_input) :: input
     type(scene_type) :: scene
     type(run_stats) :: stats
+    type(memory_sink) :: sink
     type(error_type), allocatable :: error
 
     n_samples = 0
@@ -103,6 +115,11 @@ contains
     steps = 0
     energy_residual = 0.0_c_double
     if (.not. field_count_ok(n, status, message)) return
+    if (n_cols /= n_columns) then
+      status = status_input
+      write(message, '(a, i0, a, i0)') 'internal: ', n_cols, ' sample columns asked for, the core has ', n_columns
+      return
+    end if
     input%value = real(values, wp)
     input%given = given /= 0
     input%text(i_title) = title
@@ -111,50 +128,25 @@ contains
     input%text(i_method) = method
     call prepare_scene(input, scene, error)
     if (failed(error, status, message)) return
-    call last_run%reserve(scene%n_samples)
-    last_run%show_progress = progress /= 0
-    last_run%clock_start = -1
-    call run(scene, last_run, stats, error)
-    call last_run%end_progress()
+    call sink%reserve(scene%n_samples)
+    sink%show_progress = progress /= 0
+    call run(scene, sink, stats, error)
+    call sink%end_progress()
     if (failed(error, status, message)) return
-    n_samples = last_run%n_samples
-    n_events = last_run%n_events
+    n_samples = sink%n_samples
+    n_events = sink%n_events
     steps = int(min(stats%steps, int(huge(1_c_int), kind(stats%steps))), c_int)
     energy_residual = stats%max_residual
+    if (n_samples > max_samples .or. n_events > max_events) then
+      status = status_too_small
+      message = 'internal: the result arrays are too small'
+      return
+    end if
+    samples(:n_samples, :) = sink%samples(:n_samples, :)
+    event_t(:n_events) = sink%event_time(:n_events)
+    event_kind(:n_events) = sink%event_kind(:n_events)
+    event_v(:, :n_events) = sink%event_v(:, :n_events)
   end subroutine simulate
-
-  !> The last run's samples, one column per name of column_names.
-  subroutine get_samples(n_samples, n_cols, samples)
-    integer(c_int), intent(in) :: n_samples, n_cols
-    real(c_double), intent(out) :: samples(n_samples, n_cols)
-    samples = 0.0_c_double
-    if (.not. allocated(last_run%samples)) return
-    if (n_samples /= last_run%n_samples .or. n_cols /= n_columns) return
-    samples = last_run%samples(:n_samples, :)
-  end subroutine get_samples
-
-  !> The last run's events: time, kind code (1-based word of event_kind_names), velocities.
-  subroutine get_events(n_events, t, kind, v1_before, v2_before, v1_after, v2_after)
-    integer(c_int), intent(in) :: n_events
-    real(c_double), intent(out) :: t(n_events), v1_before(n_events), v2_before(n_events), &
-      v1_after(n_events), v2_after(n_events)
-    integer(c_int), intent(out) :: kind(n_events)
-    integer :: m
-    m = 0
-    if (allocated(last_run%event_time)) m = min(n_events, last_run%n_events)
-    t = 0.0_c_double
-    kind = 0
-    v1_before = 0.0_c_double
-    v2_before = 0.0_c_double
-    v1_after = 0.0_c_double
-    v2_after = 0.0_c_double
-    t(:m) = last_run%event_time(:m)
-    kind(:m) = last_run%event_kind(:m)
-    v1_before(:m) = last_run%event_v(1, :m)
-    v2_before(:m) = last_run%event_v(2, :m)
-    v1_after(:m) = last_run%event_v(3, :m)
-    v2_after(:m) = last_run%event_v(4, :m)
-  end subroutine get_events
 
   logical function field_count_ok(n, status, message)
     integer(c_int), intent(in) :: n

@@ -117,11 +117,13 @@ _SCENE_FIELDS = tuple(f.name for f in dataclasses.fields(Scene))
 assert _SCENE_FIELDS == REAL_FIELDS + TEXT_FIELDS + ("source",)
 
 
-def _fortran_text(value) -> str:
-    # The api takes character(len=*) and blank-pads it into its buffers itself.
-    text = "" if value is None else str(value)
+def _fortran_text(value) -> bytes:
+    # The api takes character(len=*) and blank-pads it into its buffers itself. Text goes
+    # as UTF-8 bytes (f2py accepts only ASCII str), as the CLI reads it from files.
+    text = b"" if value is None else os.fsencode(value) if isinstance(value, os.PathLike) \
+        else str(value).encode("utf-8", errors="surrogateescape")
     if len(text) > TEXT_LEN:
-        raise InputError(f"text longer than {TEXT_LEN} characters: {text[:60]}...")
+        raise InputError(f"text longer than {TEXT_LEN} bytes: {decode(text[:60])}...")
     return text
 
 
@@ -147,7 +149,7 @@ def to_core(scene: Scene):
         value = fields[name]
         if value is not None and not isinstance(value, (str, os.PathLike)):
             raise InputError(f"{name} must be text, got {value!r}")
-        texts.append(_fortran_text(None if value is None else os.fspath(value)))
+        texts.append(_fortran_text(value))
     return (values, given, *texts)
 
 
@@ -168,7 +170,7 @@ def load_scene(path) -> Scene:
     if not os.path.isfile(path):
         raise InputError(f"cannot open scene file '{path}': no such file")
     (values, given, title, f1_table, f2_table, method,
-     status, message) = _api.read_scene(path, len(REAL_FIELDS))
+     status, message) = _api.read_scene(os.fsencode(path), len(REAL_FIELDS))
     raise_for_status(status, message)
     kwargs = {name: (float(values[i]) if given[i] else None)
               for i, name in enumerate(REAL_FIELDS)}

@@ -28,6 +28,24 @@ if _words(_api.column_names()) != COLUMNS:
 
 _OVERRIDABLE = tuple(f.name for f in dataclasses.fields(Scene))
 
+# The api's status for "the arrays given were too small" (it returns the sizes needed).
+_STATUS_TOO_SMALL = 3
+# Room for events a run starts with (most runs log fewer), and the most a hint asks for.
+_EVENT_CAPACITY = 256
+_EVENT_CAPACITY_MAX = 1 << 22
+_event_capacity = _EVENT_CAPACITY
+
+
+def _sample_capacity(scene) -> int:
+    """Rows a run will emit: t = 0, dt_out, ..., t_end (the core's exact count may be one
+    less; a scene the core refuses needs none)."""
+    try:
+        step = scene.dt_out if scene.dt_out is not None else scene.dt
+        rows = float(scene.t_end) / float(step)
+        return int(min(rows, 1e7)) + 2 if rows >= 0 else 1
+    except (TypeError, ValueError, ZeroDivisionError, OverflowError):
+        return 1
+
 
 @lru_cache(maxsize=None)
 def event_kinds() -> tuple:
@@ -104,25 +122,32 @@ def simulate(scene: Scene, *, progress: bool = False, **overrides) -> Result:
     if isinstance(scene.method, str): scene.method = scene.method.lower()  # as the CLI and namelists
     values, given, title, f1_table, f2_table, method = to_core(scene)
 
-    (n_samples, n_events, steps, energy_residual,
-     status, message) = _api.simulate(values, given, title, f1_table, f2_table, method,
-                                      1 if progress else 0)
+    # The core fills arrays made for this call (no state is kept between calls, so threads
+    # may run at once); when a guess at their size is short it says what is needed.
+    global _event_capacity
+    sample_capacity, event_capacity = _sample_capacity(scene), _event_capacity
+    while True:
+        (samples, event_t, event_kind, event_v, n_samples, n_events, steps, energy_residual,
+         status, message) = _api.simulate(values, given, title, f1_table, f2_table, method,
+                                          1 if progress else 0, sample_capacity, len(COLUMNS),
+                                          event_capacity)
+        if int(status) != _STATUS_TOO_SMALL:
+            break
+        sample_capacity, event_capacity = max(int(n_samples), 1), max(int(n_events), 1)
     raise_for_status(status, message)
 
     n_samples, n_events = int(n_samples), int(n_events)
-    if n_samples > 0:
-        samples = _api.get_samples(n_samples, len(COLUMNS))
-    else:
-        samples = np.empty((0, len(COLUMNS)))
+    # Event-heavy scenes tend to come in series (sweeps): start the next one with room.
+    _event_capacity = max(_EVENT_CAPACITY, min(2 * n_events, _EVENT_CAPACITY_MAX))
+    samples = samples[:n_samples]
     events = np.empty(n_events, dtype=EVENT_DTYPE)
     if n_events > 0:
-        t, kind, v1b, v2b, v1a, v2a = _api.get_events(n_events)
         names = _kind_names()
-        kind = np.asarray(kind)
-        events["t"] = t
+        kind = np.asarray(event_kind[:n_events])
+        events["t"] = event_t[:n_events]
         events["kind"] = names[np.where((kind >= 1) & (kind < len(names)), kind, 0)]
-        events["v1_before"], events["v2_before"] = v1b, v2b
-        events["v1_after"], events["v2_after"] = v1a, v2a
+        events["v1_before"], events["v2_before"] = event_v[0, :n_events], event_v[1, :n_events]
+        events["v1_after"], events["v2_after"] = event_v[2, :n_events], event_v[3, :n_events]
     return result_from_columns(samples, events, energy_residual=float(energy_residual),
                                steps=int(steps), scene=scene)
 
