@@ -22,6 +22,13 @@ module impact1d_error
     module procedure fmt_real, fmt_int, fmt_int64
   end interface fmt
 
+  !> The bytes a message shows escaped (ASCII controls and DEL).
+  character(len=*), parameter :: control_bytes = achar(0) // achar(1) // achar(2) // achar(3) // &
+    achar(4) // achar(5) // achar(6) // achar(7) // achar(8) // achar(9) // achar(10) // achar(11) // &
+    achar(12) // achar(13) // achar(14) // achar(15) // achar(16) // achar(17) // achar(18) // &
+    achar(19) // achar(20) // achar(21) // achar(22) // achar(23) // achar(24) // achar(25) // &
+    achar(26) // achar(27) // achar(28) // achar(29) // achar(30) // achar(31) // achar(127)
+
 contains
 
   !> Allocate `error` with a status and message.
@@ -32,8 +39,28 @@ contains
     if (allocated(error)) deallocate(error)
     allocate(error)
     error%status = status
-    error%message = message
+    error%message = printable(message)
   end subroutine raise
+
+  !> Control bytes (from a file quoted in a message) as \xNN: a message is one line that
+  !> cannot move the terminal's cursor or ring its bell. UTF-8 text passes unchanged.
+  pure function printable(text) result(shown)
+    character(len=*), intent(in) :: text
+    character(len=:), allocatable :: shown
+    character(len=*), parameter :: hex = '0123456789abcdef'
+    integer :: j, code
+    shown = text
+    if (scan(text, control_bytes) == 0) return
+    shown = ''
+    do j = 1, len(text)
+      code = iachar(text(j:j))
+      if (code < 32 .or. code == 127) then
+        shown = shown // '\x' // hex(code / 16 + 1:code / 16 + 1) // hex(mod(code, 16) + 1:mod(code, 16) + 1)
+      else
+        shown = shown // text(j:j)
+      end if
+    end do
+  end function printable
 
   !> Shortest decimal that reads back as x (1 to 17 digits), in plain notation for
   !> moderate magnitudes: 0.001, 2.5, 1e-12, 6.02e+23.

@@ -12,11 +12,17 @@ module impact1d_io
   private
   public :: read_scene_file, prepare_scene, read_table, lower
 
-  !> Marks a namelist variable the file did not set (no user writes the largest double).
+  !> Fills for the namelist variables before reading; a variable is given when it is not
+  !> its fill after either of two reads over different fills (see read_namelist).
   real(wp), parameter :: absent = huge(1.0_wp)
-  character(len=*), parameter :: absent_text = achar(1)
+  character(len=*), parameter :: absent_text = achar(1), absent_text_other = achar(2)
   character(len=*), parameter :: known_groups(7) = [character(len=7) :: &
     'scene', 'bodies', 'walls', 'link', 'initial', 'forces', 'run']
+  !> Each group's variables, for the message about a misspelt one (as the namelists below).
+  character(len=*), parameter :: group_variables(size(known_groups)) = [character(len=96) :: &
+    'title', 'm1, m2, mu1, mu2, g', 'x_left, r_left, x_right, r_right', 'd_min, r_min, d_max, r_max', &
+    'x1, v1, x2, v2', 'f1, f2, f1_table, f2_table, f1_amp, f1_period, f1_phase, f2_amp, f2_period, f2_phase', &
+    't_end, dt, dt_out, method, zero_vel']
   !> The tutorial's parameter files list these, in its Table 1 order; g is 10 there.
   integer, parameter :: dat_order(17) = [i_m1, i_m2, i_mu1, i_r_left, i_r_right, i_r_min, &
     i_r_max, i_x_left, i_x_right, i_d_min, i_d_max, i_x1, i_x2, i_v1, i_v2, i_f1, i_f2]
@@ -87,7 +93,8 @@ contains
     logical :: present(size(known_groups))
     integer :: unit, ios, j
     character(len=512) :: message
-    real(wp) :: values(n_real)
+    real(wp) :: values(n_real), values_other(n_real)
+    character(len=1024) :: texts(4), texts_other(4)
 
     call scan_groups(path, present, error)
     if (allocated(error)) return
@@ -99,100 +106,202 @@ contains
       end if
     end do
 
-    m1 = absent; m2 = absent; mu1 = absent; mu2 = absent; g = absent
-    x_left = absent; r_left = absent; x_right = absent; r_right = absent
-    d_min = absent; r_min = absent; d_max = absent; r_max = absent
-    x1 = absent; v1 = absent; x2 = absent; v2 = absent; f1 = absent; f2 = absent
-    f1_amp = absent; f1_period = absent; f1_phase = absent
-    f2_amp = absent; f2_period = absent; f2_phase = absent
-    t_end = absent; dt = absent; dt_out = absent; zero_vel = absent
-    title = absent_text; f1_table = absent_text; f2_table = absent_text; method = absent_text
-
-    open(newunit=unit, file=path, status='old', action='read', iostat=ios, iomsg=message)
-    if (ios /= 0) then
-      call raise(error, status_input, path // ': ' // trim(message))
-      return
-    end if
-    do j = 1, size(known_groups)
-      if (.not. present(j)) cycle
-      rewind(unit)
-      select case (trim(known_groups(j)))
-      case ('scene'); read(unit, nml=scene, iostat=ios, iomsg=message)
-      case ('bodies'); read(unit, nml=bodies, iostat=ios, iomsg=message)
-      case ('walls'); read(unit, nml=walls, iostat=ios, iomsg=message)
-      case ('link'); read(unit, nml=link, iostat=ios, iomsg=message)
-      case ('initial'); read(unit, nml=initial, iostat=ios, iomsg=message)
-      case ('forces'); read(unit, nml=forces, iostat=ios, iomsg=message)
-      case ('run'); read(unit, nml=run, iostat=ios, iomsg=message)
-      end select
-      if (ios /= 0) then
-        close(unit)
-        call raise(error, status_input, path // ': in &' // trim(known_groups(j)) // ': ' // trim(message))
-        return
-      end if
-    end do
-    close(unit)
-
-    values = [m1, m2, mu1, mu2, g, x_left, r_left, x_right, r_right, d_min, r_min, d_max, r_max, &
-      x1, v1, x2, v2, f1, f2, f1_amp, f1_period, f1_phase, f2_amp, f2_period, f2_phase, t_end, dt, dt_out, &
-      zero_vel]
-    input%given = values /= absent
+    ! Whether a variable was given cannot depend on its value: the file is read twice, over
+    ! two different fills; a variable the file sets reads the same both times.
+    call read_groups(absent, absent_text, values, texts)
+    if (allocated(error)) return
+    call read_groups(-absent, absent_text_other, values_other, texts_other)
+    if (allocated(error)) return
+    input%given = .not. (values == absent .and. values_other == -absent)
     input%value = merge(values, 0.0_wp, input%given)
+    title = texts(1)
+    f1_table = texts(2)
+    f2_table = texts(3)
+    method = texts(4)
+    do j = 1, size(texts)
+      if (texts(j) /= absent_text .or. texts_other(j) /= absent_text_other) cycle
+      if (j == 1) title = absent_text
+      if (j == 2) f1_table = absent_text
+      if (j == 3) f2_table = absent_text
+      if (j == 4) method = absent_text
+    end do
     input%text(i_title) = given_text(title)
     input%text(i_f1_table) = beside(path, given_text(f1_table))
     input%text(i_f2_table) = beside(path, given_text(f2_table))
     input%text(i_method) = lower(given_text(method))
+
+  contains
+
+    !> Every variable set to fill (texts to text_fill), then every group present read.
+    subroutine read_groups(fill, text_fill, values, texts)
+      real(wp), intent(in) :: fill
+      character(len=*), intent(in) :: text_fill
+      real(wp), intent(out) :: values(n_real)
+      character(len=1024), intent(out) :: texts(4)
+      m1 = fill; m2 = fill; mu1 = fill; mu2 = fill; g = fill
+      x_left = fill; r_left = fill; x_right = fill; r_right = fill
+      d_min = fill; r_min = fill; d_max = fill; r_max = fill
+      x1 = fill; v1 = fill; x2 = fill; v2 = fill; f1 = fill; f2 = fill
+      f1_amp = fill; f1_period = fill; f1_phase = fill
+      f2_amp = fill; f2_period = fill; f2_phase = fill
+      t_end = fill; dt = fill; dt_out = fill; zero_vel = fill
+      title = text_fill; f1_table = text_fill; f2_table = text_fill; method = text_fill
+      open(newunit=unit, file=path, status='old', action='read', iostat=ios, iomsg=message)
+      if (ios /= 0) then
+        call raise(error, status_input, path // ': ' // trim(message))
+        return
+      end if
+      do j = 1, size(known_groups)
+        if (.not. present(j)) cycle
+        rewind(unit)
+        select case (trim(known_groups(j)))
+        case ('scene'); read(unit, nml=scene, iostat=ios, iomsg=message)
+        case ('bodies'); read(unit, nml=bodies, iostat=ios, iomsg=message)
+        case ('walls'); read(unit, nml=walls, iostat=ios, iomsg=message)
+        case ('link'); read(unit, nml=link, iostat=ios, iomsg=message)
+        case ('initial'); read(unit, nml=initial, iostat=ios, iomsg=message)
+        case ('forces'); read(unit, nml=forces, iostat=ios, iomsg=message)
+        case ('run'); read(unit, nml=run, iostat=ios, iomsg=message)
+        end select
+        if (ios /= 0) then
+          close(unit)
+          call raise(error, status_input, path // ': in &' // trim(known_groups(j)) // ': ' // &
+            plain_reason(trim(message), j))
+          return
+        end if
+      end do
+      close(unit)
+      values = [m1, m2, mu1, mu2, g, x_left, r_left, x_right, r_right, d_min, r_min, d_max, r_max, &
+        x1, v1, x2, v2, f1, f2, f1_amp, f1_period, f1_phase, f2_amp, f2_period, f2_phase, t_end, dt, &
+        dt_out, zero_vel]
+      texts = [title, f1_table, f2_table, method]
+    end subroutine read_groups
   end subroutine read_namelist
 
-  !> Which groups the file has; a misspelt group (&wall) is an error, not a silent absence.
+  !> The namelist reader's message in plain words: a misspelt variable gets the group's names.
+  function plain_reason(message, group) result(text)
+    character(len=*), intent(in) :: message
+    integer, intent(in) :: group
+    character(len=:), allocatable :: text
+    character(len=*), parameter :: unmatched = 'Cannot match namelist object name '
+    integer :: at
+    text = message
+    at = index(message, unmatched)
+    if (at == 0) return
+    text = 'unknown variable ''' // trim(message(at + len(unmatched):)) // ''' (&' // &
+      trim(known_groups(group)) // ' has: ' // trim(group_variables(group)) // ')'
+  end function plain_reason
+
+  !> Which groups the file has, and the syntax the namelist reader would pass over in silence:
+  !> a misspelt group (&wall), a group given twice, text outside any group, a group without
+  !> its closing '/', and an assignment with no number (v1 = +). Quotes and '!' comments are
+  !> followed, so a '/' inside a title does not end its group.
   subroutine scan_groups(path, present, error)
     character(len=*), intent(in) :: path
     logical, intent(out) :: present(size(known_groups))
     type(error_type), allocatable, intent(out) :: error
-    integer :: unit, ios, line_number, start, finish, j
-    character(len=4096) :: line
-    character(len=512) :: message
-    character(len=:), allocatable :: name
+    character(len=*), parameter :: blanks = ' ' // achar(9) // achar(13)
+    character(len=*), parameter :: name_chars = 'abcdefghijklmnopqrstuvwxyz' // &
+      'ABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_'
+    integer :: unit, ios, line_number, j, k, finish, group, group_line(size(known_groups)), open_group
+    character(len=:), allocatable :: line, name
+    character :: quote
     logical :: any_content
 
     present = .false.
     any_content = .false.
-    open(newunit=unit, file=path, status='old', action='read', iostat=ios, iomsg=message)
-    if (ios /= 0) then
-      call raise(error, status_input, path // ': ' // trim(message))
-      return
-    end if
+    group_line = 0
+    open_group = 0
+    quote = ' '
+    call open_data_file(path, unit, error)
+    if (allocated(error)) return
     line_number = 0
     do
-      read(unit, '(a)', iostat=ios) line
+      call read_line(unit, line, ios)
       if (ios /= 0) exit
       line_number = line_number + 1
-      start = verify(line, ' ' // achar(9))
-      if (start == 0) cycle
-      if (line(start:start) == '!') cycle
-      any_content = .true.
-      if (line(start:start) /= '&' .and. line(start:start) /= '$') cycle
-      finish = scan(line(start + 1:), ' /' // achar(9))
-      if (finish == 0) then
-        finish = len_trim(line)
-      else
-        finish = start + finish - 1
-      end if
-      name = lower(line(start + 1:finish))
-      if (name == 'end' .or. len(name) == 0) cycle
-      do j = 1, size(known_groups)
-        if (name == trim(known_groups(j))) exit
+      j = 1
+      do while (j <= len(line))
+        if (quote /= ' ') then
+          if (line(j:j) == quote) quote = ' '
+          j = j + 1
+          cycle
+        end if
+        if (scan(line(j:j), blanks) > 0) then
+          j = j + 1
+          cycle
+        end if
+        if (line(j:j) == '!') exit
+        any_content = .true.
+        if (line(j:j) == '&' .or. line(j:j) == '$') then
+          finish = verify(line(j + 1:) // ' ', name_chars) + j - 1
+          name = lower(line(j + 1:finish))
+          if (name == 'end' .and. open_group > 0) then
+            open_group = 0
+          else if (open_group > 0) then
+            call fail('the group &' // trim(known_groups(open_group)) // ' (line ' // &
+              fmt(group_line(open_group)) // ') has no closing ''/'' before &' // name)
+            return
+          else
+            group = 0
+            do k = 1, size(known_groups)
+              if (trim(known_groups(k)) == name) group = k
+            end do
+            if (group == 0) then
+              call fail('unknown group &' // name // ' (groups: &scene &bodies &walls &link &initial &forces &run)')
+              return
+            end if
+            if (present(group)) then
+              call fail('the group &' // name // ' is given twice (lines ' // fmt(group_line(group)) // &
+                ' and ' // fmt(line_number) // ')')
+              return
+            end if
+            present(group) = .true.
+            group_line(group) = line_number
+            open_group = group
+          end if
+          j = finish + 1
+          cycle
+        end if
+        if (open_group == 0) then
+          call fail('text outside any group: ''' // trim(line(j:)) // '''')
+          return
+        end if
+        select case (line(j:j))
+        case ('/')
+          open_group = 0
+        case ('''', '"')
+          quote = line(j:j)
+        case ('=')
+          ! A lone sign after '=' is no value to the namelist reader: the variable would
+          ! silently stay absent.
+          k = verify(line(j + 1:) // '!', blanks) + j
+          if (k <= len(line)) then
+            finish = scan(line(k:) // ',', ' ,/!' // achar(9)) + k - 2
+            if (line(k:finish) == '+' .or. line(k:finish) == '-') then
+              call fail('''' // trim(line(:j)) // ' ' // line(k:finish) // ''' has no number after its sign')
+              return
+            end if
+          end if
+        end select
+        j = j + 1
       end do
-      if (j > size(known_groups)) then
-        close(unit)
-        call raise(error, status_input, path // ':' // fmt(line_number) // ': unknown group &' // name // &
-          ' (groups: &scene &bodies &walls &link &initial &forces &run)')
-        return
-      end if
-      present(j) = .true.
     end do
     close(unit)
-    if (.not. any_content) call raise(error, status_input, path // ': the file is empty')
+    if (open_group > 0) then
+      call raise(error, status_input, path // ':' // fmt(group_line(open_group)) // ': the group &' // &
+        trim(known_groups(open_group)) // ' has no closing ''/'' (every group ends with /)')
+    else if (.not. any_content) then
+      call raise(error, status_input, path // ': the file is empty')
+    end if
+
+  contains
+
+    subroutine fail(what)
+      character(len=*), intent(in) :: what
+      close(unit)
+      call raise(error, status_input, path // ':' // fmt(line_number) // ': ' // what)
+    end subroutine fail
   end subroutine scan_groups
 
   !> The tutorial's parameter file: 17 numbers, one per line, '#' starts a comment; an
@@ -202,16 +311,18 @@ contains
     type(scene_input), intent(inout) :: input
     type(error_type), allocatable, intent(out) :: error
     integer :: unit, ios, n_read, line_number, extra
-    character(len=4096) :: line
+    character(len=:), allocatable :: line
     real(wp) :: value, surplus
     logical :: found
 
     call open_data_file(path, unit, error)
     if (allocated(error)) return
     ! The tutorial's files open with a comment naming the case: that is the scene's title.
-    read(unit, '(a)', iostat=ios) line
+    call read_line(unit, line, ios)
     line = adjustl(line)
-    if (ios == 0 .and. line(1:1) == '#') input%text(i_title) = adjustl(line(2:))
+    if (ios == 0 .and. len(line) > 0) then
+      if (line(1:1) == '#') input%text(i_title) = adjustl(line(2:))
+    end if
     rewind(unit)
     n_read = 0
     line_number = 0
@@ -263,7 +374,7 @@ contains
     type(table_type), intent(out) :: table
     type(error_type), allocatable, intent(out) :: error
     integer :: unit, ios, line_number, n, extra
-    character(len=4096) :: line
+    character(len=:), allocatable :: line
     real(wp) :: row(2), surplus
     real(wp), allocatable :: t(:), f(:)
     logical :: found
@@ -316,32 +427,57 @@ contains
     end subroutine fail
   end subroutine read_table
 
-  !> Open a data file for reading; a missing or unreadable one is an input error naming it.
+  !> Open a file for reading; a missing or unreadable one, or a folder, is an input error
+  !> naming it.
   subroutine open_data_file(path, unit, error)
     character(len=*), intent(in) :: path
     integer, intent(out) :: unit
     type(error_type), allocatable, intent(out) :: error
     integer :: ios
     character(len=512) :: message
+    logical :: folder
+    inquire(file=path // '/.', exist=folder)
+    if (folder) then
+      call raise(error, status_input, path // ': is a folder, not a file')
+      return
+    end if
     open(newunit=unit, file=path, status='old', action='read', iostat=ios, iomsg=message)
     if (ios /= 0) call raise(error, status_input, path // ': ' // trim(message))
   end subroutine open_data_file
+
+  !> One whole line, whatever its length (a fixed buffer would cut long lines, and a long
+  !> buffer makes every list-directed read of a short line scan its blanks). ios is 0, or
+  !> negative at the end of the file; a last line without its newline still counts.
+  subroutine read_line(unit, line, ios)
+    integer, intent(in) :: unit
+    character(len=:), allocatable, intent(out) :: line
+    integer, intent(out) :: ios
+    character(len=256) :: chunk
+    integer :: n
+    line = ''
+    do
+      read(unit, '(a)', advance='no', iostat=ios, size=n) chunk
+      line = line // chunk(:n)
+      if (ios /= 0) exit
+    end do
+    if (is_iostat_eor(ios) .or. (is_iostat_end(ios) .and. len(line) > 0)) ios = 0
+  end subroutine read_line
 
   !> The next line that holds data: '#' starts a comment, blank lines are skipped.
   !> line_number counts every line read; found is false at the end of the file.
   subroutine next_data_line(unit, line, line_number, found)
     integer, intent(in) :: unit
-    character(len=*), intent(out) :: line
+    character(len=:), allocatable, intent(out) :: line
     integer, intent(inout) :: line_number
     logical, intent(out) :: found
     integer :: ios, hash
     found = .false.
     do
-      read(unit, '(a)', iostat=ios) line
+      call read_line(unit, line, ios)
       if (ios /= 0) return
       line_number = line_number + 1
       hash = index(line, '#')
-      if (hash > 0) line(hash:) = ' '
+      if (hash > 0) line = line(:hash - 1)
       if (len_trim(line) > 0) exit
     end do
     found = .true.
