@@ -43,6 +43,9 @@ module impact1d_scene
   real(wp), parameter :: default_zero_velocity = 0.005_wp
   !> Output rows a run may produce: beyond this the user almost surely meant a larger dt_out.
   integer, parameter :: max_samples = 10000000
+  !> A positive gap or limit below this many units of rounding (eps) of its coordinates is
+  !> refused: the solver's start-contact tolerance is 16 of them, so 64 leaves a clear margin.
+  real(wp), parameter :: min_resolved_ulps = 64.0_wp
   !> The smallest step, in units of the clock's spacing at t_end.
   real(wp), parameter :: clock_resolution_ulps = 8.0_wp
 
@@ -122,7 +125,10 @@ contains
     if (allocated(error)) return
 
     ! The initial state must satisfy every constraint; a gap within the rounding of the
-    ! numbers it is made of (this contact's positions and limit) is contact.
+    ! numbers it is made of (this contact's positions and limit) is contact. A gap or limit
+    ! that is positive but within a few dozen ulps of the coordinates it is measured
+    ! against cannot be told from contact (case 3 moved to x = 2e14 m got an impact across
+    ! its 0.5 m gap): refused, as is a friction bound mu m g that overflows.
     do k = 1, n_contacts
       if (.not. input%given(limit_index(k))) cycle
       gap = normal(1, k) * input%value(i_x1) + normal(2, k) * input%value(i_x2) + offset_of(k)
@@ -132,6 +138,28 @@ contains
           ', x2 = ' // fmt(input%value(i_x2)) // ' violates the ' // trim(contact_names(k)) // &
           ' constraint (' // trim(real_names(limit_index(k))) // ' = ' // &
           fmt(input%value(limit_index(k))) // ')')
+        return
+      end if
+      ! Within the rounding of the user's decimals (the contact test below) it is contact.
+      if (gap > 16.0_wp * eps_wp * max(scale, abs(offset_of(k)))) &
+        call resolvable('the initial ' // trim(contact_names(k)) // ' gap', gap, max(scale, abs(offset_of(k))))
+      if (allocated(error)) return
+    end do
+    scale = maxval(abs(input%value([i_x1, i_x2])))
+    if (input%given(i_x_left)) scale = max(scale, abs(input%value(i_x_left)))
+    if (input%given(i_x_right)) scale = max(scale, abs(input%value(i_x_right)))
+    if (input%given(i_x_left) .and. input%given(i_x_right)) &
+      call resolvable('the walls'' distance x_right - x_left', input%value(i_x_right) - input%value(i_x_left), scale)
+    if (input%given(i_d_min)) call resolvable('d_min', input%value(i_d_min), scale)
+    if (input%given(i_d_max)) call resolvable('d_max', input%value(i_d_max), scale)
+    if (input%given(i_d_min) .and. input%given(i_d_max)) &
+      call resolvable('the slot''s width d_max - d_min', input%value(i_d_max) - input%value(i_d_min), scale)
+    if (allocated(error)) return
+    do k = 0, 1
+      if (.not. input%given(i_mu1 + k)) cycle
+      if (input%value(i_mu1 + k) * input%value(i_m1 + k) * abs(value_or(i_g, default_gravity)) > huge(1.0_wp)) then
+        call raise(error, status_input, trim(real_names(i_mu1 + k)) // ' = ' // fmt(input%value(i_mu1 + k)) // &
+          ': the friction bound mu m g overflows')
         return
       end if
     end do
@@ -234,6 +262,18 @@ contains
           ' = ' // fmt(input%value(i_period)) // ' must be positive')
       end if
     end subroutine sine_terms
+
+    !> A length the scene relies on: zero (contact, a rigid link), or at least
+    !> min_resolved_ulps units of rounding of the coordinates it is measured against.
+    subroutine resolvable(what, length, scale)
+      character(len=*), intent(in) :: what
+      real(wp), intent(in) :: length, scale
+      if (allocated(error)) return
+      if (length <= 0.0_wp .or. length >= min_resolved_ulps * eps_wp * scale) return
+      call raise(error, status_input, what // ' = ' // fmt(length) // ' is below the resolution of ' // &
+        'the scene''s coordinates (|x| up to ' // fmt(scale) // ' m resolves ' // &
+        fmt(min_resolved_ulps * eps_wp * scale) // ' m): move the scene nearer the origin')
+    end subroutine resolvable
 
     real(wp) function value_or(i, default)
       integer, intent(in) :: i

@@ -134,13 +134,16 @@ def to_core(scene: Scene):
     given = np.array([value is not None for value in reals], dtype=np.int32)
     try:
         values = np.array([0.0 if value is None else value for value in reals], dtype=np.float64)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         values = None
     if values is None or values.shape != (len(REAL_FIELDS),):
-        # Name the field that is not a number.
+        # Name the field that is not a number (or an int beyond any double: 10**400).
         for name, value in zip(REAL_FIELDS, reals):
             try:
                 float(value if value is not None else 0.0)
+            except OverflowError:
+                raise InputError(f"{name} = {value!r:.40} is too large for a double "
+                                 "(largest 1.8e308)") from None
             except (TypeError, ValueError):
                 raise InputError(f"{name} must be a number, got {value!r}") from None
         raise InputError("scene fields must be numbers")
@@ -167,6 +170,8 @@ def raise_for_status(status, message) -> None:
 def load_scene(path) -> Scene:
     """Read a scene file: a namelist (.nml, or any other name) or a VisSim .dat file."""
     path = os.fspath(path)
+    if os.path.isdir(path):
+        raise InputError(f"cannot open scene file '{path}': it is a folder, not a file")
     if not os.path.isfile(path):
         raise InputError(f"cannot open scene file '{path}': no such file")
     (values, given, title, f1_table, f2_table, method,

@@ -1,0 +1,174 @@
+"""Hostile and unlucky input (issue 13 items 4, 5, 6, 8, 10; issue 12 item 5): every
+mistake is an InputError naming what is wrong, never a silently different scene."""
+
+import subprocess
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import impact1d
+from tools import find_tool
+
+ROOT = Path(__file__).resolve().parents[1]
+INPUT = ROOT / "input"
+CASE3 = (INPUT / "case3.nml").read_text()
+RUN_TIMEOUT = 120
+
+
+def scene_file(tmp_path, text, name="scene.nml"):
+    path = tmp_path / name
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def refused(tmp_path, text, match, name="scene.nml"):
+    with pytest.raises(impact1d.InputError, match=match) as caught:
+        impact1d.load_scene(scene_file(tmp_path, text, name))
+    assert "\n" not in str(caught.value)
+    return str(caught.value)
+
+
+# --- item 4: lines of any length ---------------------------------------------------
+
+def test_long_indented_group_is_read(tmp_path):
+    """A &walls group indented by 5000 blanks was dropped (case 3 then ran off to x1 = -13)."""
+    scene = impact1d.load_scene(scene_file(tmp_path, CASE3.replace("&walls", " " * 5000 + "&walls")))
+    assert scene.x_left == 0.0 and scene.x_right == 10.0
+    res = impact1d.simulate(scene)
+    assert res.x1.min() >= 0.0
+
+
+def test_long_line_in_a_dat_file_keeps_the_order(tmp_path):
+    text = (INPUT / "input3.dat").read_text().splitlines()
+    numbers = [i for i, line in enumerate(text) if line.strip() and not line.startswith("#")]
+    text[numbers[1]] = " " * 5000 + text[numbers[1]]
+    path = tmp_path / "long.dat"
+    path.write_text("\n".join(text) + "\n")
+    assert impact1d.load_scene(path) == impact1d.load_scene(INPUT / "input3.dat").__class__(
+        **{**vars(impact1d.load_scene(INPUT / "input3.dat")), "source": str(path)})
+
+
+def test_big_force_table_reads_in_linear_time(tmp_path):
+    """10^6 rows took 5.9 s (every row scanned a 4096-byte buffer twice)."""
+    def table_of(rows):
+        path = tmp_path / f"t{rows}.dat"
+        path.write_text("".join(f"{i * 1e-3} {i % 7}\n" for i in range(rows)))
+        return path
+
+    def seconds(rows):
+        text = (INPUT / "case6.nml").read_text().replace("'triangle.dat'", f"'{table_of(rows)}'")
+        scene = impact1d.load_scene(scene_file(tmp_path, text, f"s{rows}.nml"))
+        start = time.perf_counter()
+        impact1d.simulate(scene, t_end=1e-3)
+        return time.perf_counter() - start
+
+    # Linear reading: 10x the rows cost about 10x (quadratic would be 100x); the ratio,
+    # not a time, is asserted, with room for a noisy machine.
+    assert seconds(200_000) < 30 * seconds(20_000) + 0.05
+
+
+# --- item 5: given-ness does not depend on the value; syntax the reader passed over -----
+
+@pytest.mark.parametrize("field, old", [("r_right", "r_right = 1.0"), ("mu1", "mu1 = 0.0")])
+def test_largest_double_is_a_given_value(tmp_path, field, old):
+    text = CASE3.replace(old, f"{field} = 1.7976931348623157e308")
+    refused(tmp_path, text, field)
+
+
+def test_largest_double_velocity_is_given(tmp_path):
+    scene = impact1d.load_scene(scene_file(tmp_path, CASE3.replace("v1 = -9.0", "v1 = 1.7976931348623157e308")))
+    assert scene.v1 == 1.7976931348623157e308
+    with pytest.raises(impact1d.SimulationError, match="no longer finite"):
+        impact1d.simulate(scene)
+
+
+@pytest.mark.parametrize("old, new", [("v1 = -9.0", "v1 = +"), ("r_left = 1.0", "r_left = -")])
+def test_lone_sign_is_refused(tmp_path, old, new):
+    message = refused(tmp_path, CASE3.replace(old, new), "no number after its sign")
+    assert ":" + str(CASE3.splitlines().index(next(l for l in CASE3.splitlines() if old in l)) + 1) in message
+
+
+def test_second_group_is_refused(tmp_path):
+    refused(tmp_path, CASE3 + "&run t_end = nan /\n", r"&run is given twice \(lines 8 and 9\)")
+
+
+def test_stray_text_is_refused(tmp_path):
+    refused(tmp_path, CASE3.replace("&walls", "oops\n&walls"), r":4: text outside any group: 'oops'")
+
+
+def test_misspelt_variable_lists_the_group(tmp_path):
+    refused(tmp_path, CASE3.replace("mu1 =", "mu_1 ="),
+            r"unknown variable 'mu_1' \(&bodies has: m1, m2, mu1, mu2, g\)")
+
+
+def test_missing_slash_says_so(tmp_path):
+    refused(tmp_path, CASE3.replace("r_max = 1.0 /", "r_max = 1.0"),
+            r"the group &link \(line 5\) has no closing '/'")
+    refused(tmp_path, CASE3.rstrip().rstrip("/") + "\n", r"&run has no closing '/'")
+
+
+def test_slash_inside_a_title_is_text(tmp_path):
+    scene = impact1d.load_scene(scene_file(tmp_path, CASE3.replace(
+        "conservation of energy", "energy / momentum")))
+    assert scene.title.endswith("energy / momentum")
+
+
+# --- item 6 (input part): overflow is an input error ---------------------------------
+
+def test_friction_bound_that_overflows(tmp_path):
+    refused(tmp_path, CASE3.replace("mu1 = 0.0", "mu1 = 1e308"), "mu1 = 1e\\+?308: the friction bound")
+
+
+def test_int_too_large_for_a_double():
+    with pytest.raises(impact1d.InputError, match="m1 = .* too large for a double"):
+        impact1d.simulate(impact1d.load_scene(INPUT / "case3.nml"), m1=10 ** 400)
+
+
+# --- item 8: coordinates beyond their resolution -------------------------------------
+
+def test_scene_far_from_the_origin_is_refused():
+    """Case 3 moved by 2e14 m: its 1 m slot and 0.5 m gaps are a few dozen ulps of the
+    coordinates (a phantom impact at t = 0 took KE from 41.5 J to 8.17 J)."""
+    scene = impact1d.load_scene(INPUT / "case3.nml")
+    shift = 2e14
+    with pytest.raises(impact1d.InputError, match="below the resolution"):
+        impact1d.simulate(scene, x_left=shift, x_right=shift + 10, x1=shift + 1, x2=shift + 2.5)
+    # Moved by 1e6 m it is resolved, and runs as at the origin (to the rounding of 1e6).
+    res = impact1d.simulate(scene, x_left=1e6, x_right=1e6 + 10, x1=1e6 + 1, x2=1e6 + 2.5)
+    base = impact1d.simulate(scene)
+    assert len(res.events) == len(base.events)
+    np.testing.assert_allclose(res.events["t"], base.events["t"], rtol=0, atol=1e-8)
+
+
+def test_tiny_limit_is_refused():
+    with pytest.raises(impact1d.InputError, match="d_min = 1e-100 is below the resolution"):
+        impact1d.simulate(impact1d.load_scene(INPUT / "case3.nml"), d_min=1e-100, x2=1.5)
+
+
+# --- item 10: folders, control bytes ---------------------------------------------------
+
+def test_folder_as_scene(tmp_path):
+    with pytest.raises(impact1d.InputError, match="is a folder"):
+        impact1d.load_scene(tmp_path)
+    done = subprocess.run([find_tool("impact1d"), str(tmp_path)], capture_output=True,
+                          text=True, timeout=RUN_TIMEOUT)
+    assert done.returncode == 1 and "is a folder" in done.stderr
+
+
+def test_folder_as_force_table(tmp_path):
+    (tmp_path / "table").mkdir()
+    text = (INPUT / "case6.nml").read_text().replace("'triangle.dat'", "'table'")
+    scene = impact1d.load_scene(scene_file(tmp_path, text))
+    with pytest.raises(impact1d.InputError, match="f1_table: .*table: is a folder"):
+        impact1d.simulate(scene)
+
+
+def test_control_bytes_are_escaped(tmp_path):
+    path = tmp_path / "ctl.dat"
+    path.write_bytes(b"# ctl\n1.0\n\x1b[31mred\x07\n")
+    with pytest.raises(impact1d.InputError) as caught:
+        impact1d.load_scene(path)
+    assert "\\x1b[31mred\\x07" in str(caught.value)
+    assert not any(ord(c) < 32 for c in str(caught.value))
