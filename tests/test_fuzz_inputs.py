@@ -1,0 +1,120 @@
+"""Mutated scene files (issue 13, "Done when"): whatever the bytes, the outcome is a run
+with finite numbers, or an InputError / SimulationError with a one-line message; never
+another exception, a crash or a hang. Seeded, so a failure reproduces."""
+
+import random
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import impact1d
+from tools import find_tool
+
+ROOT = Path(__file__).resolve().parents[1]
+INPUT = ROOT / "input"
+SEED = 20261123
+N_MUTATIONS = 300
+N_CLI = 40
+RUN_TIMEOUT = 60
+# Runs are cut short (the outcome classes show in the first steps); a mutated dt far below
+# this would only make a legitimately long run, not a fault.
+T_END = 0.02
+DT_FLOOR = 1e-5
+
+EXTREMES = ["1e308", "-1e308", "1.7976931348623157e308", "5e-324", "-0.0", "nan", "inf",
+            "-inf", "0", "1e-300", "123456789012345678901234567890", "+", "-", "1e", ".",
+            "2*3", "'x'", "1,2", "9" * 400]
+JUNK = ["\x00", "\x1b[2J", "\x07", "é", "Δ", "/", "&", "!", "'", '"', " " * 5000, "\t", "&run",
+        "&end", "$"]
+
+
+def sources():
+    files = sorted(INPUT.glob("case*.nml")) + sorted(INPUT.glob("input*.dat"))
+    return [(path.suffix, path.read_text()) for path in files]
+
+
+def mutate(rng, text):
+    lines = text.splitlines(keepends=True)
+    for _ in range(rng.randint(1, 3)):
+        kind = rng.randrange(7)
+        if kind == 0 and text:                                   # flip a byte
+            i = rng.randrange(len(text))
+            text = text[:i] + chr(rng.randrange(1, 128)) + text[i + 1:]
+        elif kind == 1 and lines:                                # delete a line
+            del lines[rng.randrange(len(lines))]
+            text = "".join(lines)
+        elif kind == 2 and lines:                                # duplicate a line
+            i = rng.randrange(len(lines))
+            lines.insert(i, lines[i])
+            text = "".join(lines)
+        elif kind == 3:                                          # a number -> an extreme
+            words = text.split(" ")
+            candidates = [i for i, w in enumerate(words) if any(c.isdigit() for c in w)]
+            if candidates:
+                i = rng.choice(candidates)
+                tail = "".join(c for c in words[i] if c in ",/\n")
+                words[i] = rng.choice(EXTREMES) + tail
+            text = " ".join(words)
+        elif kind == 4:                                          # truncate
+            text = text[:rng.randrange(len(text) + 1)]
+        elif kind == 5:                                          # insert junk
+            i = rng.randrange(len(text) + 1)
+            text = text[:i] + rng.choice(JUNK) + text[i:]
+        else:                                                    # a long line
+            i = rng.randrange(len(text) + 1)
+            text = text[:i] + " " * rng.choice([4095, 4096, 4097, 10000]) + text[i:]
+        lines = text.splitlines(keepends=True)
+    return text
+
+
+def mutations():
+    rng = random.Random(SEED)
+    base = sources()
+    for n in range(N_MUTATIONS):
+        suffix, text = rng.choice(base)
+        yield n, suffix, mutate(rng, text)
+
+
+def one_line(error):
+    message = str(error)
+    return bool(message) and "\n" not in message and not any(ord(c) < 32 for c in message)
+
+
+def test_mutated_scenes_through_python(tmp_path):
+    (tmp_path / "triangle.dat").write_text((INPUT / "triangle.dat").read_text())
+    outcomes = {"ran": 0, "InputError": 0, "SimulationError": 0}
+    for n, suffix, text in mutations():
+        path = tmp_path / f"m{n}{suffix}"
+        path.write_bytes(text.encode("utf-8", errors="surrogateescape"))
+        try:
+            scene = impact1d.load_scene(path)
+            dt = scene.dt if scene.dt is not None and scene.dt == scene.dt else DT_FLOOR
+            res = impact1d.simulate(scene, t_end=T_END, dt=max(dt, DT_FLOOR), dt_out=None)
+        except (impact1d.InputError, impact1d.SimulationError) as error:
+            assert one_line(error), f"mutation {n}: {error!r}"
+            outcomes[type(error).__name__] += 1
+            continue
+        assert all(np.all(np.isfinite(getattr(res, c))) for c in impact1d.COLUMNS), f"mutation {n}"
+        assert np.isfinite(res.energy_residual)
+        outcomes["ran"] += 1
+    # The mutations reach both the runs and the refusals.
+    assert outcomes["ran"] > 10 and outcomes["InputError"] > 10, outcomes
+
+
+def test_mutated_scenes_through_the_cli(tmp_path):
+    cli = find_tool("impact1d")
+    (tmp_path / "triangle.dat").write_text((INPUT / "triangle.dat").read_text())
+    for n, suffix, text in list(mutations())[:N_CLI]:
+        path = tmp_path / f"c{n}{suffix}"
+        path.write_bytes(text.encode("utf-8", errors="surrogateescape"))
+        args = [cli, str(path), "-o", str(tmp_path / f"out{n}.dat"), "--t-end", str(T_END),
+                "--dt", str(DT_FLOOR) if suffix == ".dat" else "1e-3"]
+        done = subprocess.run(args, capture_output=True, timeout=RUN_TIMEOUT,
+                              stdin=subprocess.DEVNULL)
+        assert done.returncode in (0, 1, 2), f"mutation {n}: exit {done.returncode}"
+        if done.returncode:
+            lines = done.stderr.decode("utf-8", errors="replace").strip().splitlines()
+            assert len(lines) == 1 and lines[0].startswith("impact1d: "), f"mutation {n}: {lines}"
+            assert not any(b < 32 for b in done.stderr.rstrip(b"\n")), f"mutation {n}"
