@@ -22,7 +22,7 @@ module impact1d_io
   character(len=*), parameter :: group_variables(size(known_groups)) = [character(len=96) :: &
     'title', 'm1, m2, mu1, mu2, g', 'x_left, r_left, x_right, r_right', 'd_min, r_min, d_max, r_max', &
     'x1, v1, x2, v2', 'f1, f2, f1_table, f2_table, f1_amp, f1_period, f1_phase, f2_amp, f2_period, f2_phase', &
-    't_end, dt, dt_out, method, zero_vel']
+    't_end, dt, dt_out, method, zero_vel, max_rows, max_impulses, max_step_events']
   !> The tutorial's parameter files list these, in its Table 1 order; g is 10 there.
   integer, parameter :: dat_order(17) = [i_m1, i_m2, i_mu1, i_r_left, i_r_right, i_r_min, &
     i_r_max, i_x_left, i_x_right, i_d_min, i_d_max, i_x1, i_x2, i_v1, i_v2, i_f1, i_f2]
@@ -81,7 +81,7 @@ contains
     type(error_type), allocatable, intent(out) :: error
     real(wp) :: m1, m2, mu1, mu2, g, x_left, r_left, x_right, r_right, d_min, r_min, d_max, r_max
     real(wp) :: x1, v1, x2, v2, f1, f2, f1_amp, f1_period, f1_phase, f2_amp, f2_period, f2_phase
-    real(wp) :: t_end, dt, dt_out, zero_vel
+    real(wp) :: t_end, dt, dt_out, zero_vel, max_rows, max_impulses, max_step_events
     character(len=1024) :: title, f1_table, f2_table, method
     namelist /scene/ title
     namelist /bodies/ m1, m2, mu1, mu2, g
@@ -89,7 +89,7 @@ contains
     namelist /link/ d_min, r_min, d_max, r_max
     namelist /initial/ x1, v1, x2, v2
     namelist /forces/ f1, f2, f1_table, f2_table, f1_amp, f1_period, f1_phase, f2_amp, f2_period, f2_phase
-    namelist /run/ t_end, dt, dt_out, method, zero_vel
+    namelist /run/ t_end, dt, dt_out, method, zero_vel, max_rows, max_impulses, max_step_events
     logical :: present(size(known_groups))
     integer :: unit, ios, j
     character(len=512) :: message
@@ -145,6 +145,7 @@ contains
       f1_amp = fill; f1_period = fill; f1_phase = fill
       f2_amp = fill; f2_period = fill; f2_phase = fill
       t_end = fill; dt = fill; dt_out = fill; zero_vel = fill
+      max_rows = fill; max_impulses = fill; max_step_events = fill
       title = text_fill; f1_table = text_fill; f2_table = text_fill; method = text_fill
       open(newunit=unit, file=path, status='old', action='read', iostat=ios, iomsg=message)
       if (ios /= 0) then
@@ -173,7 +174,7 @@ contains
       close(unit)
       values = [m1, m2, mu1, mu2, g, x_left, r_left, x_right, r_right, d_min, r_min, d_max, r_max, &
         x1, v1, x2, v2, f1, f2, f1_amp, f1_period, f1_phase, f2_amp, f2_period, f2_phase, t_end, dt, &
-        dt_out, zero_vel]
+        dt_out, zero_vel, max_rows, max_impulses, max_step_events]
       texts = [title, f1_table, f2_table, method]
     end subroutine read_groups
   end subroutine read_namelist

@@ -15,20 +15,21 @@ module impact1d_scene
   public :: sample_time
   public :: i_title, i_f1_table, i_f2_table, i_method, default_gravity
 
-  integer, parameter :: n_real = 29, n_text = 4
+  integer, parameter :: n_real = 32, n_text = 4
   !> Names of the real inputs, as in the namelist and in Python's Scene, in this order.
-  character(len=*), parameter :: real_names(n_real) = [character(len=9) :: &
+  character(len=*), parameter :: real_names(n_real) = [character(len=15) :: &
     'm1', 'm2', 'mu1', 'mu2', 'g', 'x_left', 'r_left', 'x_right', 'r_right', &
     'd_min', 'r_min', 'd_max', 'r_max', 'x1', 'v1', 'x2', 'v2', 'f1', 'f2', &
     'f1_amp', 'f1_period', 'f1_phase', 'f2_amp', 'f2_period', 'f2_phase', 't_end', 'dt', 'dt_out', &
-    'zero_vel']
+    'zero_vel', 'max_rows', 'max_impulses', 'max_step_events']
   character(len=*), parameter :: text_names(n_text) = [character(len=8) :: &
     'title', 'f1_table', 'f2_table', 'method']
   integer, parameter :: i_m1 = 1, i_m2 = 2, i_mu1 = 3, i_mu2 = 4, i_g = 5, i_x_left = 6, &
     i_r_left = 7, i_x_right = 8, i_r_right = 9, i_d_min = 10, i_r_min = 11, i_d_max = 12, &
     i_r_max = 13, i_x1 = 14, i_v1 = 15, i_x2 = 16, i_v2 = 17, i_f1 = 18, i_f2 = 19, &
     i_f1_amp = 20, i_f1_period = 21, i_f1_phase = 22, i_f2_amp = 23, i_f2_period = 24, &
-    i_f2_phase = 25, i_t_end = 26, i_dt = 27, i_dt_out = 28, i_zero_vel = 29
+    i_f2_phase = 25, i_t_end = 26, i_dt = 27, i_dt_out = 28, i_zero_vel = 29, &
+    i_max_rows = 30, i_max_impulses = 31, i_max_step_events = 32
   integer, parameter :: i_title = 1, i_f1_table = 2, i_f2_table = 3, i_method = 4
 
   !> The four optional unilateral constraints: gap_k = normal(:,k) . x + offset_k >= 0.
@@ -42,7 +43,11 @@ module impact1d_scene
   !> The tutorial's zero-velocity threshold, used by the vissim method only.
   real(wp), parameter :: default_zero_velocity = 0.005_wp
   !> Output rows a run may produce: beyond this the user almost surely meant a larger dt_out.
+  !> Work limits, each a &run option (max_rows, max_impulses, max_step_events): output rows
+  !> of one run; impulses at one instant (elastic chains need ~pi sqrt(M/m)); event points
+  !> within one step's length of simulated time (a run that no longer advances).
   integer, parameter :: max_samples = 10000000
+  integer, parameter :: default_max_impulses = 1000000, default_max_step_events = 100000
   !> A positive gap or limit below this many units of rounding (eps) of its coordinates is
   !> refused: the solver's start-contact tolerance is 16 of them, so 64 leaves a clear margin.
   real(wp), parameter :: min_resolved_ulps = 64.0_wp
@@ -67,6 +72,7 @@ module impact1d_scene
     type(forcing_type) :: forcing
     real(wp) :: t_end, dt, dt_out
     real(wp) :: zero_velocity = default_zero_velocity
+    integer :: max_impulses = default_max_impulses, max_step_events = default_max_step_events
     integer :: n_samples
   end type scene_type
 
@@ -96,6 +102,8 @@ contains
     call positive(i_m1); call positive(i_m2)
     if (allocated(error)) return
     call nonnegative(i_mu1); call nonnegative(i_mu2); call nonnegative(i_zero_vel)
+    if (allocated(error)) return
+    call count_limit(i_max_rows); call count_limit(i_max_impulses); call count_limit(i_max_step_events)
     if (allocated(error)) return
     if (input%given(i_g) .and. input%value(i_g) < 0.0_wp .and. (value_or(i_mu1, 0.0_wp) > 0.0_wp &
         .or. value_or(i_mu2, 0.0_wp) > 0.0_wp)) then
@@ -194,10 +202,12 @@ contains
       end if
     end if
     if (input%given(i_t_end) .and. (input%given(i_dt) .or. input%given(i_dt_out))) then
-      if (input%value(i_t_end) / value_or(i_dt_out, input%value(i_dt)) > real(max_samples - 1, wp)) then
+      if (input%value(i_t_end) / value_or(i_dt_out, input%value(i_dt)) > &
+          value_or(i_max_rows, real(max_samples, wp)) - 1.0_wp) then
         call raise(error, status_input, 't_end / dt_out = ' // &
           fmt(input%value(i_t_end) / value_or(i_dt_out, input%value(i_dt))) // &
-          ' output rows is over the limit of ' // fmt(max_samples) // ': set a larger dt_out')
+          ' output rows is over the limit of ' // fmt(value_or(i_max_rows, real(max_samples, wp))) // &
+          ': set a larger dt_out (or &run max_rows)')
         return
       end if
     end if
@@ -228,6 +238,15 @@ contains
       if (input%value(i) <= 0.0_wp) call raise(error, status_input, trim(real_names(i)) // ' = ' // &
         fmt(input%value(i)) // ' must be positive')
     end subroutine positive
+
+    !> A work limit: a whole number from 1 to the largest default integer.
+    subroutine count_limit(i)
+      integer, intent(in) :: i
+      if (allocated(error) .or. .not. input%given(i)) return
+      if (input%value(i) < 1.0_wp .or. input%value(i) > real(huge(1), wp) .or. &
+          input%value(i) /= aint(input%value(i))) call raise(error, status_input, trim(real_names(i)) // &
+        ' = ' // fmt(input%value(i)) // ' must be a whole number from 1 to ' // fmt(huge(1)))
+    end subroutine count_limit
 
     subroutine nonnegative(i)
       integer, intent(in) :: i
@@ -340,6 +359,8 @@ contains
     scene%dt_out = scene%dt
     if (input%given(i_dt_out)) scene%dt_out = input%value(i_dt_out)
     if (input%given(i_zero_vel)) scene%zero_velocity = input%value(i_zero_vel)
+    if (input%given(i_max_impulses)) scene%max_impulses = int(input%value(i_max_impulses))
+    if (input%given(i_max_step_events)) scene%max_step_events = int(input%value(i_max_step_events))
     ! Samples at j*dt_out, and at t_end when it is off that grid.
     ratio = scene%t_end / scene%dt_out
     scene%n_samples = nint(ratio) + 1

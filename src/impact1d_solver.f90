@@ -22,10 +22,6 @@ module impact1d_solver
   real(wp), parameter :: gap_rounding = 16.0_wp * eps_wp      !< rounding of a gap, per unit it moved
   real(wp), parameter :: velocity_rounding = 64.0_wp * eps_wp !< a velocity this small is zero
   real(wp), parameter :: time_rounding = 64.0_wp * eps_wp     !< instants closer than this coincide
-  integer, parameter :: max_impulses = 1000000   !< per event point; elastic chains need ~pi sqrt(M/m)
-  !> Event points within one step's length of simulated time. A run with many events is fine
-  !> (case 3 for 10^6 s has millions); only one that stops advancing needs a bound.
-  integer, parameter :: max_step_events = 100000
   integer, parameter :: max_halvings = 60        !< retries of a step whose end violated a constraint
 
   !> Time, positions, velocities and the ledger integrals are sums of many step increments,
@@ -178,10 +174,10 @@ contains
           window_events = 0
         end if
         window_events = window_events + 1
-        if (window_events > max_step_events) then
+        if (window_events > scene%max_step_events) then
           call raise(error, status_simulation, 'at t = ' // fmt(s%t) // ': more than ' // &
-            fmt(max_step_events) // ' events within one step (dt = ' // fmt(scene%dt) // &
-            '): the contacts chatter faster than time advances')
+            fmt(scene%max_step_events) // ' events within one step (dt = ' // fmt(scene%dt) // &
+            '): the contacts chatter faster than time advances (&run max_step_events)')
           return
         end if
         call flush_releases(.false.)
@@ -699,9 +695,9 @@ contains
         k = most_approaching(closed, s%v, u_tolerances())
         if (k == 0) exit
         n_impulses = n_impulses + 1
-        if (n_impulses > max_impulses) then
+        if (n_impulses > scene%max_impulses) then
           call raise(error, status_simulation, 'at t = ' // fmt(s%t) // ': the impacts did not settle after ' &
-            // fmt(max_impulses) // ' impulses')
+            // fmt(scene%max_impulses) // ' impulses (&run max_impulses)')
           return
         end if
         v_before = s%v

@@ -57,3 +57,24 @@ def test_many_events_are_fine():
     # 2.4e6 impacts each rounding KE by ~1 ulp of 41.5 J: a random walk far below 1e-9 J.
     assert abs(res.ke[-1] - 41.5) < 1e-9
     assert np.all(np.isfinite(res.ke))
+
+
+def test_work_limits_are_run_options():
+    """Every remaining cap is a &run option, named in its message."""
+    case3 = impact1d.load_scene(CASE3)
+    with pytest.raises(impact1d.InputError, match=r"max_rows"):
+        impact1d.simulate(case3, max_rows=100)          # 6001 rows asked for
+    assert len(impact1d.simulate(case3, max_rows=6001).t) == 6001
+    # The pinned elastic chain of a light body between a wall and a heavy one needs about
+    # pi sqrt(M/m) = 315 impulses at one instant for M/m = 10^4.
+    chain = impact1d.Scene(m1=1.0, m2=1e4, x_left=0.0, r_left=1.0, d_min=1.0, r_min=1.0,
+                           x1=0.0, x2=1.0, v2=-1.0, t_end=0.1, dt=1e-3)
+    assert len(impact1d.simulate(chain).events) > 300
+    with pytest.raises(impact1d.SimulationError, match=r"after 100 impulses \(&run max_impulses\)"):
+        impact1d.simulate(chain, max_impulses=100)
+    shrunk = dict(x_right=0.01, d_min=0.001, d_max=0.002, x1=0.001, x2=0.0025, t_end=1.0)
+    with pytest.raises(impact1d.SimulationError, match=r"more than 3 events within one step .*max_step_events"):
+        impact1d.simulate(case3, max_step_events=3, **shrunk)
+    for bad in (0, 2.5, -1, 1e300):
+        with pytest.raises(impact1d.InputError, match="max_impulses .* must be a whole number"):
+            impact1d.simulate(case3, max_impulses=bad)

@@ -41,7 +41,7 @@ REAL_FIELDS = (
     "d_min", "r_min", "d_max", "r_max",
     "x1", "v1", "x2", "v2",
     "f1", "f2", "f1_amp", "f1_period", "f1_phase", "f2_amp", "f2_period", "f2_phase",
-    "t_end", "dt", "dt_out", "zero_vel",
+    "t_end", "dt", "dt_out", "zero_vel", "max_rows", "max_impulses", "max_step_events",
 )
 TEXT_FIELDS = ("title", "f1_table", "f2_table", "method")
 
@@ -84,6 +84,9 @@ class Scene:
     dt: Optional[float] = None
     dt_out: Optional[float] = None
     zero_vel: Optional[float] = None
+    max_rows: Optional[float] = None
+    max_impulses: Optional[float] = None
+    max_step_events: Optional[float] = None
     title: Optional[str] = None
     f1_table: Optional[str] = None
     f2_table: Optional[str] = None
