@@ -953,10 +953,15 @@ contains
       end do
     end subroutine zero_stopped
 
-    !> Body i is at rest; the rounding-level energy it had goes to the impact loss.
+    !> Body i is at rest; the rounding-level energy it had goes to the ledger: to friction
+    !> where friction stopped it (a run with no impact reports no impact loss), else to impacts.
     subroutine zero_velocity(i)
       integer, intent(in) :: i
-      s%impact_loss = s%impact_loss + 0.5_wp * scene%mass(i) * s%v(i)**2
+      if (scene%friction(i) > 0.0_wp) then
+        call add_compensated(s%friction_loss, s%friction_lo, 0.5_wp * scene%mass(i) * s%v(i)**2)
+      else
+        s%impact_loss = s%impact_loss + 0.5_wp * scene%mass(i) * s%v(i)**2
+      end if
       s%v(i) = 0.0_wp
       s%v_lo(i) = 0.0_wp
     end subroutine zero_velocity

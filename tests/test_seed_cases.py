@@ -496,3 +496,13 @@ def test_case6_breakaway_and_first_impact():
     assert_close(res.x1[moving], 1.0 + 5.0 * tm**3, STATE_TOL, "x1 before the impact")
     assert_close(res.v1[moving], 15.0 * tm**2, STATE_TOL, "v1 before the impact")
     assert_close(res.x2[res.t < t_hit], 2.0, AT_REST_TOL, "x2 before the impact")
+
+
+def test_no_impact_no_impact_loss():
+    """Case 2 has no impact: its bodies are stopped by friction, and the rounding-level
+    energy left when a stopped body's velocity is zeroed is friction's (it read
+    'impact loss = 4.6E-33')."""
+    res = impact1d.simulate(impact1d.load_scene(INPUT / "case2.nml"))
+    assert not np.isin(res.events["kind"], ["left", "right", "slot_min", "slot_max"]).any()
+    assert np.all(res.impact_loss == 0.0)
+    assert res.friction_loss[-1] == 1.5
