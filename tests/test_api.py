@@ -241,7 +241,7 @@ def test_bad_dat_file(tmp_path):
         impact1d.simulate(impact1d.load_scene(path), t_end=1.0, dt=1e-3)
 
 
-# --- sweeps and progress -------------------------------------------------------------
+# --- progress -------------------------------------------------------------
 
 # A free flight under a sine force (every step evaluates it, so no shortcut applies) long
 # enough (2e7 steps, about 3 s here; the line appears after 1 s) for the progress line to
@@ -252,17 +252,6 @@ LONG_RUN = dict(t_end=2.0e4, dt=1.0e-3, dt_out=1.0e4)
 def _free_flight():
     return impact1d.Scene(m1=1.0, m2=2.0, x1=0.0, x2=5.0, v1=1.0, v2=-0.5, f1=0.001, f2=-0.002,
                           f1_amp=0.1, f1_period=7.0)
-
-
-def test_sweep_equals_separate_runs():
-    scene = impact1d.load_scene(str(INPUT / "case3.nml"))
-    runs = [dict(dt=1e-3), dict(dt=1e-2, dt_out=1e-2), dict(t_end=1.0)]
-    swept = impact1d.sweep(scene, runs)
-    assert len(swept) == len(runs)
-    for result, overrides in zip(swept, runs):
-        alone = impact1d.simulate(scene, **overrides)
-        np.testing.assert_array_equal(result.samples, alone.samples)
-        np.testing.assert_array_equal(result.events, alone.events)
 
 
 def test_progress_only_when_asked(capfd):

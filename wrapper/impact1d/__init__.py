@@ -15,7 +15,8 @@ A thin Python layer over the Fortran engine (the f2py extension impact1d._core):
 from importlib import import_module as _import_module
 
 from ._scene import Scene, InputError, SimulationError, load_scene
-from ._simulate import Result, simulate, sweep, COLUMNS, EVENT_DTYPE, event_kinds
+from ._simulate import Result, simulate, COLUMNS, EVENT_DTYPE, event_kinds
+from .sweep import sweep, SUMMARY_COLUMNS
 from ._output import read_output
 
 try:
@@ -29,7 +30,7 @@ except ImportError:  # pragma: no cover
 
 __all__ = [
     "Scene", "Result", "InputError", "SimulationError",
-    "load_scene", "simulate", "sweep", "read_output", "event_kinds",
+    "load_scene", "simulate", "sweep", "SUMMARY_COLUMNS", "read_output", "event_kinds",
     "COLUMNS", "EVENT_DTYPE", "plot", "__version__",
 ]
 

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import dataclasses
-import sys
 from dataclasses import dataclass, field
 from functools import lru_cache
 from typing import Optional
@@ -12,7 +11,7 @@ import numpy as np
 
 from ._scene import Scene, InputError, raise_for_status, to_core, _words, _api
 
-__all__ = ["Result", "simulate", "sweep", "COLUMNS", "EVENT_DTYPE"]
+__all__ = ["Result", "simulate", "COLUMNS", "EVENT_DTYPE"]
 
 # The sample columns of the api (and of the CLI output), checked against the core below.
 COLUMNS = ("t", "x1", "v1", "x2", "v2", "ke", "work", "friction_loss",
@@ -150,19 +149,3 @@ def simulate(scene: Scene, *, progress: bool = False, **overrides) -> Result:
         events["v1_after"], events["v2_after"] = event_v[2, :n_events], event_v[3, :n_events]
     return result_from_columns(samples, events, energy_residual=float(energy_residual),
                                steps=int(steps), scene=scene)
-
-
-def sweep(scene: Scene, runs, *, progress: bool = False) -> list:
-    """Run `scene` once per entry of `runs` (each a dict of overrides, as for simulate)
-    and return the Results in order.  With progress=True, stderr shows how many runs
-    are done (and each long run its own progress)."""
-    runs = list(runs)
-    results = []
-    for done, overrides in enumerate(runs, start=1):
-        results.append(simulate(scene, progress=progress, **overrides))
-        if progress:
-            sys.stderr.write(f"\rimpact1d sweep: {done}/{len(runs)} runs")
-            sys.stderr.flush()
-    if progress and runs:
-        sys.stderr.write("\n")
-    return results

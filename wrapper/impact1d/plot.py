@@ -33,6 +33,8 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.ticker import ScalarFormatter
 
+from ._files import write_whole
+
 __all__ = ["figure", "save", "PANELS", "CONTACTS"]
 
 #: Panel names, in drawing order; ``save(..., separate=True)`` appends them to the file stem.
@@ -482,19 +484,43 @@ def save(result, path, separate=False, *, dpi=100, figure_factory=None):
     folder = os.path.dirname(os.path.abspath(path))
     os.makedirs(folder, exist_ok=True)
     for fig, p in zip(figs, paths):
-        _save_whole(fig, p, dpi)
+        write_whole(p, lambda temporary: fig.savefig(temporary, dpi=dpi))
     return paths
 
 
-def _save_whole(fig, path, dpi):
-    """Save under a temporary name and rename: a full disk or an interrupt leaves the
-    previous image (or none), never a truncated one."""
-    root, ext = os.path.splitext(path)
-    temporary = f"{root}.part{ext}"      # the extension tells matplotlib the format
-    try:
-        fig.savefig(temporary, dpi=dpi)
-        os.replace(temporary, path)
-    except BaseException:
-        if os.path.exists(temporary):
-            os.remove(temporary)
-        raise
+def sweep(table, x, y=None, value=("t_rest",), path=None, *, dpi=100, figure_factory=None):
+    """A figure of a sweep's table (impact1d.sweep or impact1d-sweep's CSV): with one varied
+    field `x`, a line per summary column in `value` against it; with two (`x`, `y`), a
+    heatmap of the one column `value`. Failed runs (NaN) are gaps. Saved to `path` when
+    given (written whole); the Figure is returned."""
+    import pandas as pd
+
+    table = table if isinstance(table, pd.DataFrame) else pd.read_csv(table)
+    values = [value] if isinstance(value, str) else list(value)
+    for name in [x, y] + values:
+        if name is not None and name not in table.columns:
+            raise ValueError(f"no column {name!r} in the table (columns: {', '.join(table.columns)})")
+    fig = (figure_factory or Figure)(figsize=(7, 5))
+    ax = fig.add_subplot(1, 1, 1)
+    if y is None:
+        ordered = table.sort_values(x)
+        for name in values:
+            ax.plot(ordered[x], ordered[name], marker=".", label=name)
+        ax.set_xlabel(x)
+        ax.set_ylabel(values[0] if len(values) == 1 else "value")
+        if len(values) > 1:
+            ax.legend()
+    else:
+        if len(values) != 1:
+            raise ValueError("a heatmap shows one value column")
+        grid = table.pivot_table(index=y, columns=x, values=values[0], aggfunc="mean", dropna=False)
+        mesh = ax.pcolormesh(grid.columns.to_numpy(float), grid.index.to_numpy(float),
+                             grid.to_numpy(float), shading="nearest")
+        fig.colorbar(mesh, ax=ax, label=values[0])
+        ax.set_xlabel(x)
+        ax.set_ylabel(y)
+    ax.set_title(f"{', '.join(values)} over {x}" + (f" and {y}" if y else ""))
+    if path is not None:
+        os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
+        write_whole(path, lambda temporary: fig.savefig(temporary, dpi=dpi))
+    return fig

@@ -1,4 +1,6 @@
 """``impact1d-plot OUTPUT.dat [-o PNG] [--separate] [--show]``: plot a run written by the CLI.
+``impact1d-plot TABLE.csv --x NAME [--y NAME] [--value COLUMN ...]``: plot a sweep's table
+(impact1d-sweep): lines over one varied field, a heatmap over two.
 
 Reads OUTPUT.dat (and OUTPUT.events.dat next to it, if present: the output's
 extension replaced by .events.dat) and writes OUTPUT.png next to it, or one PNG per panel with ``--separate``
@@ -30,6 +32,10 @@ def _parser():
     p.add_argument("--separate", action="store_true",
                    help="one PNG per panel: PNG stem + _positions, _velocities, ...")
     p.add_argument("--show", action="store_true", help="also open the figures in a window")
+    p.add_argument("--x", help="a sweep table's varied field for the x axis")
+    p.add_argument("--y", help="a second varied field: a heatmap of --value")
+    p.add_argument("--value", action="append", default=None,
+                   help="summary column(s) to show (default t_rest)")
     p.add_argument("--version", action="version", version=f"{PROG} {_version()}")
     return p
 
@@ -73,6 +79,8 @@ def main(argv=None):
     output = args.output
     if not os.path.isfile(output):
         return _fail(f"no such file: {output}")
+    if output.endswith((".csv", ".parquet")):
+        return _plot_table(args)
     try:
         result = _read(output)
     except Exception as exc:  # noqa: BLE001 - any read failure is reported the same way
@@ -101,6 +109,26 @@ def main(argv=None):
         print(f"wrote {p}")
     if args.show:
         plt.show()
+    return 0
+
+
+def _plot_table(args):
+    """A sweep's table: lines or a heatmap (impact1d.plot.sweep)."""
+    if not args.x:
+        return _fail("a sweep table needs --x NAME (and --y NAME for a heatmap)")
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import pandas as pd
+    from impact1d import plot
+
+    png = args.png or _default_png(args.output)
+    try:
+        table = (pd.read_parquet if args.output.endswith(".parquet") else pd.read_csv)(args.output)
+        plot.sweep(table, args.x, args.y, args.value or ["t_rest"], png)
+    except Exception as exc:  # noqa: BLE001 - one line, whatever went wrong
+        return _fail(f"cannot plot {args.output}: {_one_line(exc)}")
+    print(f"wrote {png}")
     return 0
 
 

@@ -1,0 +1,136 @@
+"""Parameter sweeps (issue 11): a table with a row per run, equal to single runs, on threads
+and on a real Dask LocalCluster with worker processes; a failing run is a row."""
+
+import math
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import impact1d
+from impact1d.sweep import SUMMARY_COLUMNS, summarize
+from tools import find_tool
+
+ROOT = Path(__file__).resolve().parents[1]
+INPUT = ROOT / "input"
+RUN_TIMEOUT = 300
+GRID = {"r_left": [0.0, 0.5, 1.0], "r_right": [0.25, 0.75]}
+
+
+@pytest.fixture(scope="module")
+def case5():
+    return impact1d.load_scene(INPUT / "case5.nml")
+
+
+@pytest.fixture(scope="module")
+def dask_client():
+    distributed = pytest.importorskip("distributed")
+    cluster = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                       dashboard_address=None)
+    client = distributed.Client(cluster)
+    yield client
+    client.close()
+    cluster.close()
+
+
+def assert_rows_equal_single_runs(table, scene, runs):
+    assert len(table) == len(runs)
+    for (_, row), overrides in zip(table.iterrows(), runs):
+        for name, value in overrides.items():
+            assert row[name] == value
+        alone = summarize(impact1d.simulate(scene, **overrides))
+        for name in SUMMARY_COLUMNS:
+            want, got = alone[name], row[name]
+            assert (math.isnan(want) and math.isnan(got)) if isinstance(want, float) and math.isnan(want) \
+                else got == want, (overrides, name, got, want)
+        assert row["error"] == ""
+
+
+def grid_runs():
+    return [{"r_left": a, "r_right": b} for a in GRID["r_left"] for b in GRID["r_right"]]
+
+
+def test_columns_and_grid_order(case5):
+    table = impact1d.sweep(case5, GRID)
+    assert list(table.columns) == ["r_left", "r_right", *SUMMARY_COLUMNS, "error"]
+    assert_rows_equal_single_runs(table, case5, grid_runs())
+
+
+@pytest.mark.parametrize("workers", [1, 2, 3])
+def test_workers_give_the_same_rows(case5, workers):
+    runs = [{"r_left": a, "dt": dt} for a in np.linspace(0, 1, 9) for dt in (1e-3, 2e-3)]
+    table = impact1d.sweep(case5, runs, workers=workers)
+    assert_rows_equal_single_runs(table, case5, [{k: float(v) for k, v in r.items()} for r in runs])
+
+
+def test_dask_local_cluster_gives_the_same_rows(case5, dask_client):
+    runs = [{"r_left": float(a)} for a in np.linspace(0, 1, 150)]
+    table = impact1d.sweep(case5, runs, client=dask_client)
+    assert_rows_equal_single_runs(table, case5, runs)
+
+
+def test_a_bad_run_is_one_row(case5):
+    runs = [{"r_left": 0.5}] * 1000
+    runs[417] = {"r_left": 0.5, "dt": -1.0}
+    table = impact1d.sweep(case5, runs)
+    errors = table["error"] != ""
+    assert errors.sum() == 1 and errors[417]
+    assert "dt = -1" in table.loc[417, "error"]
+    assert math.isnan(table.loc[417, "x1_end"])
+    assert table.loc[~errors, "t_rest"].eq(3.0).all()
+
+
+def test_t_rest(case5):
+    table = impact1d.sweep(case5, [{"r_left": 0.5, "r_right": 0.5}, {"r_right": 1.0}])
+    assert table.loc[0, "t_rest"] == 3.0               # both rest at the accumulation time
+    assert math.isnan(table.loc[1, "t_rest"])          # an elastic wall never lets it rest
+
+
+def test_keep_results(case5):
+    table, results = impact1d.sweep(case5, [{"r_left": 0.5}, {"dt": 0.0}], keep="results")
+    assert results[1] is None and table.loc[1, "error"]
+    np.testing.assert_array_equal(results[0].x1, impact1d.simulate(case5, r_left=0.5).x1)
+
+
+def test_unknown_field_is_refused(case5):
+    with pytest.raises(impact1d.InputError, match="unknown scene field.*r_lft"):
+        impact1d.sweep(case5, {"r_lft": [0.1]})
+
+
+def test_cli_writes_the_table_and_the_plot_draws_it(case5, tmp_path):
+    out = tmp_path / "table.csv"
+    done = subprocess.run([find_tool("impact1d-sweep"), str(INPUT / "case5.nml"),
+                           "--vary", "r_left=0:1:3", "--vary", "r_right=0.25,0.75",
+                           "--workers", "2", "-o", str(out)],
+                          capture_output=True, text=True, timeout=RUN_TIMEOUT)
+    assert done.returncode == 0, done.stderr
+    table = pd.read_csv(out, keep_default_na=False, na_values=[""])
+    expected = impact1d.sweep(case5, GRID)
+    np.testing.assert_array_equal(table["t_rest"].to_numpy(float), expected["t_rest"].to_numpy(float))
+    np.testing.assert_array_equal(table["x2_end"], expected["x2_end"])
+    png = tmp_path / "map.png"
+    done = subprocess.run([find_tool("impact1d-plot"), str(out), "--x", "r_left", "--y", "r_right",
+                           "--value", "t_rest", "-o", str(png)],
+                          capture_output=True, text=True, timeout=RUN_TIMEOUT)
+    assert done.returncode == 0, done.stderr
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_cli_bad_vary_is_one_line(tmp_path):
+    done = subprocess.run([find_tool("impact1d-sweep"), str(INPUT / "case5.nml"),
+                           "--vary", "r_left=0:1"], capture_output=True, text=True,
+                          timeout=RUN_TIMEOUT)
+    assert done.returncode == 1
+    assert done.stderr.strip().count("\n") == 0 and "start:stop:count" in done.stderr
+
+
+def test_plot_axes(case5):
+    from impact1d import plot
+    fig = plot.sweep(impact1d.sweep(case5, GRID), "r_left", "r_right", "t_rest")
+    ax = fig.axes[0]
+    assert (ax.get_xlabel(), ax.get_ylabel()) == ("r_left", "r_right")
+    fig = plot.sweep(impact1d.sweep(case5, {"r_left": [0.1, 0.5, 0.9]}), "r_left",
+                     value=["t_rest", "impact_loss"])
+    assert [line.get_label() for line in fig.axes[0].lines] == ["t_rest", "impact_loss"]

@@ -1,0 +1,194 @@
+"""Parameter studies: many runs of one scene, one table row per run.
+
+    table = impact1d.sweep(scene, {"r_left": np.linspace(0, 1, 21), "r_right": [0.5, 1.0]})
+
+A row holds the varied fields, then the run's summary (SUMMARY_COLUMNS), then `error`: empty
+when the run succeeded, else the message of its InputError or SimulationError (a failing run
+is a row, never the end of the sweep). Runs go in chunks to threads of this machine (the
+Fortran run releases the GIL) or to the workers of a dask.distributed Client.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import os
+import sys
+from concurrent.futures import ThreadPoolExecutor
+from typing import Optional
+
+import numpy as np
+
+from ._scene import InputError, Scene, SimulationError
+from ._simulate import _OVERRIDABLE, simulate
+
+__all__ = ["sweep", "SUMMARY_COLUMNS", "summarize", "run_chunk"]
+
+# Named so that they never clash with a varied field (x1 is a field, x1_end is not).
+SUMMARY_COLUMNS = ("x1_end", "v1_end", "x2_end", "v2_end", "ke_end", "n_impacts",
+                   "n_left", "n_right", "n_slot_min", "n_slot_max", "t_rest",
+                   "impact_loss", "friction_loss", "energy_residual", "steps")
+_IMPACT_KINDS = ("left", "right", "slot_min", "slot_max")
+# Below this many runs a sweep stays on one thread unless asked: a pool costs more than
+# it saves on a few milliseconds of work.
+_PARALLEL_FROM = 200
+# Runs per chunk: enough that a chunk's overhead (a task, a progress update) is small.
+_CHUNK = 64
+
+
+def summarize(result) -> dict:
+    """The summary row of one Result.
+
+    t_rest is when every body came to rest for good: the time of the last logged event
+    (a stick, or a rest at an accumulation time) if from then on to t_end no sample shows
+    a velocity; 0 if nothing ever moved; NaN if a body still moves at t_end."""
+    events = result.events
+    kinds = events["kind"]
+    counts = {kind: int(np.count_nonzero(kinds == kind)) for kind in _IMPACT_KINDS}
+    moving = (result.v1 != 0.0) | (result.v2 != 0.0)
+    if moving[-1]:
+        t_rest = math.nan
+    else:
+        last_moving = result.t[np.flatnonzero(moving)[-1]] if moving.any() else -math.inf
+        t_rest = float(events["t"][-1]) if len(events) else 0.0
+        if t_rest < last_moving:     # moved after its last event: no event marks the stop
+            t_rest = math.nan
+    row = {"x1_end": result.x1[-1], "v1_end": result.v1[-1], "x2_end": result.x2[-1],
+           "v2_end": result.v2[-1], "ke_end": result.ke[-1],
+           "n_impacts": sum(counts.values()), **{f"n_{k}": counts[k] for k in _IMPACT_KINDS},
+           "t_rest": t_rest, "impact_loss": result.impact_loss[-1],
+           "friction_loss": result.friction_loss[-1],
+           "energy_residual": result.energy_residual, "steps": result.steps}
+    return {name: row[name] for name in SUMMARY_COLUMNS}
+
+
+def _failed_row() -> dict:
+    """A failed run's summary: nothing measured (its `error` says why)."""
+    return {name: math.nan for name in SUMMARY_COLUMNS}
+
+
+def run_chunk(scene: Scene, overrides: list, keep_results: bool = False):
+    """Run the scene once per override dict: (summary rows, error messages[, Results]).
+    A plain function of plain data, so that a Dask worker can run it."""
+    rows, errors, results = [], [], []
+    for changes in overrides:
+        try:
+            result = simulate(scene, **changes)
+        except (InputError, SimulationError) as error:
+            rows.append(_failed_row())
+            errors.append(str(error))
+            results.append(None)
+            continue
+        rows.append(summarize(result))
+        errors.append("")
+        results.append(result if keep_results else None)
+    return (rows, errors, results) if keep_results else (rows, errors)
+
+
+def _runs(params) -> tuple:
+    """(varied field names, list of override dicts) from a grid dict or a list of dicts."""
+    if isinstance(params, dict):
+        names = list(params)
+        values = [list(np.atleast_1d(params[name])) for name in names]
+        runs = [dict(zip(names, combo)) for combo in itertools.product(*values)]
+    else:
+        runs = [dict(run) for run in params]
+        names = list(dict.fromkeys(name for run in runs for name in run))
+    unknown = [name for name in names if name not in _OVERRIDABLE]
+    if unknown:
+        raise InputError(f"unknown scene field(s) to vary: {', '.join(unknown)} "
+                         f"(known: {', '.join(_OVERRIDABLE)})")
+    # numpy scalars become plain floats: the row equals a simulate() call with those numbers.
+    runs = [{k: (v.item() if isinstance(v, np.generic) else v) for k, v in run.items()}
+            for run in runs]
+    return names, runs
+
+
+class _Progress:
+    """A tqdm bar when tqdm is installed, else a counter line on stderr."""
+
+    def __init__(self, total, show):
+        self.total, self.done, self.bar = total, 0, None
+        self.show = show
+        if show:
+            try:
+                from tqdm import tqdm
+                self.bar = tqdm(total=total, unit="run", desc="impact1d sweep", file=sys.stderr)
+            except ImportError:
+                pass
+
+    def update(self, n):
+        self.done += n
+        if not self.show:
+            return
+        if self.bar is not None:
+            self.bar.update(n)
+        else:
+            sys.stderr.write(f"\rimpact1d sweep: {self.done}/{self.total} runs")
+            sys.stderr.flush()
+
+    def close(self):
+        if self.bar is not None:
+            self.bar.close()
+        elif self.show:
+            sys.stderr.write("\n")
+
+
+def sweep(scene: Scene, params, *, workers: Optional[int] = None, client=None,
+          progress: Optional[bool] = None, keep: Optional[str] = None):
+    """Run `scene` over `params` and return a pandas DataFrame, one row per run in order.
+
+    params: a dict field -> sequence (the Cartesian grid, the first field varying slowest)
+    or a list of override dicts. workers: threads of this machine (default: all cores for
+    sweeps of 200 runs or more, else 1). client: a dask.distributed Client to run the chunks
+    on instead. progress: a progress bar (default: when stderr is a terminal).
+    keep="results": return (table, list of Result or None for failed runs)."""
+    import pandas as pd
+
+    if not isinstance(scene, Scene):
+        raise InputError(f"sweep() needs an impact1d.Scene, got {type(scene).__name__}")
+    if keep not in (None, "results"):
+        raise InputError(f"keep must be None or 'results', got {keep!r}")
+    names, runs = _runs(params)
+    if progress is None:
+        progress = sys.stderr.isatty()
+    if workers is None:
+        workers = (os.cpu_count() or 1) if len(runs) >= _PARALLEL_FROM else 1
+    if workers < 1:
+        raise InputError(f"workers must be at least 1, got {workers}")
+    keep_results = keep == "results"
+    chunks = [runs[i:i + _CHUNK] for i in range(0, len(runs), _CHUNK)]
+    bar = _Progress(len(runs), progress)
+    try:
+        if client is not None:
+            if keep_results:
+                raise InputError("keep='results' is for local sweeps, not a Dask client")
+            futures = client.map(run_chunk, [scene] * len(chunks), chunks, pure=False)
+            outputs = []
+            for future, chunk in zip(futures, chunks):
+                outputs.append(future.result())
+                bar.update(len(chunk))
+        elif workers == 1:
+            outputs = []
+            for chunk in chunks:
+                outputs.append(run_chunk(scene, chunk, keep_results))
+                bar.update(len(chunk))
+        else:
+            with ThreadPoolExecutor(max_workers=workers) as pool:
+                outputs = []
+                for chunk, output in zip(chunks, pool.map(
+                        lambda c: run_chunk(scene, c, keep_results), chunks)):
+                    outputs.append(output)
+                    bar.update(len(chunk))
+    finally:
+        bar.close()
+
+    rows = [row for output in outputs for row in output[0]]
+    errors = [error for output in outputs for error in output[1]]
+    table = pd.DataFrame({name: [run.get(name) for run in runs] for name in names})
+    summary = pd.DataFrame(rows, columns=list(SUMMARY_COLUMNS))
+    table = pd.concat([table, summary], axis=1)
+    table["error"] = errors
+    if keep_results:
+        return table, [result for output in outputs for result in output[2]]
+    return table
