@@ -27,12 +27,13 @@ PKG_SOURCES := $(shell find src app wrapper -not -path '*/__pycache__*' 2>/dev/n
 DEPS_STAMP    := $(VENV)/.build-deps
 INSTALL_STAMP := $(VENV)/.installed
 
-.PHONY: help setup demo test clean gfortran
+.PHONY: help setup demo test clean gfortran study
 
 help:
 	@echo "make setup   gfortran (apt, if missing), .venv, pip install .[test]"
 	@echo "make demo    run input/case1..6.nml with the impact1d CLI and plot them"
 	@echo "make test    Fortran unit tests (meson test), then pytest"
+	@echo "make study   case 5's rest time over (r_left, r_right): a sweep and its heatmap"
 	@echo "make bench   accuracy and speed studies, Siconos as a peer (apt, if missing)"
 	@echo "             -> docs/accuracy.md, docs/performance.md"
 	@echo "make clean   remove .venv, build/ and output files"
@@ -81,6 +82,13 @@ demo: setup
 	  impact1d input/case$$n.nml; \
 	  impact1d-plot output/case$$n.dat; \
 	done
+
+# An example study (README): 400 runs of case 5 on every core, then the heatmap.
+study: setup
+	impact1d-sweep input/case5.nml --vary r_left=0:0.95:20 --vary r_right=0:0.95:20 \
+	    --vary t_end=10 -o output/case5_rest.csv
+	impact1d-plot output/case5_rest.csv --x r_left --y r_right --value t_rest \
+	    -o docs/study_case5_rest.png
 
 test: setup
 	meson test -C $(BUILDDIR) --print-errorlogs

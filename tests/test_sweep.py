@@ -134,3 +134,15 @@ def test_plot_axes(case5):
     fig = plot.sweep(impact1d.sweep(case5, {"r_left": [0.1, 0.5, 0.9]}), "r_left",
                      value=["t_rest", "impact_loss"])
     assert [line.get_label() for line in fig.axes[0].lines] == ["t_rest", "impact_loss"]
+
+
+def test_rest_time_map_matches_the_closed_form(case5):
+    """The README's study: each wall's impacts accumulate at 1 + 2 r / (1 - r) s (the first
+    impact at t = 1, flights shrinking by r), and the pair rests at the later of the two."""
+    r = np.linspace(0.0, 0.9, 7)
+    table = impact1d.sweep(case5, {"r_left": r, "r_right": r, "t_end": [10.0]}, workers=2)
+    accumulation = lambda x: 1.0 + 2.0 * x / (1.0 - x)
+    expected = np.maximum(accumulation(table["r_left"]), accumulation(table["r_right"]))
+    rested = table["t_rest"].notna()
+    np.testing.assert_allclose(table.loc[rested, "t_rest"], expected[rested], rtol=0, atol=1e-12)
+    assert (expected[~rested] > 10.0 - 1e-9).all()
