@@ -14,6 +14,7 @@ import time
 
 import common
 import siconos_peer
+import sweep_study
 
 COMMAND = "make bench"
 
@@ -365,15 +366,19 @@ def main(argv):
         performance.run()
         print("Siconos peer comparison ...", flush=True)
         siconos_peer.run()
+        print("sweep study ...", flush=True)
+        sweep_study.run()
         print(f"studies done in {time.perf_counter() - start:.0f} s", flush=True)
     info = common.load_json("machine") if info_path.exists() else common.machine()
     conv, wp, perf = (common.load_json(n) for n in ("convergence", "work_precision", "performance"))
     # Siconos is optional: without results its sections say it was not compared.
     peer = common.load_json("siconos") if (common.RESULTS / "siconos.json").exists() else None
+    sweeps = common.load_json("sweep") if (common.RESULTS / "sweep.json").exists() else None
     (common.DOCS / "accuracy.md").write_text(
         accuracy_md(conv, wp, perf, info).rstrip() + "\n\n" + siconos_peer.accuracy_section(peer))
     (common.DOCS / "performance.md").write_text(
-        performance_md(perf, info).rstrip() + "\n\n" + siconos_peer.performance_section(peer))
+        performance_md(perf, info).rstrip() + "\n\n" + siconos_peer.performance_section(peer).rstrip()
+        + "\n\n" + sweep_study.performance_section(sweeps))
     print("wrote docs/accuracy.md, docs/performance.md and docs/*.png")
 
 
