@@ -5,18 +5,26 @@
 !> at once (the long calls are `threadsafe` for f2py: they release the GIL).
 module impact1d_api
   use, intrinsic :: iso_c_binding, only: c_double, c_int
+  use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
   use impact1d_kinds, only: wp
   use impact1d_error, only: error_type, status_ok, status_input
   use impact1d_scene, only: scene_input, scene_type, n_real, n_text, real_names, text_names, &
-    i_title, i_f1_table, i_f2_table, i_method
+    i_title, i_f1_table, i_f2_table, i_method, n_contacts
   use impact1d_io, only: read_scene_file, prepare_scene
-  use impact1d_output, only: memory_sink, column_names_text => column_names, event_names, n_columns
+  use impact1d_output, only: memory_sink, summary_sink, column_names_text => column_names, event_names, &
+    n_columns, event_impact
   use impact1d_solver, only: run, run_stats
   implicit none
   private
-  public :: field_names, column_names, event_kind_names, read_scene, simulate
+  public :: field_names, column_names, event_kind_names, read_scene, simulate, simulate_summaries, &
+    summary_column_names
 
   integer(c_int), parameter :: status_too_small = 3   !< arrays too small: sizes needed returned
+  integer, parameter :: message_length = 512
+  !> What simulate_summaries keeps of a run (sweep's columns, in this order).
+  character(len=*), parameter :: summary_names(15) = [character(len=15) :: 'x1_end', 'v1_end', &
+    'x2_end', 'v2_end', 'ke_end', 'n_impacts', 'n_left', 'n_right', 'n_slot_min', 'n_slot_max', &
+    't_rest', 'impact_loss', 'friction_loss', 'energy_residual', 'steps']
 
 contains
 
@@ -147,6 +155,78 @@ contains
     event_kind(:n_events) = sink%event_kind(:n_events)
     event_v(:, :n_events) = sink%event_v(:, :n_events)
   end subroutine simulate
+
+  !> Run one scene n_runs times, run j with the real fields over_index(:) (1-based, in the
+  !> order of field_names) set to over_values(:, j), keeping only each run's summary (a
+  !> summary_sink: no samples): summary(:, j) in the order of summary_names, status(j) and
+  !> message_codes(:, j) (the message's character codes, blank-padded) say how it ended. A
+  !> failing run is a status, never the end of the batch.
+  subroutine simulate_summaries(n, values, given, title, f1_table, f2_table, method, n_over, &
+      over_index, n_runs, over_values, n_summary, summary, status, message_codes)
+    !f2py threadsafe
+    integer(c_int), intent(in) :: n, n_over, n_runs, n_summary
+    real(c_double), intent(in) :: values(n), over_values(n_over, n_runs)
+    integer(c_int), intent(in) :: given(n), over_index(n_over)
+    character(len=*), intent(in) :: title, f1_table, f2_table, method
+    real(c_double), intent(out) :: summary(n_summary, n_runs)
+    integer(c_int), intent(out) :: status(n_runs)
+    integer(c_int), intent(out) :: message_codes(512, n_runs)   ! 512: message_length (f2py needs the number)
+    type(scene_input) :: base, input
+    type(scene_type) :: scene
+    type(run_stats) :: stats
+    type(summary_sink) :: sink
+    type(error_type), allocatable :: error
+    character(len=message_length) :: message
+    integer :: j, k
+
+    summary = ieee_value(1.0_c_double, ieee_quiet_nan)
+    message_codes = iachar(' ')
+    status = status_input
+    if (.not. field_count_ok(n, status(1), message)) then
+      message_codes(:, 1) = [(iachar(message(k:k)), k = 1, message_length)]
+      return
+    end if
+    if (n_summary /= size(summary_names) .or. any(over_index < 1 .or. over_index > n)) then
+      message = 'internal: bad summary size or override index'
+      message_codes(:, 1) = [(iachar(message(k:k)), k = 1, message_length)]
+      return
+    end if
+    base%value = real(values, wp)
+    base%given = given /= 0
+    base%text(i_title) = title
+    base%text(i_f1_table) = f1_table
+    base%text(i_f2_table) = f2_table
+    base%text(i_method) = method
+    do j = 1, n_runs
+      input = base
+      input%value(over_index) = real(over_values(:, j), wp)
+      input%given(over_index) = .true.
+      call prepare_scene(input, scene, error)
+      if (.not. allocated(error)) then
+        sink = summary_sink()
+        call run(scene, sink, stats, error)
+      end if
+      if (failed(error, status(j), message)) then
+        message_codes(:, j) = [(iachar(message(k:k)), k = 1, message_length)]
+        cycle
+      end if
+      summary(:, j) = [stats%last_row([2, 3, 4, 5, 6]), &
+        real(sum(stats%events(event_impact + 1:event_impact + n_contacts)), wp), &
+        real(stats%events(event_impact + 1:event_impact + n_contacts), wp), &
+        sink%rest_time(stats%last_row), stats%last_row([9, 8]), stats%max_residual, real(stats%steps, wp)]
+    end do
+  end subroutine simulate_summaries
+
+  !> Names of simulate_summaries' rows, space separated.
+  subroutine summary_column_names(names)
+    character(len=1024), intent(out) :: names
+    integer :: k
+    names = ''
+    do k = 1, size(summary_names)
+      names = trim(names) // ' ' // trim(summary_names(k))
+    end do
+    names = adjustl(names)
+  end subroutine summary_column_names
 
   logical function field_count_ok(n, status, message)
     integer(c_int), intent(in) :: n

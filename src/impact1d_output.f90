@@ -3,13 +3,14 @@
 module impact1d_output
   use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char
   use, intrinsic :: iso_fortran_env, only: error_unit, int64
+  use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
   use impact1d_kinds, only: wp
   use impact1d_error, only: error_type, raise, status_input, status_simulation, fmt
   use impact1d_scene, only: scene_input, real_names, n_real, i_title, i_method, i_g, i_dt_out, &
     i_dt, default_gravity
   implicit none
   private
-  public :: sink_type, memory_sink, file_sink, n_columns, column_names, n_event_kinds, event_names
+  public :: sink_type, memory_sink, summary_sink, file_sink, n_columns, column_names, n_event_kinds, event_names
   public :: event_impact, event_rest, event_release, event_stick, event_slip, make_folder, run_stats
   public :: emit_sample, events_path
 
@@ -76,6 +77,18 @@ module impact1d_output
     procedure :: put_event => memory_put_event
     procedure :: reserve => memory_reserve
   end type memory_sink
+
+  !> Keeps no samples, only what a sweep's summary needs (memory O(1) per run): the last
+  !> row comes in run_stats; here, when a body was last seen moving and the last event.
+  type, extends(sink_type) :: summary_sink
+    real(wp) :: last_moving = -huge(1.0_wp)   !< time of the last sample with a velocity
+    real(wp) :: last_event = -huge(1.0_wp)    !< time of the last logged event
+    logical :: any_event = .false.
+  contains
+    procedure :: put_sample => summary_put_sample
+    procedure :: put_event => summary_put_event
+    procedure :: rest_time
+  end type summary_sink
 
   !> Streams rows to NAME.dat and NAME.events.dat, written under temporary names and renamed
   !> only when the run succeeds and every write, flush and close did: a failed run or a full
@@ -190,6 +203,35 @@ contains
     allocate(self%event_time(64), self%event_v(4, 64), self%event_kind(64))
     self%n_events = 0
   end subroutine memory_reserve
+
+  subroutine summary_put_sample(self, row)
+    class(summary_sink), intent(inout) :: self
+    real(wp), intent(in) :: row(n_columns)
+    if (row(3) /= 0.0_wp .or. row(5) /= 0.0_wp) self%last_moving = row(1)
+  end subroutine summary_put_sample
+
+  subroutine summary_put_event(self, t, kind, v_before, v_after)
+    class(summary_sink), intent(inout) :: self
+    real(wp), intent(in) :: t, v_before(2), v_after(2)
+    integer, intent(in) :: kind
+    self%last_event = t
+    self%any_event = .true.
+  end subroutine summary_put_event
+
+  !> When every body came to rest for good: the last event (a stick, or a rest at an
+  !> accumulation time) if no sample after it shows a velocity; 0 if nothing ever moved;
+  !> NaN if a body still moves at t_end (last_row: the final sample).
+  real(wp) function rest_time(self, last_row)
+    class(summary_sink), intent(in) :: self
+    real(wp), intent(in) :: last_row(n_columns)
+    rest_time = ieee_value(1.0_wp, ieee_quiet_nan)
+    if (last_row(3) /= 0.0_wp .or. last_row(5) /= 0.0_wp) return
+    if (.not. self%any_event) then
+      if (self%last_moving < 0.0_wp) rest_time = 0.0_wp
+      return
+    end if
+    if (self%last_event >= self%last_moving) rest_time = self%last_event
+  end function rest_time
 
   subroutine memory_put_sample(self, row)
     class(memory_sink), intent(inout) :: self

@@ -19,8 +19,8 @@ from typing import Optional
 
 import numpy as np
 
-from ._scene import InputError, Scene, SimulationError
-from ._simulate import _OVERRIDABLE, simulate
+from ._scene import REAL_FIELDS, InputError, Scene, SimulationError
+from ._simulate import _OVERRIDABLE, run_summaries, simulate
 
 __all__ = ["sweep", "SUMMARY_COLUMNS", "summarize", "run_chunk"]
 
@@ -67,9 +67,25 @@ def _failed_row() -> dict:
     return {name: math.nan for name in SUMMARY_COLUMNS}
 
 
+def _batchable(overrides: list) -> bool:
+    """Runs the core's batch entry can take: the same real fields, numbers only."""
+    if not overrides:
+        return False
+    names = set(overrides[0])
+    return all(set(run) == names and all(name in REAL_FIELDS and isinstance(value, (int, float))
+                                         and not isinstance(value, bool)
+                                         for name, value in run.items())
+               for run in overrides)
+
+
 def run_chunk(scene: Scene, overrides: list, keep_results: bool = False):
     """Run the scene once per override dict: (summary rows, error messages[, Results]).
-    A plain function of plain data, so that a Dask worker can run it."""
+    A plain function of plain data, so that a Dask worker can run it. Without Results
+    wanted, runs that only change numbers go to the core in one call (no per-run glue)."""
+    if not keep_results and _batchable(overrides):
+        columns, errors = run_summaries(scene, overrides)
+        rows = [{name: columns[name][j] for name in SUMMARY_COLUMNS} for j in range(len(overrides))]
+        return rows, errors
     rows, errors, results = [], [], []
     for changes in overrides:
         try:
@@ -189,6 +205,10 @@ def sweep(scene: Scene, params, *, workers: Optional[int] = None, client=None,
     summary = pd.DataFrame(rows, columns=list(SUMMARY_COLUMNS))
     table = pd.concat([table, summary], axis=1)
     table["error"] = errors
+    # Counts are whole numbers; a failed run's are missing (pandas' nullable integers).
+    for name in SUMMARY_COLUMNS:
+        if name.startswith("n_") or name == "steps":
+            table[name] = table[name].astype("Int64")
     if keep_results:
         return table, [result for output in outputs for result in output[2]]
     return table
