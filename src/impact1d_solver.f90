@@ -8,36 +8,27 @@ module impact1d_solver
   use impact1d_error, only: error_type, raise, status_simulation, fmt
   use impact1d_scene, only: scene_type, n_contacts, normal, sample_time, i_slot_min, i_slot_max
   use impact1d_modes, only: mode_type, solve_mode, max_holds
-  use impact1d_events, only: hermite, earliest_crossing
+  use impact1d_events, only: earliest_crossing
   use impact1d_impacts, only: normal_velocity, impulse, most_approaching, restitution_of, &
     kinetic_energy, joint_inelastic, inelastic_projection
   use impact1d_output, only: sink_type, run_stats, emit_sample, event_impact, event_rest, &
     event_release, event_stick, event_slip
   use impact1d_vissim, only: run_vissim
+  use impact1d_state, only: state_type, add_compensated, renormalise, finite_state, constant_steps
+  use impact1d_yardsticks, only: velocity_rounding, time_rounding, gap_rounding, force_scale, &
+    same_instant
+  use impact1d_contacts, only: gap, gap_tolerance, gap_tolerance_along, displacement, snap, rigid_pair
+  use impact1d_stepping, only: rk4_type, book_constant_ledger, dense_output
   implicit none
   private
   public :: run, run_stats
 
-  !> Tolerances, each a multiple of the unit roundoff of the quantity it guards.
-  real(wp), parameter :: gap_rounding = 16.0_wp * eps_wp      !< rounding of a gap, per unit it moved
-  real(wp), parameter :: velocity_rounding = 64.0_wp * eps_wp !< a velocity this small is zero
-  real(wp), parameter :: time_rounding = 64.0_wp * eps_wp     !< instants closer than this coincide
   integer, parameter :: max_impulses = 1000000   !< per event point; elastic chains need ~pi sqrt(M/m)
   integer, parameter :: max_stalls = 10000       !< event points in a row without time advancing
   !> Work is bounded: elastic micro-bounces can make millions of genuine events a second.
   integer, parameter :: max_event_points = 2000000
   integer, parameter :: max_halvings = 60        !< retries of a step whose end violated a constraint
 
-  !> Time, positions, velocities and the ledger integrals are sums of many step increments,
-  !> kept compensated (value + its rounding error, the _lo parts): a micrometre bounce near a
-  !> wall at x = 10 m keeps its digits, and 10^6 steps of 1e-5 s do not drift the clock by
-  !> 1e-10 s. This is what keeps polynomial scenes at rounding error whatever the step count.
-  type :: state_type
-    real(wp) :: t = 0.0_wp, t_lo = 0.0_wp
-    real(wp) :: x(2) = 0.0_wp, x_lo(2) = 0.0_wp, v(2) = 0.0_wp, v_lo(2) = 0.0_wp
-    real(wp) :: work = 0.0_wp, work_lo = 0.0_wp, friction_loss = 0.0_wp, friction_lo = 0.0_wp
-    real(wp) :: impact_loss = 0.0_wp
-  end type state_type
 
 contains
 
@@ -52,15 +43,13 @@ contains
     type(state_type) :: s, trial
     type(mode_type) :: mode
     real(wp) :: ke0, t_stop, t_break, h, h_event, pending_rest(n_contacts), sample_t
-    logical :: in_contact(n_contacts), at_rest(2), located, at_stop, constant_forcing, watching
+    logical :: in_contact(n_contacts), at_rest(2), located, at_stop, watching
     logical :: polynomial_forcing, event_due, glided
     real(wp) :: t_rest
     ! Velocity scale of each body entering the current event point: impulses redistribute
     ! velocity but cannot create precision, so what is below its rounding is zero.
     real(wp) :: entry_scale(2)
-    real(wp) :: constant_acceleration(2)
-    ! The force at the end of the last step taken (rk4_step), and when.
-    real(wp) :: end_force(2), end_force_t
+    type(rk4_type) :: rk
     ! Until when each open gap (1..4) and each sliding body (5, 6) needs no location.
     real(wp) :: quiet_until(n_contacts + 2)
     ! When impulses last moved each body off its rest (see the stick log in event_point).
@@ -74,9 +63,9 @@ contains
       call run_vissim(scene, sink, stats, error)
       return
     end if
-    constant_forcing = .not. (any(scene%forcing%has_table) .or. any(scene%forcing%has_sine))
+    rk%constant_forcing = .not. (any(scene%forcing%has_table) .or. any(scene%forcing%has_sine))
     quiet_until = -huge(1.0_wp)
-    end_force_t = -huge(1.0_wp)
+    rk%end_force_t = -huge(1.0_wp)
     rest_lost_time = -huge(1.0_wp)
     release_time = huge(1.0_wp)
     release_v = 0.0_wp
@@ -108,7 +97,7 @@ contains
 
       located = .false.
       glided = .false.
-      if (constant_forcing) then
+      if (rk%constant_forcing) then
         call glide(t_stop, glided)
         if (allocated(error)) return
       end if
@@ -124,7 +113,7 @@ contains
             trial = s
             exit
           end if
-          call rk4_step(s, h, trial)
+          call rk%step(scene, mode, s, h, trial)
           if (.not. watching) exit      ! nothing in this mode can end it: no location needed
           call locate(s, trial, h, h_event, watched)
           located = h_event <= h
@@ -170,7 +159,7 @@ contains
       ! A stop reached by quiet steps has no gap near closing.
       if (.not. event_due .and. at_stop .and. .not. glided) event_due = impact_due()
       if (event_due) then
-        if (same_instant(s%t, t_last_event)) then
+        if (same_instant(scene, s%t, t_last_event)) then
           stalls = stalls + 1
           if (stalls > max_stalls) then
             call raise(error, status_simulation, 'at t = ' // fmt(s%t) // ': ' // fmt(max_stalls) // &
@@ -244,7 +233,7 @@ contains
       logical, intent(out) :: at_stop      !< the steps reached t_stop
       type(state_type) :: start
       real(wp) :: t_quiet, h, t, t_lo, x(2), x_lo(2), v(2), v_lo(2), dv(2), half_dv(2)
-      integer(int64) :: n_bulk, n, j
+      integer(int64) :: n_bulk, n
 
       at_stop = .false.
       t_quiet = minval(quiet_until)
@@ -254,7 +243,7 @@ contains
       ! (capped where the count would not fit an integer: such a run never ends anyway).
       n_bulk = int(min(min((t_stop - s%t) - s%t_lo, t_quiet - s%t) / scene%dt, 1.0e18_wp), int64) - 1
       h = scene%dt
-      dv = h * constant_acceleration
+      dv = h * rk%constant_acceleration
       half_dv = 0.5_wp * dv
       t = s%t
       t_lo = s%t_lo
@@ -265,11 +254,7 @@ contains
       do while (n_bulk > 0)
         ! In runs of up to the next progress report.
         n = min(n_bulk, 4096_int64 - iand(stats%steps, 4095_int64))
-        do j = 1, n
-          call accumulate(t, t_lo, h)
-          call accumulate(x, x_lo, h * ((v + v_lo) + half_dv))
-          call accumulate(v, v_lo, dv)
-        end do
+        call constant_steps(n, h, dv, half_dv, t, t_lo, x, x_lo, v, v_lo)
         n_bulk = n_bulk - n
         stats%steps = stats%steps + n
         if (iand(stats%steps, 4095_int64) == 0) call sink%progress(t, scene%t_end)
@@ -288,7 +273,7 @@ contains
         h = step_toward(t_stop)
         if (h <= 0.0_wp .or. s%t + h >= t_quiet) exit
         at_stop = h == (t_stop - s%t) - s%t_lo
-        call advance_constant(s, h)
+        call rk%advance_constant(s, h)
         stats%steps = stats%steps + 1
         if (iand(stats%steps, 4095_int64) == 0) call sink%progress(s%t, scene%t_end)
         if (at_stop) then
@@ -297,7 +282,7 @@ contains
           exit
         end if
       end do
-      call book_constant_ledger(start, s)
+      call book_constant_ledger(scene, mode, start, s)
       call check_finite()
     end subroutine glide
 
@@ -306,69 +291,8 @@ contains
         ': the state is no longer finite')
     end subroutine check_finite
 
-    !> One step of the mode under constant acceleration: RK4 is exact there, and its step is
-    !> the quadratic x + h v + h^2 a / 2, v + h a.
-    pure subroutine advance_constant(state, step)
-      type(state_type), intent(inout) :: state
-      real(wp), intent(in) :: step
-      call add_compensated(state%t, state%t_lo, step)
-      call add_compensated(state%x, state%x_lo, step * ((state%v + state%v_lo) + &
-        (0.5_wp * step) * constant_acceleration))
-      call add_compensated(state%v, state%v_lo, step * constant_acceleration)
-    end subroutine advance_constant
 
-    !> Under constant forces the work and the friction loss over any stretch of one mode are
-    !> the forces times the displacement, exactly (no quadrature).
-    subroutine book_constant_ledger(a, b)
-      type(state_type), intent(in) :: a
-      type(state_type), intent(inout) :: b
-      real(wp) :: dx(2)
-      dx = (b%x - a%x) + (b%x_lo - a%x_lo)
-      call add_compensated(b%work, b%work_lo, dot_product(scene%forcing%constant, dx))
-      call add_compensated(b%friction_loss, b%friction_lo, -dot_product(mode%f_slide, dx))
-    end subroutine book_constant_ledger
 
-    !> One classical RK4 step of the mode's equations from a to b; the energy ledger by
-    !> Simpson's rule on the step's Hermite velocity, exact where RK4 is (polynomial forcing).
-    subroutine rk4_step(a, step, b)
-      type(state_type), intent(in) :: a
-      real(wp), intent(in) :: step
-      type(state_type), intent(inout) :: b     ! all of it is set (inout: no default init)
-      real(wp) :: f0(2), fm(2), f1(2), a0(2), am(2), a1(2)
-      real(wp) :: v0(2), vm(2)
-      b = a
-      if (constant_forcing) then
-        ! The mode's acceleration was worked out once, at the event point.
-        call advance_constant(b, step)
-        call book_constant_ledger(a, b)
-        return
-      end if
-      ! A step's end force is the next step's start force: evaluated once (a sine costs).
-      call add_compensated(b%t, b%t_lo, step)
-      if (a%t == end_force_t) then
-        f0 = end_force
-      else
-        f0 = scene%forcing%force(a%t)
-      end if
-      fm = scene%forcing%force(a%t + 0.5_wp * step)
-      f1 = scene%forcing%force(b%t)
-      end_force_t = b%t
-      end_force = f1
-      ! Within a mode the acceleration depends on time only, so stages 2 and 3 share it.
-      a0 = mode%acceleration(f0)
-      am = mode%acceleration(fm)
-      a1 = mode%acceleration(f1)
-      ! RK4's stages collapse (the acceleration does not depend on the state): x gains
-      ! h v + h^2/6 (a0 + 2 am) and v gains h/6 (a0 + 4 am + a1).
-      v0 = a%v + a%v_lo
-      call add_compensated(b%x, b%x_lo, step * (v0 + (step / 6.0_wp) * (a0 + 2.0_wp * am)))
-      call add_compensated(b%v, b%v_lo, (step / 6.0_wp) * (a0 + 4.0_wp * am + a1))
-      vm = 0.5_wp * (a%v + b%v) + 0.125_wp * step * (a0 - a1)
-      call add_compensated(b%work, b%work_lo, step / 6.0_wp * (dot_product(f0, a%v) + &
-        4.0_wp * dot_product(fm, vm) + dot_product(f1, b%v)))
-      call add_compensated(b%friction_loss, b%friction_lo, step / 6.0_wp * &
-        dot_product(-mode%f_slide, a%v + 4.0_wp * vm + b%v))
-    end subroutine rk4_step
 
     !> Earliest event in (0, step]: a gap closing, a sliding body stopping, a mode condition
     !> failing. watched = k for contact k, 100 + i for body i, -1 for a mode condition.
@@ -390,15 +314,15 @@ contains
         if (a%t + step < quiet_until(k)) cycle
         if (.not. have_dense) c = dense_output(a, b, step)
         have_dense = .true.
-        p(0) = gap(k, a)
+        p(0) = gap(scene, k, a)
         p(1:3) = normal(1, k) * c(:, 1) + normal(2, k) * c(:, 2)
         ! The common case first: the gap cannot reach zero within the step.
         if (p(0) - step * (abs(p(1)) + step * (abs(p(2)) + step * abs(p(3)))) > 0.0_wp) cycle
         ! Only a gap that may close needs the forces' rounding (a sine costs two evaluations).
         if (.not. have_acc_rounding) acc_rounding = 1.0e3_wp * eps_wp * &
-          force_scale(scene%forcing%force(a%t), scene%forcing%rate(a%t)) / scene%mass
+          force_scale(scene, scene%forcing%force(a%t), scene%forcing%rate(a%t)) / scene%mass
         have_acc_rounding = .true.
-        candidate = earliest_crossing(p, step, gap_tolerance_along(k, a, c, acc_rounding))
+        candidate = earliest_crossing(p, step, gap_tolerance_along(scene, k, a, c, acc_rounding))
         if (candidate < theta) then
           theta = candidate
           which = k
@@ -419,7 +343,7 @@ contains
         end if
       end do
       ! Under constant forces the mode's conditions are constant: they held when it began.
-      if (mode%n_hold > 0 .and. .not. constant_forcing) then
+      if (mode%n_hold > 0 .and. .not. rk%constant_forcing) then
         candidate = hold_crossing(a%t, step)
         if (candidate < theta) then
           theta = candidate
@@ -428,14 +352,6 @@ contains
       end if
     end subroutine locate
 
-    !> The step's dense output: Hermite coefficients of both bodies' displacements.
-    pure function dense_output(a, b, step) result(c)
-      type(state_type), intent(in) :: a, b
-      real(wp), intent(in) :: step
-      real(wp) :: c(3, 2)
-      c(:, 1) = hermite((b%x(1) - a%x(1)) + (b%x_lo(1) - a%x_lo(1)), a%v(1), b%v(1), step)
-      c(:, 2) = hermite((b%x(2) - a%x(2)) + (b%x_lo(2) - a%x_lo(2)), a%v(2), b%v(2), step)
-    end function dense_output
 
     !> Earliest time in [0, step] at which a condition of the mode (a contact force, a static
     !> friction margin) has turned negative. They depend on time only: linear within a step under
@@ -483,16 +399,10 @@ contains
 
     real(wp) function hold_tolerance(t)
       real(wp), intent(in) :: t
-      hold_tolerance = 1.0e3_wp * eps_wp * force_scale(scene%forcing%force(t), scene%forcing%rate(t)) &
+      hold_tolerance = 1.0e3_wp * eps_wp * force_scale(scene, scene%forcing%force(t), scene%forcing%rate(t)) &
         + tiny(1.0_wp)
     end function hold_tolerance
 
-    !> Size of the forces around an instant, for rounding tolerances: a force crossing zero
-    !> is still as large as what a step changes it by.
-    pure real(wp) function force_scale(f, df)
-      real(wp), intent(in) :: f(2), df(2)
-      force_scale = sum(abs(f)) + 2.0_wp * sum(scene%friction) + sum(abs(df)) * scene%dt
-    end function force_scale
 
     !> Re-take the step to the located time and polish it by Newton's method on the watched
     !> function evaluated on the integrator's own state: under polynomial forcing the dense
@@ -505,7 +415,7 @@ contains
       real(wp) :: value, slope, tol, acc(2), located_step
       integer :: iteration
       located_step = step
-      call rk4_step(a, step, b)
+      call rk%step(scene, mode, a, step, b)
       if (which <= 0) return
       do iteration = 1, 8
         if (which > 100) then
@@ -514,15 +424,15 @@ contains
           slope = acc(which - 100)
           tol = velocity_rounding * max(abs(a%v(which - 100)), abs(value))
         else
-          value = gap(which, b)
+          value = gap(scene, which, b)
           slope = normal_velocity(which, b%v)
-          tol = gap_tolerance(which, b, displacement(which, a, b))
+          tol = gap_tolerance(scene, which, b, displacement(which, a, b))
         end if
         if (abs(value) <= tol .or. slope == 0.0_wp) exit
         ! Newton stays inside the step that was located, or the clock could pass a stop.
         if (step - value / slope <= 0.0_wp .or. step - value / slope > located_step) exit
         step = step - value / slope
-        call rk4_step(a, step, b)
+        call rk%step(scene, mode, a, step, b)
       end do
     end subroutine refine
 
@@ -533,7 +443,7 @@ contains
       impact_due = .false.
       do k = 1, n_contacts
         if (.not. scene%has_contact(k) .or. mode%active(k)) cycle
-        if (gap(k, s) <= gap_tolerance(k, s, 0.0_wp) .and. normal_velocity(k, s%v) < -u_tolerance(k)) &
+        if (gap(scene, k, s) <= gap_tolerance(scene, k, s, 0.0_wp) .and. normal_velocity(k, s%v) < -u_tolerance(k)) &
           impact_due = .true.
       end do
     end function impact_due
@@ -548,7 +458,7 @@ contains
       constraints_hold = .true.
       do k = 1, n_contacts
         if (.not. scene%has_contact(k) .or. mode%active(k) .or. k == located_contact) cycle
-        if (gap(k, b) < -gap_tolerance(k, b, displacement(k, s, b))) constraints_hold = .false.
+        if (gap(scene, k, b) < -gap_tolerance(scene, k, b, displacement(k, s, b))) constraints_hold = .false.
       end do
       do i = 1, 2
         if (scene%friction(i) == 0.0_wp .or. mode%sgn(i) == 0.0_wp) cycle
@@ -557,84 +467,11 @@ contains
       end do
     end function constraints_hold
 
-    !> Gap k of a state, exact to its own size: x2 - x1 is formed without rounding (two-sum),
-    !> and subtracting a limit it is close to is exact, so the slot is resolved like a wall.
-    pure real(wp) function gap(k, state)
-      integer, intent(in) :: k
-      type(state_type), intent(in) :: state
-      real(wp) :: a, b, total, rounded
-      a = normal(1, k) * state%x(1)
-      b = normal(2, k) * state%x(2)
-      total = a + b
-      rounded = total - a
-      gap = (total + scene%offset(k)) + (((a - (total - rounded)) + (b - rounded)) + &
-        dot_product(normal(:, k), state%x_lo))
-    end function gap
-
-    !> Rounding level of gap k. A gap is exact to its own size (compensated positions, exact
-    !> differences) up to the rounding of the low parts, so only that and what a step moved
-    !> it by count. A gap closing within the clock's
-    !> resolution is closed now: this is what makes contacts hit at the same instant one
-    !> event, while a tiny flight elsewhere keeps its own time.
-    pure real(wp) function gap_tolerance(k, state, moved)
-      integer, intent(in) :: k
-      type(state_type), intent(in) :: state
-      real(wp), intent(in) :: moved
-      gap_tolerance = gap_rounding * (moved + dot_product(abs(normal(:, k)), abs(state%x_lo))) + &
-        time_rounding * max(abs(state%t), scene%dt) * max(0.0_wp, -normal_velocity(k, state%v))
-    end function gap_tolerance
-
-    !> gap_tolerance along a step from state a with dense output c, as a polynomial in theta:
-    !> what the step has moved the gap by at theta (each body's displacement), not by the
-    !> step's end, so a gap closing early in a long step is not lost in the rounding of
-    !> the whole step's motion; and the gap's curvature only to the rounding of the forces
-    !> (acc_rounding per body), so a contact released with a rounding-level acceleration
-    !> back into it (a force ramp through its bound) does not close again at once.
-    pure function gap_tolerance_along(k, a, c, acc_rounding) result(q)
-      integer, intent(in) :: k
-      type(state_type), intent(in) :: a
-      real(wp), intent(in) :: c(3, 2), acc_rounding(2)
-      real(wp) :: q(0:3)
-      q(0) = gap_tolerance(k, a, 0.0_wp)
-      q(1:3) = gap_rounding * (abs(normal(1, k)) * abs(c(:, 1)) + abs(normal(2, k)) * abs(c(:, 2)))
-      q(2) = q(2) + 0.5_wp * dot_product(abs(normal(:, k)), acc_rounding)
-    end function gap_tolerance_along
-
-    !> How far a step from a to b moved gap k (through either body).
-    pure real(wp) function displacement(k, a, b)
-      integer, intent(in) :: k
-      type(state_type), intent(in) :: a, b
-      displacement = dot_product(abs(normal(:, k)), abs((b%x - a%x) + (b%x_lo - a%x_lo)))
-    end function displacement
 
 
-    !> Put a closed contact exactly on its constraint (gap = 0, no roundoff penetration).
-    subroutine snap(k, closed)
-      integer, intent(in) :: k
-      logical, intent(in) :: closed(n_contacts)
-      real(wp) :: limit
-      select case (k)
-      case (1)
-        s%x(1) = -scene%offset(1)
-        s%x_lo(1) = 0.0_wp
-      case (2)
-        s%x(2) = scene%offset(2)
-        s%x_lo(2) = 0.0_wp
-      case (3, 4)
-        ! Move the body that no wall holds.
-        ! x2 = x1 + d exactly, the sum's rounding kept in the low part.
-        limit = merge(-scene%offset(3), scene%offset(4), k == 3)
-        if (closed(2)) then
-          s%x(1) = s%x(2)
-          s%x_lo(1) = s%x_lo(2)
-          call add_compensated(s%x(1), s%x_lo(1), -limit)
-        else
-          s%x(2) = s%x(1)
-          s%x_lo(2) = s%x_lo(1)
-          call add_compensated(s%x(2), s%x_lo(2), limit)
-        end if
-      end select
-    end subroutine snap
+
+
+
 
     !> Everything that happens at one instant: closed contacts snapped, impacts resolved by
     !> sequential impulses, unresolvable bounce series put to rest (Zeno), stopped bodies
@@ -653,10 +490,10 @@ contains
       df = scene%forcing%rate(s%t)
       do k = 1, n_contacts
         closed(k) = scene%has_contact(k)
-        if (closed(k)) closed(k) = k == which .or. gap(k, s) <= gap_tolerance(k, s, 0.0_wp)
+        if (closed(k)) closed(k) = k == which .or. gap(scene, k, s) <= gap_tolerance(scene, k, s, 0.0_wp)
         ! The user's numbers carry their decimal rounding (7.553 - 7.122 is not 0.431): at the
         ! start, a gap within it is contact, as the validator accepted it.
-        if (initial .and. scene%has_contact(k)) closed(k) = closed(k) .or. gap(k, s) <= &
+        if (initial .and. scene%has_contact(k)) closed(k) = closed(k) .or. gap(scene, k, s) <= &
           gap_rounding * max(maxval(abs(normal(:, k) * s%x)), abs(scene%offset(k)))
       end do
       ! A rigid link (d_min = d_max) is one constraint seen from both sides.
@@ -667,7 +504,7 @@ contains
         end if
       end if
       do k = 1, n_contacts
-        if (closed(k)) call snap(k, closed)
+        if (closed(k)) call snap(scene, k, closed, s)
       end do
       ! A sliding body whose stop was located, or that stopped within rounding (its velocity
       ! change over a step is the scale), is at rest.
@@ -739,7 +576,7 @@ contains
       end do
 
       call candidates(closed, candidate, resting, moving_sign)
-      call solve_mode(scene, f, df, candidate, resting, moving_sign, new_mode, found, force_scale(f, df))
+      call solve_mode(scene, f, df, candidate, resting, moving_sign, new_mode, found, force_scale(scene, f, df))
       if (.not. found) then
         call raise(error, status_simulation, 'at t = ' // fmt(s%t) // &
           ': no consistent contact and friction state (complementarity problem has no solution)')
@@ -749,7 +586,7 @@ contains
       ! Log what a user can see change: contacts that start or stop holding, bodies that
       ! come to rest or break away.
       acc = new_mode%acceleration(f)
-      tol_a = 1.0e3_wp * eps_wp * force_scale(f, df) / scene%mass
+      tol_a = 1.0e3_wp * eps_wp * force_scale(scene, f, df) / scene%mass
       do k = 1, n_contacts
         if (new_mode%active(k) .and. .not. in_contact(k)) then
           call begin_rest(k, s%t)
@@ -782,7 +619,7 @@ contains
         ! (a chain of impacts ending there) never left rest: no stick (its leaving was not
         ! logged either).
         if (resting_now .and. .not. at_rest(i) .and. .not. initial .and. &
-            .not. same_instant(s%t, rest_lost_time(i))) call log_event(event_stick + i, s%v, s%v)
+            .not. same_instant(scene, s%t, rest_lost_time(i))) call log_event(event_stick + i, s%v, s%v)
         if (.not. resting_now .and. at_rest(i)) then
           if (s%v(i) == 0.0_wp) then
             call log_event(event_slip + i, s%v, s%v)
@@ -795,8 +632,8 @@ contains
       mode = new_mode
       entry_scale = 0.0_wp
       quiet_until = -huge(1.0_wp)
-      if (constant_forcing) then
-        constant_acceleration = mode%acceleration(scene%forcing%constant)
+      if (rk%constant_forcing) then
+        rk%constant_acceleration = mode%acceleration(scene%forcing%constant)
         call find_quiet_times()
       end if
       watching = mode%n_hold > 0 .or. any(scene%has_contact .and. .not. mode%active) .or. &
@@ -845,7 +682,7 @@ contains
       if (in_contact(k)) return
       in_contact(k) = .true.
       if (release_time(k) < huge(1.0_wp)) then
-        if (same_instant(s%t, release_time(k))) then
+        if (same_instant(scene, s%t, release_time(k))) then
           release_time(k) = huge(1.0_wp)
           return
         end if
@@ -859,11 +696,6 @@ contains
       end if
     end subroutine begin_rest
 
-    !> Instants closer than the clock resolves are one (t_later >= t_earlier).
-    pure logical function same_instant(t_later, t_earlier)
-      real(wp), intent(in) :: t_later, t_earlier
-      same_instant = t_later - t_earlier <= time_rounding * max(abs(t_later), scene%dt)
-    end function same_instant
 
     !> Log the releases decided at an earlier instant (all of them with everything).
     subroutine flush_releases(everything)
@@ -871,7 +703,7 @@ contains
       integer :: k
       do k = 1, n_contacts
         if (release_time(k) == huge(1.0_wp)) cycle
-        if (.not. everything .and. same_instant(s%t, release_time(k))) cycle
+        if (.not. everything .and. same_instant(scene, s%t, release_time(k))) cycle
         stats%events(event_release + k) = stats%events(event_release + k) + 1
         call sink%put_event(release_time(k), event_release + k, release_v(:, k), release_v(:, k))
         release_time(k) = huge(1.0_wp)
@@ -887,13 +719,13 @@ contains
       quiet_until = huge(1.0_wp)     ! what is not watched needs no location
       do k = 1, n_contacts
         if (.not. scene%has_contact(k) .or. mode%active(k)) cycle
-        quiet_until(k) = s%t + 0.99_wp * first_negative(gap(k, s), normal_velocity(k, s%v), &
-          dot_product(normal(:, k), constant_acceleration))
+        quiet_until(k) = s%t + 0.99_wp * first_negative(gap(scene, k, s), normal_velocity(k, s%v), &
+          dot_product(normal(:, k), rk%constant_acceleration))
       end do
       do i = 1, 2
         if (scene%friction(i) == 0.0_wp .or. mode%sgn(i) == 0.0_wp) cycle
         quiet_until(n_contacts + i) = s%t + 0.99_wp * first_negative(mode%sgn(i) * s%v(i), &
-          mode%sgn(i) * constant_acceleration(i), 0.0_wp)
+          mode%sgn(i) * rk%constant_acceleration(i), 0.0_wp)
       end do
     end subroutine find_quiet_times
 
@@ -921,11 +753,6 @@ contains
       if (tau /= tau) tau = 0.0_wp
     end function first_negative
 
-    !> Both slot limits closed on a rigid link (d_min = d_max): the bodies are one.
-    pure logical function rigid_pair(closed)
-      logical, intent(in) :: closed(n_contacts)
-      rigid_pair = closed(i_slot_min) .and. closed(i_slot_max)
-    end function rigid_pair
 
     !> Normal acceleration of contact k with k left free and the others as they are.
     real(wp) function free_gap_acceleration(k, v, f, df, closed) result(a_gap)
@@ -940,7 +767,7 @@ contains
       call candidates(closed, candidate, resting, moving_sign)
       s%v = v_saved
       candidate(k) = .false.
-      call solve_mode(scene, f, df, candidate, resting, moving_sign, free_mode, found, force_scale(f, df))
+      call solve_mode(scene, f, df, candidate, resting, moving_sign, free_mode, found, force_scale(scene, f, df))
       a_gap = 0.0_wp
       if (found) a_gap = dot_product(normal(:, k), free_mode%acceleration(f))
     end function free_gap_acceleration
@@ -1003,41 +830,8 @@ contains
       tol = [(u_tolerance(k), k = 1, n_contacts)]
     end function u_tolerances
 
-    !> hi + lo += increment: the exact rounding error of hi + increment (Knuth's two-sum, valid
-    !> whichever is larger) goes into lo; then hi takes what of lo it can hold (Fast2Sum), so
-    !> hi alone is the sum correctly rounded (event times and samples read hi) and lo stays
-    !> below half an ulp of it.
-    elemental subroutine add_compensated(hi, lo, increment)
-      real(wp), intent(inout) :: hi, lo
-      real(wp), intent(in) :: increment
-      call accumulate(hi, lo, increment)
-      call renormalise(hi, lo)
-    end subroutine add_compensated
 
-    !> hi += increment, its exact rounding error (two-sum) into lo; hi + lo is the sum.
-    elemental subroutine accumulate(hi, lo, increment)
-      real(wp), intent(inout) :: hi, lo
-      real(wp), intent(in) :: increment
-      real(wp) :: total, rounded
-      total = hi + increment
-      rounded = total - hi
-      lo = lo + ((hi - (total - rounded)) + (increment - rounded))
-      hi = total
-    end subroutine accumulate
 
-    !> hi becomes hi + lo correctly rounded and lo what is left (Fast2Sum, exact while |lo| is
-    !> below |hi|, as it is but for a sum passing through zero).
-    elemental subroutine renormalise(hi, lo)
-      real(wp), intent(inout) :: hi, lo
-      real(wp) :: total
-      total = hi + lo
-      lo = lo - (total - hi)
-      hi = total
-    end subroutine renormalise
 
-    pure logical function finite_state(state)
-      type(state_type), intent(in) :: state
-      finite_state = all(abs([state%x, state%v, state%work]) <= huge(1.0_wp))
-    end function finite_state
   end subroutine run
 end module impact1d_solver
