@@ -5,10 +5,11 @@ module impact1d_contacts
   use impact1d_scene, only: scene_type, n_contacts, normal, i_slot_min, i_slot_max
   use impact1d_impacts, only: normal_velocity
   use impact1d_state, only: state_type, add_compensated
-  use impact1d_yardsticks, only: gap_rounding, time_rounding
+  use impact1d_yardsticks, only: gap_rounding, time_rounding, velocity_rounding
+  use impact1d_modes, only: mode_type
   implicit none
   private
-  public :: gap, gap_tolerance, gap_tolerance_along, displacement, snap, rigid_pair
+  public :: gap, gap_tolerance, gap_tolerance_along, displacement, snap, rigid_pair, u_tolerance
 
 contains
 
@@ -100,4 +101,19 @@ contains
     logical, intent(in) :: closed(n_contacts)
     rigid_pair = closed(i_slot_min) .and. closed(i_slot_max)
   end function rigid_pair
+
+  !> Rounding level of contact k's normal velocity: from the speeds of the bodies it
+  !> involves and what a step changes them by, so a slow body is not judged by a fast one;
+  !> within an event point, not below the speeds it started from (entry_scale, else 0).
+  pure real(wp) function u_tolerance(scene, mode, s, k, entry_scale)
+    type(scene_type), intent(in) :: scene
+    type(mode_type), intent(in) :: mode
+    type(state_type), intent(in) :: s
+    integer, intent(in) :: k
+    real(wp), intent(in) :: entry_scale(2)
+    real(wp) :: acc(2)
+    acc = mode%acceleration(scene%forcing%force(s%t))
+    u_tolerance = velocity_rounding * dot_product(abs(normal(:, k)), &
+      max(abs(s%v) + abs(acc) * scene%dt, entry_scale))
+  end function u_tolerance
 end module impact1d_contacts

@@ -14,6 +14,8 @@ module impact1d_stepping
   type :: rk4_type
     !> No table, no sine: the forces are constant and so is each mode's acceleration.
     logical :: constant_forcing = .false.
+    !> Tables and constants: the dense output is exact, so no root can be missed.
+    logical :: polynomial_forcing = .false.
     !> The mode's acceleration under constant forces, worked out once at the event point.
     real(wp) :: constant_acceleration(2) = 0.0_wp
     !> The force at the end of the last step taken, and when: the next step's start force.
