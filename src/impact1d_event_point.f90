@@ -27,13 +27,13 @@ contains
   !> The event point at s%t. which: what the location found (contact k, 100 + body i, -1 a
   !> mode condition) or 0; initial: the start of the run (no mode yet). Leaves the new mode,
   !> what it needs watched and the integrator's constant acceleration set.
-  subroutine event_point(scene, initial, which, s, mode, log, watch, rk, sink, stats, error)
+  subroutine event_point(scene, initial, which, s, mode, event_log, watch, rk, sink, stats, error)
     type(scene_type), intent(in) :: scene
     logical, intent(in) :: initial
     integer, intent(in) :: which
     type(state_type), intent(inout) :: s
     type(mode_type), intent(inout) :: mode
-    type(event_log_type), intent(inout) :: log
+    type(event_log_type), intent(inout) :: event_log
     type(watch_type), intent(inout) :: watch
     type(rk4_type), intent(inout) :: rk
     class(sink_type), intent(inout) :: sink
@@ -123,7 +123,7 @@ contains
     ! rest now; the rest is logged at the series' accumulation time.
     do k = 1, n_contacts
       if (.not. closed(k)) cycle
-      call settle_bounce_series(scene, mode, k, f, df, closed, entry_scale, s, log, sink, stats)
+      call settle_bounce_series(scene, mode, k, f, df, closed, entry_scale, s, event_log, sink, stats)
     end do
 
     ! Impulses can leave a rounding-level velocity on a body that had stopped; it is zero.
@@ -146,7 +146,7 @@ contains
       return
     end if
 
-    call log_mode_change(scene, initial, f, df, candidate, new_mode, s, log, sink, stats)
+    call log_mode_change(scene, initial, f, df, candidate, new_mode, s, event_log, sink, stats)
     mode = new_mode
     watch%quiet_until = -huge(1.0_wp)
     if (rk%constant_forcing) then
@@ -159,13 +159,13 @@ contains
 
   !> Log what a user can see change between the old mode and new_mode: contacts that start
   !> or stop holding, bodies that come to rest or break away.
-  subroutine log_mode_change(scene, initial, f, df, candidate, new_mode, s, log, sink, stats)
+  subroutine log_mode_change(scene, initial, f, df, candidate, new_mode, s, event_log, sink, stats)
     type(scene_type), intent(in) :: scene
     logical, intent(in) :: initial, candidate(n_contacts)
     real(wp), intent(in) :: f(2), df(2)
     type(mode_type), intent(in) :: new_mode
     type(state_type), intent(in) :: s
-    type(event_log_type), intent(inout) :: log
+    type(event_log_type), intent(inout) :: event_log
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
     real(wp) :: acc(2), tol_a(2), acc_rate(2)
@@ -175,22 +175,22 @@ contains
     acc = new_mode%acceleration(f)
     tol_a = 1.0e3_wp * eps_wp * force_scale(scene, f, df) / scene%mass
     do k = 1, n_contacts
-      if (new_mode%active(k) .and. .not. log%in_contact(k)) then
-        call log%begin_rest(scene, k, s%t, s%t, s%v, sink, stats)
-      else if (log%in_contact(k) .and. .not. new_mode%active(k)) then
+      if (new_mode%active(k) .and. .not. event_log%in_contact(k)) then
+        call event_log%begin_rest(scene, k, s%t, s%t, s%v, sink, stats)
+      else if (event_log%in_contact(k) .and. .not. new_mode%active(k)) then
         if (.not. candidate(k) .or. dot_product(normal(:, k), acc) > dot_product(abs(normal(:, k)), tol_a) .or. &
             (dot_product(normal(:, k), acc) >= -dot_product(abs(normal(:, k)), tol_a) .and. &
             dot_product(normal(:, k), matmul(new_mode%gain, df)) > 1.0e3_wp * eps_wp * sum(abs(df)) / &
             minval(scene%mass))) then
-          if (log%pending_rest(k) < huge(1.0_wp)) then
+          if (event_log%pending_rest(k) < huge(1.0_wp)) then
             call log_event(sink, stats, s%t, event_rest + k, s%v, s%v)
-            log%pending_rest(k) = huge(1.0_wp)
+            event_log%pending_rest(k) = huge(1.0_wp)
           end if
           ! Logged once time has moved on: a contact that closes again at this same
           ! instant never opened (rounding-level relabelling), and neither entry is kept.
-          log%in_contact(k) = .false.
-          log%release_time(k) = s%t
-          log%release_v(:, k) = s%v
+          event_log%in_contact(k) = .false.
+          event_log%release_time(k) = s%t
+          event_log%release_v(:, k) = s%v
         end if
       end if
     end do
@@ -205,17 +205,17 @@ contains
       ! A body that impulses moved off its rest and that stops again at that same instant
       ! (a chain of impacts ending there) never left rest: no stick (its leaving was not
       ! logged either).
-      if (resting_now .and. .not. log%at_rest(i) .and. .not. initial .and. &
-          .not. same_instant(scene, s%t, log%rest_lost_time(i))) &
+      if (resting_now .and. .not. event_log%at_rest(i) .and. .not. initial .and. &
+          .not. same_instant(scene, s%t, event_log%rest_lost_time(i))) &
         call log_event(sink, stats, s%t, event_stick + i, s%v, s%v)
-      if (.not. resting_now .and. log%at_rest(i)) then
+      if (.not. resting_now .and. event_log%at_rest(i)) then
         if (s%v(i) == 0.0_wp) then
           call log_event(sink, stats, s%t, event_slip + i, s%v, s%v)
         else
-          log%rest_lost_time(i) = s%t
+          event_log%rest_lost_time(i) = s%t
         end if
       end if
-      log%at_rest(i) = resting_now
+      event_log%at_rest(i) = resting_now
     end do
   end subroutine log_mode_change
 
@@ -224,14 +224,14 @@ contains
   !> the velocities now and with the normal velocity reversed (friction may change sides).
   !> If what remains of the series is below the clock's resolution, the contact rests now,
   !> logged at the series' accumulation time.
-  subroutine settle_bounce_series(scene, mode, k, f, df, closed, entry_scale, s, log, sink, stats)
+  subroutine settle_bounce_series(scene, mode, k, f, df, closed, entry_scale, s, event_log, sink, stats)
     type(scene_type), intent(in) :: scene
     type(mode_type), intent(in) :: mode
     integer, intent(in) :: k
     real(wp), intent(in) :: f(2), df(2), entry_scale(2)
     logical, intent(in) :: closed(n_contacts)
     type(state_type), intent(inout) :: s
-    type(event_log_type), intent(inout) :: log
+    type(event_log_type), intent(inout) :: event_log
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
     real(wp) :: u, a_up, a_down, remaining
@@ -247,9 +247,9 @@ contains
     if (remaining > time_rounding * max(abs(s%t), scene%dt)) return
     call apply(scene, s, impulse(scene, k, 0.0_wp, s%v, rigid_pair(closed)))
     if (remaining < huge(1.0_wp)) then
-      call log%begin_rest(scene, k, s%t, s%t + remaining, s%v, sink, stats)
+      call event_log%begin_rest(scene, k, s%t, s%t + remaining, s%v, sink, stats)
     else
-      call log%begin_rest(scene, k, s%t, s%t, s%v, sink, stats)
+      call event_log%begin_rest(scene, k, s%t, s%t, s%v, sink, stats)
     end if
   end subroutine settle_bounce_series
 

@@ -44,7 +44,7 @@ contains
     type(mode_type) :: mode
     type(rk4_type) :: rk
     type(watch_type) :: watch
-    type(event_log_type) :: log
+    type(event_log_type) :: event_log
     real(wp) :: ke0, t_stop, t_break, t_rest, sample_t, t_last_event
     logical :: located, at_stop, glided, event_due
     integer :: j_sample, stalls, watched, event_points
@@ -63,7 +63,7 @@ contains
     stalls = 0
     t_last_event = -huge(1.0_wp)
 
-    call event_point(scene, .true., 0, s, mode, log, watch, rk, sink, stats, error)
+    call event_point(scene, .true., 0, s, mode, event_log, watch, rk, sink, stats, error)
     if (allocated(error)) return
     j_sample = 0
     call emit(scene, s, ke0, j_sample, sink, stats)
@@ -73,7 +73,7 @@ contains
       ! Step: to the next sample, table corner or accumulation time, whichever is first.
       sample_t = sample_time(scene, j_sample)
       if (t_break <= s%t) t_break = scene%forcing%next_breakpoint(s%t)
-      t_rest = minval(log%pending_rest)
+      t_rest = minval(event_log%pending_rest)
       t_stop = min(sample_t, t_break, t_rest)
 
       located = .false.
@@ -107,23 +107,23 @@ contains
           stalls = 0
         end if
         t_last_event = s%t
-        call log%flush_releases(scene, s%t, .false., sink, stats)
+        call event_log%flush_releases(scene, s%t, .false., sink, stats)
         event_points = event_points + 1
         if (event_points > max_event_points) then
           call raise(error, status_simulation, 'at t = ' // fmt(s%t) // ': more than ' // fmt(max_event_points) // &
             ' events (a bounce that never settles, such as r = 1 under a pressing force, makes them without end)')
           return
         end if
-        call log%flush_pending_rest(s%t, s%v, sink, stats)
+        call event_log%flush_pending_rest(s%t, s%v, sink, stats)
         ! The event point: impacts, rest, the new mode, the log.
-        call event_point(scene, .false., merge(watched, 0, located), s, mode, log, watch, rk, &
+        call event_point(scene, .false., merge(watched, 0, located), s, mode, event_log, watch, rk, &
           sink, stats, error)
         if (allocated(error)) return
       end if
       ! Emit.
       if (at_stop .and. s%t == sample_t) call emit(scene, s, ke0, j_sample, sink, stats)
     end do
-    call log%flush_releases(scene, s%t, .true., sink, stats)
+    call event_log%flush_releases(scene, s%t, .true., sink, stats)
     call sink%end_progress()
   end subroutine run
 
