@@ -1,0 +1,119 @@
+!> The contacts' geometry (METHOD.md 2): gaps exact to their own size, their rounding
+!> levels, and putting a closed contact exactly on its constraint.
+module impact1d_contacts
+  use impact1d_kinds, only: wp
+  use impact1d_scene, only: scene_type, n_contacts, normal, i_slot_min, i_slot_max
+  use impact1d_impacts, only: normal_velocity
+  use impact1d_state, only: state_type, add_compensated
+  use impact1d_yardsticks, only: gap_rounding, time_rounding, velocity_rounding
+  use impact1d_modes, only: mode_type
+  implicit none
+  private
+  public :: gap, gap_tolerance, gap_tolerance_along, displacement, snap, rigid_pair, u_tolerance
+
+contains
+
+  !> Gap k of a state, exact to its own size: x2 - x1 is formed without rounding (two-sum),
+  !> and subtracting a limit it is close to is exact, so the slot is resolved like a wall.
+  pure real(wp) function gap(scene, k, state)
+    type(scene_type), intent(in) :: scene
+    integer, intent(in) :: k
+    type(state_type), intent(in) :: state
+    real(wp) :: a, b, total, rounded
+    a = normal(1, k) * state%x(1)
+    b = normal(2, k) * state%x(2)
+    total = a + b
+    rounded = total - a
+    gap = (total + scene%offset(k)) + (((a - (total - rounded)) + (b - rounded)) + &
+      dot_product(normal(:, k), state%x_lo))
+  end function gap
+
+  !> Rounding level of gap k. A gap is exact to its own size (compensated positions, exact
+  !> differences) up to the rounding of the low parts, so only that and what a step moved
+  !> it by count. A gap closing within the clock's
+  !> resolution is closed now: this is what makes contacts hit at the same instant one
+  !> event, while a tiny flight elsewhere keeps its own time.
+  pure real(wp) function gap_tolerance(scene, k, state, moved)
+    type(scene_type), intent(in) :: scene
+    integer, intent(in) :: k
+    type(state_type), intent(in) :: state
+    real(wp), intent(in) :: moved
+    gap_tolerance = gap_rounding * (moved + dot_product(abs(normal(:, k)), abs(state%x_lo))) + &
+      time_rounding * max(abs(state%t), scene%dt) * max(0.0_wp, -normal_velocity(k, state%v))
+  end function gap_tolerance
+
+  !> gap_tolerance along a step from state a with dense output c, as a polynomial in theta:
+  !> what the step has moved the gap by at theta (each body's displacement), not by the
+  !> step's end, so a gap closing early in a long step is not lost in the rounding of
+  !> the whole step's motion; and the gap's curvature only to the rounding of the forces
+  !> (acc_rounding per body), so a contact released with a rounding-level acceleration
+  !> back into it (a force ramp through its bound) does not close again at once.
+  pure function gap_tolerance_along(scene, k, a, c, acc_rounding) result(q)
+    type(scene_type), intent(in) :: scene
+    integer, intent(in) :: k
+    type(state_type), intent(in) :: a
+    real(wp), intent(in) :: c(3, 2), acc_rounding(2)
+    real(wp) :: q(0:3)
+    q(0) = gap_tolerance(scene, k, a, 0.0_wp)
+    q(1:3) = gap_rounding * (abs(normal(1, k)) * abs(c(:, 1)) + abs(normal(2, k)) * abs(c(:, 2)))
+    q(2) = q(2) + 0.5_wp * dot_product(abs(normal(:, k)), acc_rounding)
+  end function gap_tolerance_along
+
+  !> How far a step from a to b moved gap k (through either body).
+  pure real(wp) function displacement(k, a, b)
+    integer, intent(in) :: k
+    type(state_type), intent(in) :: a, b
+    displacement = dot_product(abs(normal(:, k)), abs((b%x - a%x) + (b%x_lo - a%x_lo)))
+  end function displacement
+
+  !> Put a closed contact exactly on its constraint (gap = 0, no roundoff penetration).
+  pure subroutine snap(scene, k, closed, s)
+    type(scene_type), intent(in) :: scene
+    integer, intent(in) :: k
+    logical, intent(in) :: closed(n_contacts)
+    type(state_type), intent(inout) :: s
+    real(wp) :: limit
+    select case (k)
+    case (1)
+      s%x(1) = -scene%offset(1)
+      s%x_lo(1) = 0.0_wp
+    case (2)
+      s%x(2) = scene%offset(2)
+      s%x_lo(2) = 0.0_wp
+    case (3, 4)
+      ! Move the body that no wall holds.
+      ! x2 = x1 + d exactly, the sum's rounding kept in the low part.
+      limit = merge(-scene%offset(3), scene%offset(4), k == 3)
+      if (closed(2)) then
+        s%x(1) = s%x(2)
+        s%x_lo(1) = s%x_lo(2)
+        call add_compensated(s%x(1), s%x_lo(1), -limit)
+      else
+        s%x(2) = s%x(1)
+        s%x_lo(2) = s%x_lo(1)
+        call add_compensated(s%x(2), s%x_lo(2), limit)
+      end if
+    end select
+  end subroutine snap
+
+  !> Both slot limits closed on a rigid link (d_min = d_max): the bodies are one.
+  pure logical function rigid_pair(closed)
+    logical, intent(in) :: closed(n_contacts)
+    rigid_pair = closed(i_slot_min) .and. closed(i_slot_max)
+  end function rigid_pair
+
+  !> Rounding level of contact k's normal velocity: from the speeds of the bodies it
+  !> involves and what a step changes them by, so a slow body is not judged by a fast one;
+  !> within an event point, not below the speeds it started from (entry_scale, else 0).
+  pure real(wp) function u_tolerance(scene, mode, s, k, entry_scale)
+    type(scene_type), intent(in) :: scene
+    type(mode_type), intent(in) :: mode
+    type(state_type), intent(in) :: s
+    integer, intent(in) :: k
+    real(wp), intent(in) :: entry_scale(2)
+    real(wp) :: acc(2)
+    acc = mode%acceleration(scene%forcing%force(s%t))
+    u_tolerance = velocity_rounding * dot_product(abs(normal(:, k)), &
+      max(abs(s%v) + abs(acc) * scene%dt, entry_scale))
+  end function u_tolerance
+end module impact1d_contacts

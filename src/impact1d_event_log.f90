@@ -1,0 +1,103 @@
+!> What the event log has said and still owes (METHOD.md 6): which contacts rest, which
+!> bodies are at rest, rests logged at a bounce series' accumulation time, and releases
+!> held back until time moves on (a contact that closes again at the same instant never
+!> opened).
+module impact1d_event_log
+  use impact1d_kinds, only: wp
+  use impact1d_scene, only: scene_type, n_contacts
+  use impact1d_output, only: sink_type, run_stats, event_rest, event_release
+  use impact1d_yardsticks, only: same_instant
+  implicit none
+  private
+  public :: event_log_type, log_event
+
+  !> The log's bookkeeping between event points.
+  type :: event_log_type
+    logical :: in_contact(n_contacts) = .false.    !< contact k has been logged resting
+    logical :: at_rest(2) = .false.                !< body i has been logged at rest (stick)
+    !> A rest after an accumulation of impacts, logged when its time comes.
+    real(wp) :: pending_rest(n_contacts) = huge(1.0_wp)
+    !> A release waiting for time to move on (see begin_rest), with its velocities.
+    real(wp) :: release_time(n_contacts) = huge(1.0_wp)
+    real(wp) :: release_v(2, n_contacts) = 0.0_wp
+    !> When impulses last moved each body off its rest (see the stick log at the event point).
+    real(wp) :: rest_lost_time(2) = -huge(1.0_wp)
+  contains
+    procedure :: flush_pending_rest
+    procedure :: flush_releases
+    procedure :: begin_rest
+  end type event_log_type
+
+contains
+
+  !> An event of `kind` at t, counted and sent to the sink.
+  subroutine log_event(sink, stats, t, kind, v_before, v_after)
+    class(sink_type), intent(inout) :: sink
+    type(run_stats), intent(inout) :: stats
+    real(wp), intent(in) :: t
+    integer, intent(in) :: kind
+    real(wp), intent(in) :: v_before(2), v_after(2)
+    stats%events(kind) = stats%events(kind) + 1
+    call sink%put_event(t, kind, v_before, v_after)
+  end subroutine log_event
+
+  !> Rest after an accumulation of impacts is logged at the accumulation time (t, velocities v).
+  subroutine flush_pending_rest(self, t, v, sink, stats)
+    class(event_log_type), intent(inout) :: self
+    real(wp), intent(in) :: t, v(2)
+    class(sink_type), intent(inout) :: sink
+    type(run_stats), intent(inout) :: stats
+    integer :: k
+    do k = 1, n_contacts
+      if (self%pending_rest(k) <= t) then
+        call log_event(sink, stats, t, event_rest + k, v, v)
+        self%pending_rest(k) = huge(1.0_wp)
+      end if
+    end do
+  end subroutine flush_pending_rest
+
+  !> Log the releases decided at an instant before t (all of them with everything).
+  subroutine flush_releases(self, scene, t, everything, sink, stats)
+    class(event_log_type), intent(inout) :: self
+    type(scene_type), intent(in) :: scene
+    real(wp), intent(in) :: t
+    logical, intent(in) :: everything
+    class(sink_type), intent(inout) :: sink
+    type(run_stats), intent(inout) :: stats
+    integer :: k
+    do k = 1, n_contacts
+      if (self%release_time(k) == huge(1.0_wp)) cycle
+      if (.not. everything .and. same_instant(scene, t, self%release_time(k))) cycle
+      stats%events(event_release + k) = stats%events(event_release + k) + 1
+      call sink%put_event(self%release_time(k), event_release + k, self%release_v(:, k), self%release_v(:, k))
+      self%release_time(k) = huge(1.0_wp)
+    end do
+  end subroutine flush_releases
+
+  !> Contact k starts to rest at t (velocities v), logged at `when` (now, or a series'
+  !> accumulation time). Nothing is logged if it already rests, or if it was released at
+  !> this same instant.
+  subroutine begin_rest(self, scene, k, t, when, v, sink, stats)
+    class(event_log_type), intent(inout) :: self
+    type(scene_type), intent(in) :: scene
+    integer, intent(in) :: k
+    real(wp), intent(in) :: t, when, v(2)
+    class(sink_type), intent(inout) :: sink
+    type(run_stats), intent(inout) :: stats
+    if (self%in_contact(k)) return
+    self%in_contact(k) = .true.
+    if (self%release_time(k) < huge(1.0_wp)) then
+      if (same_instant(scene, t, self%release_time(k))) then
+        self%release_time(k) = huge(1.0_wp)
+        return
+      end if
+    end if
+    ! Releases from earlier instants go first; one at this instant may still cancel.
+    call self%flush_releases(scene, t, .false., sink, stats)
+    if (when > t) then
+      self%pending_rest(k) = when
+    else
+      call log_event(sink, stats, t, event_rest + k, v, v)
+    end if
+  end subroutine begin_rest
+end module impact1d_event_log

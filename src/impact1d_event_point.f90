@@ -1,0 +1,359 @@
+!> Everything that happens at one instant (METHOD.md 5-6): closed contacts snapped,
+!> impacts resolved (one joint inelastic impact, then sequential impulses), bounce series
+!> whose rest is below the clock's resolution put to rest (Zeno), stopped bodies zeroed,
+!> the new mode from the complementarity problem, and the log of what changed.
+module impact1d_event_point
+  use impact1d_kinds, only: wp, eps_wp
+  use impact1d_error, only: error_type, raise, status_simulation, fmt
+  use impact1d_scene, only: scene_type, n_contacts, normal, i_slot_min, i_slot_max
+  use impact1d_modes, only: mode_type, solve_mode
+  use impact1d_impacts, only: normal_velocity, impulse, most_approaching, restitution_of, &
+    kinetic_energy, joint_inelastic, inelastic_projection
+  use impact1d_output, only: sink_type, run_stats, event_impact, event_rest, event_stick, event_slip
+  use impact1d_state, only: state_type, add_compensated
+  use impact1d_yardsticks, only: gap_rounding, velocity_rounding, time_rounding, force_scale, same_instant
+  use impact1d_contacts, only: gap, gap_tolerance, snap, rigid_pair, u_tolerance
+  use impact1d_stepping, only: rk4_type
+  use impact1d_location, only: watch_type
+  use impact1d_event_log, only: event_log_type, log_event
+  implicit none
+  private
+  public :: event_point, bounce_series_time
+
+
+contains
+
+  !> The event point at s%t. which: what the location found (contact k, 100 + body i, -1 a
+  !> mode condition) or 0; initial: the start of the run (no mode yet). Leaves the new mode,
+  !> what it needs watched and the integrator's constant acceleration set.
+  subroutine event_point(scene, initial, which, s, mode, event_log, watch, rk, sink, stats, error)
+    type(scene_type), intent(in) :: scene
+    logical, intent(in) :: initial
+    integer, intent(in) :: which
+    type(state_type), intent(inout) :: s
+    type(mode_type), intent(inout) :: mode
+    type(event_log_type), intent(inout) :: event_log
+    type(watch_type), intent(inout) :: watch
+    type(rk4_type), intent(inout) :: rk
+    class(sink_type), intent(inout) :: sink
+    type(run_stats), intent(inout) :: stats
+    type(error_type), allocatable, intent(inout) :: error
+    logical :: closed(n_contacts), candidate(n_contacts), resting(2), found
+    logical :: pushed(n_contacts)
+    real(wp) :: f(2), df(2), v_before(2), v_after(2), moving_sign(2), acc(2)
+    ! Velocity scale of each body entering this event point: impulses redistribute
+    ! velocity but cannot create precision, so what is below its rounding is zero.
+    real(wp) :: entry_scale(2)
+    integer :: k, i, n_impulses
+    type(mode_type) :: new_mode
+
+    f = scene%forcing%force(s%t)
+    df = scene%forcing%rate(s%t)
+    do k = 1, n_contacts
+      closed(k) = scene%has_contact(k)
+      if (closed(k)) closed(k) = k == which .or. gap(scene, k, s) <= gap_tolerance(scene, k, s, 0.0_wp)
+      ! The user's numbers carry their decimal rounding (7.553 - 7.122 is not 0.431): at the
+      ! start, a gap within it is contact, as the validator accepted it.
+      if (initial .and. scene%has_contact(k)) closed(k) = closed(k) .or. gap(scene, k, s) <= &
+        gap_rounding * max(maxval(abs(normal(:, k) * s%x)), abs(scene%offset(k)))
+    end do
+    ! A rigid link (d_min = d_max) is one constraint seen from both sides.
+    if (scene%has_contact(i_slot_min) .and. scene%has_contact(i_slot_max)) then
+      if (scene%offset(i_slot_min) == -scene%offset(i_slot_max)) then
+        closed(i_slot_min) = closed(i_slot_min) .or. closed(i_slot_max)
+        closed(i_slot_max) = closed(i_slot_min)
+      end if
+    end if
+    do k = 1, n_contacts
+      if (closed(k)) call snap(scene, k, closed, s)
+    end do
+    ! A sliding body whose stop was located, or that stopped within rounding (its velocity
+    ! change over a step is the scale), is at rest.
+    acc = mode%acceleration(f)
+    if (initial) acc = f / scene%mass     ! no mode yet: the free accelerations set the scale
+    entry_scale = abs(s%v) + abs(acc) * scene%dt
+    do i = 1, 2
+      if (scene%friction(i) == 0.0_wp) cycle
+      if (i == which - 100 .or. abs(s%v(i)) <= velocity_rounding * abs(acc(i)) * scene%dt) &
+        call zero_velocity(scene, s, i)
+    end do
+
+    ! Perfectly inelastic contacts closed together take one joint impact: sequential
+    ! impulses would only approach it geometrically (a body pinned by a heavier one).
+    if (joint_inelastic(scene, closed)) then
+      v_before = s%v
+      call inelastic_projection(scene, closed, s%v, u_tolerances(scene, mode, s, entry_scale), &
+        v_after, pushed)
+      if (any(pushed)) then
+        call apply(scene, s, v_after)
+        if (any(pushed .and. [.false., .false., .true., .true.])) entry_scale = maxval(entry_scale)
+        do k = 1, n_contacts
+          if (pushed(k)) call log_event(sink, stats, s%t, event_impact + k, v_before, v_after)
+        end do
+      end if
+    end if
+    n_impulses = 0
+    do
+      k = most_approaching(closed, s%v, u_tolerances(scene, mode, s, entry_scale))
+      if (k == 0) exit
+      n_impulses = n_impulses + 1
+      if (n_impulses > scene%max_impulses) then
+        call raise(error, status_simulation, 'at t = ' // fmt(s%t) // ': the impacts did not settle after ' &
+          // fmt(scene%max_impulses) // ' impulses (&run max_impulses)')
+        return
+      end if
+      v_before = s%v
+      v_after = impulse(scene, k, restitution_of(scene, k, closed), s%v, rigid_pair(closed))
+      call apply(scene, s, v_after)
+      if (all(normal(:, k) /= 0.0_wp)) entry_scale = maxval(entry_scale)
+      call log_event(sink, stats, s%t, event_impact + k, v_before, v_after)
+    end do
+
+    ! Contacts left with a rounding-level normal velocity are closed and still.
+    call zero_stopped(scene, s, acc, entry_scale)
+    do k = 1, n_contacts
+      if (.not. closed(k)) cycle
+      if (abs(normal_velocity(k, s%v)) <= u_tolerance(scene, mode, s, k, entry_scale) .and. &
+          normal_velocity(k, s%v) /= 0.0_wp) &
+        call apply(scene, s, impulse(scene, k, 0.0_wp, s%v, rigid_pair(closed)))
+    end do
+
+    ! Zeno: a bounce series whose remaining time is below the clock's resolution ends in
+    ! rest now; the rest is logged at the series' accumulation time.
+    do k = 1, n_contacts
+      if (.not. closed(k)) cycle
+      call settle_bounce_series(scene, mode, k, f, df, closed, entry_scale, s, event_log, sink, stats)
+    end do
+
+    ! Impulses can leave a rounding-level velocity on a body that had stopped; it is zero.
+    call zero_stopped(scene, s, acc, entry_scale)
+    ! A body still against the other one (a closed slot limit) that has stopped has stopped
+    ! too: its velocity is the contact's rounding-level normal velocity.
+    do k = 1, n_contacts
+      if (.not. closed(k) .or. any(normal(:, k) == 0.0_wp)) cycle
+      if (abs(normal_velocity(k, s%v)) > u_tolerance(scene, mode, s, k, entry_scale)) cycle
+      do i = 1, 2
+        if (s%v(i) == 0.0_wp) call zero_velocity(scene, s, 3 - i)
+      end do
+    end do
+
+    call candidates(scene, mode, s, entry_scale, closed, candidate, resting, moving_sign)
+    call solve_mode(scene, f, df, candidate, resting, moving_sign, new_mode, found, force_scale(scene, f, df))
+    if (.not. found) then
+      call raise(error, status_simulation, 'at t = ' // fmt(s%t) // &
+        ': no consistent contact and friction state (complementarity problem has no solution)')
+      return
+    end if
+
+    call log_mode_change(scene, initial, f, df, candidate, new_mode, s, event_log, sink, stats)
+    mode = new_mode
+    watch%quiet_until = -huge(1.0_wp)
+    if (rk%constant_forcing) then
+      rk%constant_acceleration = mode%acceleration(scene%forcing%constant)
+      call watch%find_quiet_times(scene, mode, s, rk%constant_acceleration)
+    end if
+    watch%watching = mode%n_hold > 0 .or. any(scene%has_contact .and. .not. mode%active) .or. &
+      any(scene%friction > 0.0_wp .and. mode%sgn /= 0.0_wp)
+  end subroutine event_point
+
+  !> Log what a user can see change between the old mode and new_mode: contacts that start
+  !> or stop holding, bodies that come to rest or break away.
+  subroutine log_mode_change(scene, initial, f, df, candidate, new_mode, s, event_log, sink, stats)
+    type(scene_type), intent(in) :: scene
+    logical, intent(in) :: initial, candidate(n_contacts)
+    real(wp), intent(in) :: f(2), df(2)
+    type(mode_type), intent(in) :: new_mode
+    type(state_type), intent(in) :: s
+    type(event_log_type), intent(inout) :: event_log
+    class(sink_type), intent(inout) :: sink
+    type(run_stats), intent(inout) :: stats
+    real(wp) :: acc(2), tol_a(2), acc_rate(2)
+    logical :: leaving, resting_now
+    integer :: k, i
+
+    acc = new_mode%acceleration(f)
+    tol_a = 1.0e3_wp * eps_wp * force_scale(scene, f, df) / scene%mass
+    do k = 1, n_contacts
+      if (new_mode%active(k) .and. .not. event_log%in_contact(k)) then
+        call event_log%begin_rest(scene, k, s%t, s%t, s%v, sink, stats)
+      else if (event_log%in_contact(k) .and. .not. new_mode%active(k)) then
+        if (.not. candidate(k) .or. dot_product(normal(:, k), acc) > dot_product(abs(normal(:, k)), tol_a) .or. &
+            (dot_product(normal(:, k), acc) >= -dot_product(abs(normal(:, k)), tol_a) .and. &
+            dot_product(normal(:, k), matmul(new_mode%gain, df)) > 1.0e3_wp * eps_wp * sum(abs(df)) / &
+            minval(scene%mass))) then
+          if (event_log%pending_rest(k) < huge(1.0_wp)) then
+            call log_event(sink, stats, s%t, event_rest + k, s%v, s%v)
+            event_log%pending_rest(k) = huge(1.0_wp)
+          end if
+          ! Logged once time has moved on: a contact that closes again at this same
+          ! instant never opened (rounding-level relabelling), and neither entry is kept.
+          event_log%in_contact(k) = .false.
+          event_log%release_time(k) = s%t
+          event_log%release_v(:, k) = s%v
+        end if
+      end if
+    end do
+    ! A body at rest leaves it when its acceleration, or at a break-away instant (force
+    ! exactly at the bound) the acceleration's rate, points along its sliding direction.
+    acc_rate = matmul(new_mode%gain, df)
+    do i = 1, 2
+      if (scene%friction(i) == 0.0_wp) cycle
+      leaving = new_mode%sgn(i) * acc(i) > tol_a(i) .or. (new_mode%sgn(i) * acc(i) >= -tol_a(i) .and. &
+        new_mode%sgn(i) * acc_rate(i) > 1.0e3_wp * eps_wp * sum(abs(df)) / scene%mass(i))
+      resting_now = s%v(i) == 0.0_wp .and. .not. leaving
+      ! A body that impulses moved off its rest and that stops again at that same instant
+      ! (a chain of impacts ending there) never left rest: no stick (its leaving was not
+      ! logged either).
+      if (resting_now .and. .not. event_log%at_rest(i) .and. .not. initial .and. &
+          .not. same_instant(scene, s%t, event_log%rest_lost_time(i))) &
+        call log_event(sink, stats, s%t, event_stick + i, s%v, s%v)
+      if (.not. resting_now .and. event_log%at_rest(i)) then
+        if (s%v(i) == 0.0_wp) then
+          call log_event(sink, stats, s%t, event_slip + i, s%v, s%v)
+        else
+          event_log%rest_lost_time(i) = s%t
+        end if
+      end if
+      event_log%at_rest(i) = resting_now
+    end do
+  end subroutine log_mode_change
+
+  !> The bounce series on closed contact k, if its bodies separate slowly: gap acceleration
+  !> while rising (a_up) and falling back (a_down) come from the mode with k left free, for
+  !> the velocities now and with the normal velocity reversed (friction may change sides).
+  !> If what remains of the series is below the clock's resolution, the contact rests now,
+  !> logged at the series' accumulation time.
+  subroutine settle_bounce_series(scene, mode, k, f, df, closed, entry_scale, s, event_log, sink, stats)
+    type(scene_type), intent(in) :: scene
+    type(mode_type), intent(in) :: mode
+    integer, intent(in) :: k
+    real(wp), intent(in) :: f(2), df(2), entry_scale(2)
+    logical, intent(in) :: closed(n_contacts)
+    type(state_type), intent(inout) :: s
+    type(event_log_type), intent(inout) :: event_log
+    class(sink_type), intent(inout) :: sink
+    type(run_stats), intent(inout) :: stats
+    real(wp) :: u, a_up, a_down, remaining
+    u = normal_velocity(k, s%v)
+    if (u <= u_tolerance(scene, mode, s, k, entry_scale)) return
+    a_up = free_gap_acceleration(scene, mode, k, s, s%v, f, df, closed, entry_scale)
+    if (a_up >= 0.0_wp) return
+    a_down = free_gap_acceleration(scene, mode, k, s, impulse(scene, k, 1.0_wp, s%v, rigid_pair(closed)), &
+      f, df, closed, entry_scale)
+    remaining = bounce_series_time(u, a_up, a_down, restitution_of(scene, k, closed))
+    ! Gaps are exact to their own size, so the series is followed until what remains of it
+    ! is below the clock's resolution.
+    if (remaining > time_rounding * max(abs(s%t), scene%dt)) return
+    call apply(scene, s, impulse(scene, k, 0.0_wp, s%v, rigid_pair(closed)))
+    if (remaining < huge(1.0_wp)) then
+      call event_log%begin_rest(scene, k, s%t, s%t + remaining, s%v, sink, stats)
+    else
+      call event_log%begin_rest(scene, k, s%t, s%t, s%v, sink, stats)
+    end if
+  end subroutine settle_bounce_series
+
+  !> Total time of a bounce series starting at separating normal speed u > 0, rising
+  !> with gap acceleration a_up < 0 and falling back with a_down, restitution r (huge if it
+  !> does not end). Under constant forces each arc takes u/|a_up| + u/sqrt(a_up a_down) and
+  !> the next impact speed is r u sqrt(a_down/a_up): the series is geometric, its sum
+  !> closed form.
+  pure real(wp) function bounce_series_time(u, a_up, a_down, r) result(remaining)
+    real(wp), intent(in) :: u, a_up, a_down, r
+    real(wp) :: ratio, first_arc
+    remaining = huge(1.0_wp)
+    if (a_down < 0.0_wp) then
+      first_arc = u / (-a_up) + u / sqrt(a_up * a_down)
+      ratio = r * sqrt(a_down / a_up)
+      if (ratio < 1.0_wp) remaining = first_arc / (1.0_wp - ratio)
+    end if
+  end function bounce_series_time
+
+  !> Normal acceleration of contact k with k left free and the others as they are, for
+  !> state s with velocities v.
+  real(wp) function free_gap_acceleration(scene, mode, k, s, v, f, df, closed, entry_scale) result(a_gap)
+    type(scene_type), intent(in) :: scene
+    type(mode_type), intent(in) :: mode
+    integer, intent(in) :: k
+    type(state_type), intent(in) :: s
+    real(wp), intent(in) :: v(2), f(2), df(2), entry_scale(2)
+    logical, intent(in) :: closed(n_contacts)
+    type(mode_type) :: free_mode
+    type(state_type) :: probe
+    logical :: candidate(n_contacts), resting(2), found
+    real(wp) :: moving_sign(2)
+    probe = s
+    probe%v = v
+    call candidates(scene, mode, probe, entry_scale, closed, candidate, resting, moving_sign)
+    candidate(k) = .false.
+    call solve_mode(scene, f, df, candidate, resting, moving_sign, free_mode, found, force_scale(scene, f, df))
+    a_gap = 0.0_wp
+    if (found) a_gap = dot_product(normal(:, k), free_mode%acceleration(f))
+  end function free_gap_acceleration
+
+  !> Bodies whose velocity is below the rounding of what a step changes it by, or of the
+  !> velocities this event point started from, are at rest.
+  pure subroutine zero_stopped(scene, s, acc, entry_scale)
+    type(scene_type), intent(in) :: scene
+    type(state_type), intent(inout) :: s
+    real(wp), intent(in) :: acc(2), entry_scale(2)
+    integer :: i
+    do i = 1, 2
+      if (s%v(i) /= 0.0_wp .and. abs(s%v(i)) <= velocity_rounding * max(abs(acc(i)) * scene%dt, &
+          entry_scale(i))) call zero_velocity(scene, s, i)
+    end do
+  end subroutine zero_stopped
+
+  !> Body i is at rest; the rounding-level energy it had goes to the ledger: to friction
+  !> where friction stopped it (a run with no impact reports no impact loss), else to impacts.
+  pure subroutine zero_velocity(scene, s, i)
+    type(scene_type), intent(in) :: scene
+    type(state_type), intent(inout) :: s
+    integer, intent(in) :: i
+    if (scene%friction(i) > 0.0_wp) then
+      call add_compensated(s%friction_loss, s%friction_lo, 0.5_wp * scene%mass(i) * s%v(i)**2)
+    else
+      s%impact_loss = s%impact_loss + 0.5_wp * scene%mass(i) * s%v(i)**2
+    end if
+    s%v(i) = 0.0_wp
+    s%v_lo(i) = 0.0_wp
+  end subroutine zero_velocity
+
+  !> Set new velocities at an instant, booking the kinetic energy they remove as impact loss.
+  pure subroutine apply(scene, s, v_new)
+    type(scene_type), intent(in) :: scene
+    type(state_type), intent(inout) :: s
+    real(wp), intent(in) :: v_new(2)
+    s%impact_loss = s%impact_loss + kinetic_energy(scene, s%v) - kinetic_energy(scene, v_new)
+    s%v = v_new
+    s%v_lo = 0.0_wp
+  end subroutine apply
+
+  !> The complementarity problem's unknowns at this instant.
+  pure subroutine candidates(scene, mode, s, entry_scale, closed, candidate, resting, moving_sign)
+    type(scene_type), intent(in) :: scene
+    type(mode_type), intent(in) :: mode
+    type(state_type), intent(in) :: s
+    real(wp), intent(in) :: entry_scale(2)
+    logical, intent(in) :: closed(n_contacts)
+    logical, intent(out) :: candidate(n_contacts), resting(2)
+    real(wp), intent(out) :: moving_sign(2)
+    integer :: k
+    do k = 1, n_contacts
+      candidate(k) = closed(k)
+      if (candidate(k)) candidate(k) = abs(normal_velocity(k, s%v)) <= u_tolerance(scene, mode, s, k, entry_scale)
+    end do
+    resting = scene%friction > 0.0_wp .and. s%v == 0.0_wp
+    moving_sign = 0.0_wp
+    where (scene%friction > 0.0_wp .and. s%v /= 0.0_wp) moving_sign = sign(1.0_wp, s%v)
+  end subroutine candidates
+
+  pure function u_tolerances(scene, mode, s, entry_scale) result(tol)
+    type(scene_type), intent(in) :: scene
+    type(mode_type), intent(in) :: mode
+    type(state_type), intent(in) :: s
+    real(wp), intent(in) :: entry_scale(2)
+    real(wp) :: tol(n_contacts)
+    integer :: k
+    tol = [(u_tolerance(scene, mode, s, k, entry_scale), k = 1, n_contacts)]
+  end function u_tolerances
+end module impact1d_event_point

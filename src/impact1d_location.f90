@@ -1,0 +1,251 @@
+!> Event location within a step (METHOD.md 4): the earliest gap closing, sliding body
+!> stopping or mode condition failing on the step's dense output, its refinement on the
+!> integrator's own state, and the quiet times before which nothing needs locating.
+module impact1d_location
+  use impact1d_kinds, only: wp, eps_wp
+  use impact1d_scene, only: scene_type, n_contacts, normal
+  use impact1d_modes, only: mode_type, max_holds
+  use impact1d_events, only: earliest_crossing
+  use impact1d_impacts, only: normal_velocity
+  use impact1d_state, only: state_type
+  use impact1d_yardsticks, only: velocity_rounding, force_scale
+  use impact1d_contacts, only: gap, gap_tolerance, gap_tolerance_along, displacement
+  use impact1d_stepping, only: rk4_type, dense_output
+  implicit none
+  private
+  public :: watch_type, hold_crossing, refine, constraints_hold, first_negative
+
+  !> What the current mode needs watched.
+  type :: watch_type
+    !> Until when each open gap (1..4) and each sliding body (5, 6) needs no location.
+    real(wp) :: quiet_until(n_contacts + 2) = -huge(1.0_wp)
+    !> Something in the mode can end it (else its steps need no location at all).
+    logical :: watching = .true.
+  contains
+    procedure :: locate
+    procedure :: find_quiet_times
+  end type watch_type
+
+contains
+
+  !> Earliest event in (0, step]: a gap closing, a sliding body stopping, a mode condition
+  !> failing. which = k for contact k, 100 + i for body i, -1 for a mode condition.
+  subroutine locate(self, scene, mode, constant_forcing, a, b, step, theta, which)
+    class(watch_type), intent(in) :: self
+    type(scene_type), intent(in) :: scene
+    type(mode_type), intent(in) :: mode
+    logical, intent(in) :: constant_forcing
+    type(state_type), intent(in) :: a, b
+    real(wp), intent(in) :: step
+    real(wp), intent(out) :: theta
+    integer, intent(out) :: which
+    real(wp) :: c(3, 2), p(0:3), candidate, scale, acc_rounding(2)
+    integer :: k, i
+    logical :: have_dense, have_acc_rounding
+
+    theta = huge(1.0_wp)
+    which = 0
+    have_dense = .false.
+    have_acc_rounding = .false.
+    do k = 1, n_contacts
+      if (.not. scene%has_contact(k) .or. mode%active(k)) cycle
+      if (a%t + step < self%quiet_until(k)) cycle
+      if (.not. have_dense) c = dense_output(a, b, step)
+      have_dense = .true.
+      p(0) = gap(scene, k, a)
+      p(1:3) = normal(1, k) * c(:, 1) + normal(2, k) * c(:, 2)
+      ! The common case first: the gap cannot reach zero within the step.
+      if (p(0) - step * (abs(p(1)) + step * (abs(p(2)) + step * abs(p(3)))) > 0.0_wp) cycle
+      ! Only a gap that may close needs the forces' rounding (a sine costs two evaluations).
+      if (.not. have_acc_rounding) acc_rounding = 1.0e3_wp * eps_wp * &
+        force_scale(scene, scene%forcing%force(a%t), scene%forcing%rate(a%t)) / scene%mass
+      have_acc_rounding = .true.
+      candidate = earliest_crossing(p, step, gap_tolerance_along(scene, k, a, c, acc_rounding))
+      if (candidate < theta) then
+        theta = candidate
+        which = k
+      end if
+    end do
+    do i = 1, 2
+      if (scene%friction(i) == 0.0_wp .or. mode%sgn(i) == 0.0_wp) cycle
+      if (a%t + step < self%quiet_until(n_contacts + i)) cycle
+      if (.not. have_dense) c = dense_output(a, b, step)
+      have_dense = .true.
+      ! Sliding velocity in its own direction: the derivative of the Hermite cubic.
+      p = mode%sgn(i) * [c(1, i), 2.0_wp * c(2, i), 3.0_wp * c(3, i), 0.0_wp]
+      scale = max(abs(a%v(i)), abs(b%v(i)), abs(b%v(i) - a%v(i)))
+      candidate = earliest_crossing(p, step, [velocity_rounding * scale, 0.0_wp, 0.0_wp, 0.0_wp])
+      if (candidate < theta) then
+        theta = candidate
+        which = 100 + i
+      end if
+    end do
+    ! Under constant forces the mode's conditions are constant: they held when it began.
+    if (mode%n_hold > 0 .and. .not. constant_forcing) then
+      candidate = hold_crossing(scene, mode, a%t, step)
+      if (candidate < theta) then
+        theta = candidate
+        which = -1
+      end if
+    end if
+  end subroutine locate
+
+  !> Earliest time in [0, step] at which a condition of the mode (a contact force, a static
+  !> friction margin) has turned negative. They depend on time only: linear within a step under
+  !> piecewise-linear forcing, so the ends decide; a sine is sampled finer before bisection.
+  real(wp) function hold_crossing(scene, mode, t0, step) result(theta)
+    type(scene_type), intent(in) :: scene
+    type(mode_type), intent(in) :: mode
+    real(wp), intent(in) :: t0, step
+    real(wp) :: lo, hi, mid, tol
+    integer :: n_sub, j
+    theta = huge(1.0_wp)
+    tol = hold_tolerance(scene, t0)
+    n_sub = 1
+    do j = 1, 2
+      if (scene%forcing%has_sine(j)) n_sub = max(n_sub, &
+        ceiling(16.0_wp * step * scene%forcing%omega(j) / (2.0_wp * acos(-1.0_wp))))
+    end do
+    lo = 0.0_wp
+    do j = 1, n_sub
+      hi = step * real(j, wp) / real(n_sub, wp)
+      if (worst_hold(scene, mode, t0 + hi) < -tol) then
+        ! Bisection to the first instant at which a condition has failed (within rounding):
+        ! there the new mode's accelerations have the sign of the change. At the last
+        ! instant that held, a released contact would be left a rounding-level acceleration
+        ! back into it and close again at once, for ever.
+        do while (hi - lo > 2.0_wp * eps_wp * max(abs(t0 + hi), step))
+          mid = 0.5_wp * (lo + hi)
+          if (worst_hold(scene, mode, t0 + mid) < 0.0_wp) then
+            hi = mid
+          else
+            lo = mid
+          end if
+        end do
+        theta = hi
+        return
+      end if
+      lo = hi
+    end do
+  end function hold_crossing
+
+  real(wp) function worst_hold(scene, mode, t)
+    type(scene_type), intent(in) :: scene
+    type(mode_type), intent(in) :: mode
+    real(wp), intent(in) :: t
+    real(wp) :: values(max_holds)
+    values = mode%holds(scene%forcing%force(t))
+    worst_hold = minval(values(1:mode%n_hold))
+  end function worst_hold
+
+  real(wp) function hold_tolerance(scene, t)
+    type(scene_type), intent(in) :: scene
+    real(wp), intent(in) :: t
+    hold_tolerance = 1.0e3_wp * eps_wp * force_scale(scene, scene%forcing%force(t), scene%forcing%rate(t)) &
+      + tiny(1.0_wp)
+  end function hold_tolerance
+
+  !> Re-take the step to the located time and polish it by Newton's method on the watched
+  !> function evaluated on the integrator's own state: under polynomial forcing the dense
+  !> output is exact and the first check passes; under a sine it is approximate.
+  subroutine refine(rk, scene, mode, a, step, which, b)
+    type(rk4_type), intent(inout) :: rk
+    type(scene_type), intent(in) :: scene
+    type(mode_type), intent(in) :: mode
+    type(state_type), intent(in) :: a
+    real(wp), intent(inout) :: step
+    integer, intent(in) :: which
+    type(state_type), intent(inout) :: b
+    real(wp) :: value, slope, tol, acc(2), located_step
+    integer :: iteration
+    located_step = step
+    call rk%step(scene, mode, a, step, b)
+    if (which <= 0) return
+    do iteration = 1, 8
+      if (which > 100) then
+        value = b%v(which - 100)
+        acc = mode%acceleration(scene%forcing%force(b%t))
+        slope = acc(which - 100)
+        tol = velocity_rounding * max(abs(a%v(which - 100)), abs(value))
+      else
+        value = gap(scene, which, b)
+        slope = normal_velocity(which, b%v)
+        tol = gap_tolerance(scene, which, b, displacement(which, a, b))
+      end if
+      if (abs(value) <= tol .or. slope == 0.0_wp) exit
+      ! Newton stays inside the step that was located, or the clock could pass a stop.
+      if (step - value / slope <= 0.0_wp .or. step - value / slope > located_step) exit
+      step = step - value / slope
+      call rk%step(scene, mode, a, step, b)
+    end do
+  end subroutine refine
+
+  !> No step from s may end (at b) with a gap below zero beyond rounding, nor a sliding body
+  !> past zero. The contact whose closing ended the step (located_contact) is put on its
+  !> constraint at the event point, so its own rounding does not count.
+  pure logical function constraints_hold(scene, mode, s, b, located_contact)
+    type(scene_type), intent(in) :: scene
+    type(mode_type), intent(in) :: mode
+    type(state_type), intent(in) :: s, b
+    integer, intent(in) :: located_contact
+    integer :: k, i
+    constraints_hold = .true.
+    do k = 1, n_contacts
+      if (.not. scene%has_contact(k) .or. mode%active(k) .or. k == located_contact) cycle
+      if (gap(scene, k, b) < -gap_tolerance(scene, k, b, displacement(k, s, b))) constraints_hold = .false.
+    end do
+    do i = 1, 2
+      if (scene%friction(i) == 0.0_wp .or. mode%sgn(i) == 0.0_wp) cycle
+      if (mode%sgn(i) * b%v(i) < -velocity_rounding * max(abs(s%v(i)), abs(b%v(i)), &
+          abs(b%v(i) - s%v(i)))) constraints_hold = .false.
+    end do
+  end function constraints_hold
+
+  !> Under constant forces a mode's motion is an exact quadratic, so the first instant an
+  !> open gap can close, or a sliding body can stop, is known in closed form; steps that end
+  !> well before it (1% of the way, far beyond rounding) need no location for it. Only a
+  !> shortcut: the location itself still finds the event.
+  pure subroutine find_quiet_times(self, scene, mode, s, constant_acceleration)
+    class(watch_type), intent(inout) :: self
+    type(scene_type), intent(in) :: scene
+    type(mode_type), intent(in) :: mode
+    type(state_type), intent(in) :: s
+    real(wp), intent(in) :: constant_acceleration(2)
+    integer :: k, i
+    self%quiet_until = huge(1.0_wp)     ! what is not watched needs no location
+    do k = 1, n_contacts
+      if (.not. scene%has_contact(k) .or. mode%active(k)) cycle
+      self%quiet_until(k) = s%t + 0.99_wp * first_negative(gap(scene, k, s), normal_velocity(k, s%v), &
+        dot_product(normal(:, k), constant_acceleration))
+    end do
+    do i = 1, 2
+      if (scene%friction(i) == 0.0_wp .or. mode%sgn(i) == 0.0_wp) cycle
+      self%quiet_until(n_contacts + i) = s%t + 0.99_wp * first_negative(mode%sgn(i) * s%v(i), &
+        mode%sgn(i) * constant_acceleration(i), 0.0_wp)
+    end do
+  end subroutine find_quiet_times
+
+  !> First tau > 0 with g0 + u tau + a tau^2 / 2 < 0, for g0 >= 0 (0 if g0 < 0, huge if never).
+  pure real(wp) function first_negative(g0, u, a) result(tau)
+    real(wp), intent(in) :: g0, u, a
+    real(wp) :: disc, q
+    tau = huge(1.0_wp)
+    if (g0 < 0.0_wp) then
+      tau = 0.0_wp
+    else if (a == 0.0_wp) then
+      if (u < 0.0_wp) tau = g0 / (-u)
+    else
+      disc = u**2 - 2.0_wp * a * g0
+      if (disc < 0.0_wp) return
+      ! Roots of a/2 tau^2 + u tau + g0 by the stable pair q/(a/2) and g0/q.
+      q = -0.5_wp * (u + sign(sqrt(disc), u))
+      if (a > 0.0_wp) then
+        if (u < 0.0_wp .and. q /= 0.0_wp) tau = g0 / q        ! the smaller positive root
+      else
+        tau = max(q / (0.5_wp * a), merge(g0 / q, 0.0_wp, q /= 0.0_wp))   ! the positive root
+      end if
+      tau = max(tau, 0.0_wp)
+    end if
+    if (tau /= tau) tau = 0.0_wp
+  end function first_negative
+end module impact1d_location

@@ -1,0 +1,90 @@
+!> The compensated state of the two bodies (METHOD.md 3) and its arithmetic: time,
+!> positions, velocities and the ledger integrals are sums of many step increments, each
+!> kept as a value and its rounding error (the _lo parts).
+module impact1d_state
+  use, intrinsic :: iso_fortran_env, only: int64
+  use impact1d_kinds, only: wp
+  implicit none
+  private
+  public :: state_type, add_compensated, accumulate, renormalise, finite_state, constant_steps
+
+  !> Time, positions, velocities and the ledger integrals, compensated: a micrometre bounce
+  !> near a wall at x = 10 m keeps its digits, and 10^6 steps of 1e-5 s do not drift the clock
+  !> by 1e-10 s. This is what keeps polynomial scenes at rounding error whatever the step count.
+  type :: state_type
+    real(wp) :: t = 0.0_wp, t_lo = 0.0_wp
+    real(wp) :: x(2) = 0.0_wp, x_lo(2) = 0.0_wp, v(2) = 0.0_wp, v_lo(2) = 0.0_wp
+    real(wp) :: work = 0.0_wp, work_lo = 0.0_wp, friction_loss = 0.0_wp, friction_lo = 0.0_wp
+    real(wp) :: impact_loss = 0.0_wp
+  end type state_type
+
+contains
+
+  !> hi + lo += increment: the exact rounding error of hi + increment (Knuth's two-sum, valid
+  !> whichever is larger) goes into lo; then hi takes what of lo it can hold (Fast2Sum), so
+  !> hi alone is the sum correctly rounded (event times and samples read hi) and lo stays
+  !> below half an ulp of it.
+  elemental subroutine add_compensated(hi, lo, increment)
+    real(wp), intent(inout) :: hi, lo
+    real(wp), intent(in) :: increment
+    call accumulate(hi, lo, increment)
+    call renormalise(hi, lo)
+  end subroutine add_compensated
+
+  !> hi += increment, its exact rounding error (two-sum) into lo; hi + lo is the sum.
+  elemental subroutine accumulate(hi, lo, increment)
+    real(wp), intent(inout) :: hi, lo
+    real(wp), intent(in) :: increment
+    real(wp) :: total, rounded
+    total = hi + increment
+    rounded = total - hi
+    lo = lo + ((hi - (total - rounded)) + (increment - rounded))
+    hi = total
+  end subroutine accumulate
+
+  !> hi becomes hi + lo correctly rounded and lo what is left (Fast2Sum, exact while |lo| is
+  !> below |hi|, as it is but for a sum passing through zero).
+  elemental subroutine renormalise(hi, lo)
+    real(wp), intent(inout) :: hi, lo
+    real(wp) :: total
+    total = hi + lo
+    lo = lo - (total - hi)
+    hi = total
+  end subroutine renormalise
+
+  !> n steps of h under the constant velocity change dv per step (half_dv = dv / 2): RK4's
+  !> closed form, the sums accumulated but not renormalised (the low parts carry the
+  !> rounding meanwhile; the caller renormalises once at the end). Kept here, next to
+  !> accumulate, so the compiler inlines it into this hottest loop.
+  pure subroutine constant_steps(n, h, dv, half_dv, t, t_lo, x, x_lo, v, v_lo)
+    integer(int64), intent(in) :: n
+    real(wp), intent(in) :: h, dv(2), half_dv(2)
+    real(wp), intent(inout) :: t, t_lo, x(2), x_lo(2), v(2), v_lo(2)
+    integer(int64) :: j
+    real(wp) :: t_, t_lo_, x_(2), x_lo_(2), v_(2), v_lo_(2)
+    ! Local copies: the compiler keeps them in registers through the loop.
+    t_ = t
+    t_lo_ = t_lo
+    x_ = x
+    x_lo_ = x_lo
+    v_ = v
+    v_lo_ = v_lo
+    do j = 1, n
+      call accumulate(t_, t_lo_, h)
+      call accumulate(x_, x_lo_, h * ((v_ + v_lo_) + half_dv))
+      call accumulate(v_, v_lo_, dv)
+    end do
+    t = t_
+    t_lo = t_lo_
+    x = x_
+    x_lo = x_lo_
+    v = v_
+    v_lo = v_lo_
+  end subroutine constant_steps
+
+  !> All of the state a run reports is finite.
+  pure logical function finite_state(state)
+    type(state_type), intent(in) :: state
+    finite_state = all(abs([state%x, state%v, state%work]) <= huge(1.0_wp))
+  end function finite_state
+end module impact1d_state
