@@ -162,7 +162,7 @@ def simulate(scene: Scene, *, progress: bool = False, **overrides) -> Result:
 
     n_samples, n_events = int(n_samples), int(n_events)
     # Event-heavy scenes tend to come in series (sweeps): start the next one with room.
-    _event_capacity = max(_EVENT_CAPACITY, min(2 * n_events, _EVENT_CAPACITY_MAX))
+    _event_capacity = max(_EVENT_CAPACITY, min(n_events + n_events // 8, _EVENT_CAPACITY_MAX))
     samples = samples[:n_samples]
     events = np.empty(n_events, dtype=EVENT_DTYPE)
     if n_events > 0:
