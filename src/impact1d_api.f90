@@ -31,17 +31,8 @@ contains
   !> Names of the scene's real and text fields, space separated, in the order of the arrays.
   subroutine field_names(real_field_names, text_field_names)
     character(len=1024), intent(out) :: real_field_names, text_field_names
-    integer :: k
-    real_field_names = ''
-    text_field_names = ''
-    do k = 1, n_real
-      real_field_names = trim(real_field_names) // ' ' // trim(real_names(k))
-    end do
-    do k = 1, n_text
-      text_field_names = trim(text_field_names) // ' ' // trim(text_names(k))
-    end do
-    real_field_names = adjustl(real_field_names)
-    text_field_names = adjustl(text_field_names)
+    real_field_names = joined(real_names)
+    text_field_names = joined(text_names)
   end subroutine field_names
 
   !> Names of the sample columns, space separated.
@@ -53,12 +44,7 @@ contains
   !> Event kind names, space separated: code k is the k-th word.
   subroutine event_kind_names(names)
     character(len=1024), intent(out) :: names
-    integer :: k
-    names = ''
-    do k = 1, size(event_names)
-      names = trim(names) // ' ' // trim(event_names(k))
-    end do
-    names = adjustl(names)
+    names = joined(event_names)
   end subroutine event_kind_names
 
   !> Read and check a scene file ('.dat': VisSim-style parameters; else a namelist).
@@ -128,12 +114,7 @@ contains
       write(message, '(a, i0, a, i0)') 'internal: ', n_cols, ' sample columns asked for, the core has ', n_columns
       return
     end if
-    input%value = real(values, wp)
-    input%given = given /= 0
-    input%text(i_title) = title
-    input%text(i_f1_table) = f1_table
-    input%text(i_f2_table) = f2_table
-    input%text(i_method) = method
+    input = flat_input(values, given, title, f1_table, f2_table, method)
     call prepare_scene(input, scene, error)
     if (failed(error, status, message)) return
     call sink%reserve(scene%n_samples)
@@ -191,12 +172,7 @@ contains
       message_codes(:, 1) = [(iachar(message(k:k)), k = 1, message_length)]
       return
     end if
-    base%value = real(values, wp)
-    base%given = given /= 0
-    base%text(i_title) = title
-    base%text(i_f1_table) = f1_table
-    base%text(i_f2_table) = f2_table
-    base%text(i_method) = method
+    base = flat_input(values, given, title, f1_table, f2_table, method)
     do j = 1, n_runs
       input = base
       input%value(over_index) = real(over_values(:, j), wp)
@@ -220,13 +196,34 @@ contains
   !> Names of simulate_summaries' rows, space separated.
   subroutine summary_column_names(names)
     character(len=1024), intent(out) :: names
-    integer :: k
-    names = ''
-    do k = 1, size(summary_names)
-      names = trim(names) // ' ' // trim(summary_names(k))
-    end do
-    names = adjustl(names)
+    names = joined(summary_names)
   end subroutine summary_column_names
+
+  !> A scene's fields as the flat layer gets them (given: non-zero where set).
+  pure function flat_input(values, given, title, f1_table, f2_table, method) result(input)
+    real(c_double), intent(in) :: values(n_real)
+    integer(c_int), intent(in) :: given(n_real)
+    character(len=*), intent(in) :: title, f1_table, f2_table, method
+    type(scene_input) :: input
+    input%value = real(values, wp)
+    input%given = given /= 0
+    input%text(i_title) = title
+    input%text(i_f1_table) = f1_table
+    input%text(i_f2_table) = f2_table
+    input%text(i_method) = method
+  end function flat_input
+
+  !> Words separated by single spaces (how names cross to Python).
+  pure function joined(words) result(text)
+    character(len=*), intent(in) :: words(:)
+    character(len=:), allocatable :: text
+    integer :: k
+    text = ''
+    do k = 1, size(words)
+      text = text // ' ' // trim(words(k))
+    end do
+    text = adjustl(text)
+  end function joined
 
   logical function field_count_ok(n, status, message)
     integer(c_int), intent(in) :: n
