@@ -179,6 +179,11 @@ def sweep(scene: Scene, params, *, workers: Optional[int] = None, client=None,
         if client is not None:
             if keep_results:
                 raise InputError("keep='results' is for local sweeps, not a Dask client")
+            # Few, large tasks: a task costs the scheduler and the workers' processes
+            # (on the same cores here) far more than a thread's chunk does.
+            workers_there = max(1, len(client.scheduler_info().get("workers", {})))
+            size = max(_CHUNK, -(-len(runs) // (4 * workers_there)))
+            chunks = [runs[i:i + size] for i in range(0, len(runs), size)]
             futures = client.map(run_chunk, [scene] * len(chunks), chunks, pure=False)
             outputs = []
             for future, chunk in zip(futures, chunks):
