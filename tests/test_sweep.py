@@ -146,3 +146,14 @@ def test_rest_time_map_matches_the_closed_form(case5):
     rested = table["t_rest"].notna()
     np.testing.assert_allclose(table.loc[rested, "t_rest"], expected[rested], rtol=0, atol=1e-12)
     assert (expected[~rested] > 10.0 - 1e-9).all()
+
+
+def test_runs_the_batch_entry_cannot_take(case5):
+    """No override at all, a text field, a field made absent: each run goes on its own."""
+    plain = impact1d.sweep(case5, [{}] * 2)
+    assert_rows_equal_single_runs(plain, case5, [{}] * 2)
+    methods = impact1d.sweep(case5, {"method": ["event", "vissim"]})
+    assert list(methods["method"]) == ["event", "vissim"] and (methods["error"] == "").all()
+    assert methods.loc[0, "x2_end"] == impact1d.simulate(case5).x2[-1]
+    absent = impact1d.sweep(case5, [{"dt_out": None}, {"dt_out": 0.01}])
+    assert (absent["error"] == "").all() and absent.loc[0, "steps"] == impact1d.simulate(case5).steps

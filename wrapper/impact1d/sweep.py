@@ -69,7 +69,7 @@ def _failed_row() -> dict:
 
 def _batchable(overrides: list) -> bool:
     """Runs the core's batch entry can take: the same real fields, numbers only."""
-    if not overrides:
+    if not overrides or not overrides[0]:
         return False
     names = set(overrides[0])
     return all(set(run) == names and all(name in REAL_FIELDS and isinstance(value, (int, float))
