@@ -28,6 +28,8 @@ program impact1d_cli
     end subroutine hold_signals
     subroutine release_signals() bind(C, name='impact1d_release_signals')
     end subroutine release_signals
+    subroutine allow_signals() bind(C, name='impact1d_allow_signals')
+    end subroutine allow_signals
     integer(c_int) function c_isatty(fd) bind(C, name='isatty')
       import :: c_int
       integer(c_int), value :: fd
@@ -141,9 +143,16 @@ program impact1d_cli
   call refuse_to_overwrite_inputs(out_path)
   call refuse_to_overwrite_inputs(events_path(out_path))
   call make_parent_folders(out_path)
+  ! Held from creating the temporary files until they are registered: a signal in between
+  ! would otherwise leave them behind.
+  call hold_signals()
   call sink%open(out_path, input, error)
-  if (allocated(error)) call fail(error%status, error%message)
+  if (allocated(error)) then
+    call release_signals()
+    call fail(error%status, error%message)
+  end if
   call guard_temporaries(out_path // '.part' // c_null_char, events_path(out_path) // '.part' // c_null_char)
+  call allow_signals()
   ! Progress only where a person watches: stderr a terminal (file descriptor 2).
   sink%show_progress = c_isatty(2_c_int) == 1
   call run(scene, sink, stats, error)

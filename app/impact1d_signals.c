@@ -56,6 +56,9 @@ void impact1d_guard_temporaries(const char *first, const char *second)
 /* While the output is put in place: a signal waits, so the pair is never half replaced. */
 void impact1d_hold_signals(void) { signal_mask(SIG_BLOCK); }
 
+/* A signal that waited is delivered now (the guard, if any, removes the temporaries). */
+void impact1d_allow_signals(void) { signal_mask(SIG_UNBLOCK); }
+
 /* The temporaries are gone (renamed or removed): a signal that waited now just ends us. */
 void impact1d_release_signals(void)
 {
