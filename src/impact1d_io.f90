@@ -95,8 +95,13 @@ contains
     character(len=512) :: message
     real(wp) :: values(n_real), values_other(n_real)
     character(len=1024) :: texts(4), texts_other(4)
+    character(len=:), allocatable :: lines(:)
 
     call scan_groups(path, present, error)
+    if (allocated(error)) return
+    ! The namelist reader reads the file's lines as an internal file: reading the file itself
+    ! it hit its end on a last line without a newline ("in &run: End of file").
+    call read_all_lines(path, lines, error)
     if (allocated(error)) return
     do j = 1, size(known_groups)
       if (any(trim(known_groups(j)) == ['bodies ', 'initial', 'run    ']) .and. .not. present(j)) then
@@ -147,37 +152,55 @@ contains
       t_end = fill; dt = fill; dt_out = fill; zero_vel = fill
       max_rows = fill; max_impulses = fill; max_step_events = fill
       title = text_fill; f1_table = text_fill; f2_table = text_fill; method = text_fill
-      open(newunit=unit, file=path, status='old', action='read', iostat=ios, iomsg=message)
-      if (ios /= 0) then
-        call raise(error, status_input, path // ': ' // trim(message))
-        return
-      end if
       do j = 1, size(known_groups)
         if (.not. present(j)) cycle
-        rewind(unit)
         select case (trim(known_groups(j)))
-        case ('scene'); read(unit, nml=scene, iostat=ios, iomsg=message)
-        case ('bodies'); read(unit, nml=bodies, iostat=ios, iomsg=message)
-        case ('walls'); read(unit, nml=walls, iostat=ios, iomsg=message)
-        case ('link'); read(unit, nml=link, iostat=ios, iomsg=message)
-        case ('initial'); read(unit, nml=initial, iostat=ios, iomsg=message)
-        case ('forces'); read(unit, nml=forces, iostat=ios, iomsg=message)
-        case ('run'); read(unit, nml=run, iostat=ios, iomsg=message)
+        case ('scene'); read(lines, nml=scene, iostat=ios, iomsg=message)
+        case ('bodies'); read(lines, nml=bodies, iostat=ios, iomsg=message)
+        case ('walls'); read(lines, nml=walls, iostat=ios, iomsg=message)
+        case ('link'); read(lines, nml=link, iostat=ios, iomsg=message)
+        case ('initial'); read(lines, nml=initial, iostat=ios, iomsg=message)
+        case ('forces'); read(lines, nml=forces, iostat=ios, iomsg=message)
+        case ('run'); read(lines, nml=run, iostat=ios, iomsg=message)
         end select
         if (ios /= 0) then
-          close(unit)
           call raise(error, status_input, path // ': in &' // trim(known_groups(j)) // ': ' // &
             plain_reason(trim(message), j))
           return
         end if
       end do
-      close(unit)
       values = [m1, m2, mu1, mu2, g, x_left, r_left, x_right, r_right, d_min, r_min, d_max, r_max, &
         x1, v1, x2, v2, f1, f2, f1_amp, f1_period, f1_phase, f2_amp, f2_period, f2_phase, t_end, dt, &
         dt_out, zero_vel, max_rows, max_impulses, max_step_events]
       texts = [title, f1_table, f2_table, method]
     end subroutine read_groups
   end subroutine read_namelist
+
+  !> Every line of a file, as the records of an internal file (blank-padded to the longest).
+  subroutine read_all_lines(path, lines, error)
+    character(len=*), intent(in) :: path
+    character(len=:), allocatable, intent(out) :: lines(:)
+    type(error_type), allocatable, intent(out) :: error
+    character(len=:), allocatable :: line
+    integer :: unit, ios, n, longest
+    call open_data_file(path, unit, error)
+    if (allocated(error)) return
+    n = 0
+    longest = 1
+    do
+      call read_line(unit, line, ios)
+      if (ios /= 0) exit
+      n = n + 1
+      longest = max(longest, len(line))
+    end do
+    allocate(character(len=longest) :: lines(n))
+    rewind(unit)
+    do n = 1, size(lines)
+      call read_line(unit, line, ios)
+      lines(n) = line
+    end do
+    close(unit)
+  end subroutine read_all_lines
 
   !> The namelist reader's message in plain words: a misspelt variable gets the group's names.
   function plain_reason(message, group) result(text)

@@ -172,3 +172,11 @@ def test_control_bytes_are_escaped(tmp_path):
         impact1d.load_scene(path)
     assert "\\x1b[31mred\\x07" in str(caught.value)
     assert not any(ord(c) < 32 for c in str(caught.value))
+
+
+def test_last_line_without_newline(tmp_path):
+    """An editor that ends the file without a newline: the namelist read hit the end of
+    the file inside &run ("in &run: End of file")."""
+    scene = impact1d.load_scene(scene_file(tmp_path, CASE3.rstrip("\n")))
+    assert scene == impact1d.load_scene(INPUT / "case3.nml").__class__(
+        **{**vars(impact1d.load_scene(INPUT / "case3.nml")), "source": str(tmp_path / "scene.nml")})
