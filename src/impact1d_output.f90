@@ -79,11 +79,11 @@ module impact1d_output
   end type memory_sink
 
   !> Keeps no samples, only what a sweep's summary needs (memory O(1) per run): the last
-  !> row comes in run_stats; here, when a body was last seen moving and the last event.
+  !> row comes in run_stats; here, since the bodies were last seen moving, the first event
+  !> that left both at rest and the first sample at rest (see rest_time).
   type, extends(sink_type) :: summary_sink
-    real(wp) :: last_moving = -huge(1.0_wp)   !< time of the last sample with a velocity
-    real(wp) :: last_event = -huge(1.0_wp)    !< time of the last logged event
-    logical :: any_event = .false.
+    real(wp) :: rest_event = huge(1.0_wp)    !< first event since then leaving both at rest
+    real(wp) :: rest_sample = huge(1.0_wp)   !< first sample since then with both at rest
   contains
     procedure :: put_sample => summary_put_sample
     procedure :: put_event => summary_put_event
@@ -207,30 +207,36 @@ contains
   subroutine summary_put_sample(self, row)
     class(summary_sink), intent(inout) :: self
     real(wp), intent(in) :: row(n_columns)
-    if (row(3) /= 0.0_wp .or. row(5) /= 0.0_wp) self%last_moving = row(1)
+    if (row(3) /= 0.0_wp .or. row(5) /= 0.0_wp) then
+      self%rest_event = huge(1.0_wp)
+      self%rest_sample = huge(1.0_wp)
+    else if (self%rest_sample == huge(1.0_wp)) then
+      self%rest_sample = row(1)
+    end if
   end subroutine summary_put_sample
 
   subroutine summary_put_event(self, t, kind, v_before, v_after)
     class(summary_sink), intent(inout) :: self
     real(wp), intent(in) :: t, v_before(2), v_after(2)
     integer, intent(in) :: kind
-    self%last_event = t
-    self%any_event = .true.
+    if (any(v_after /= 0.0_wp)) then
+      self%rest_event = huge(1.0_wp)
+      self%rest_sample = huge(1.0_wp)
+    else if (self%rest_event == huge(1.0_wp)) then
+      self%rest_event = t
+    end if
   end subroutine summary_put_event
 
-  !> When every body came to rest for good: the last event (a stick, or a rest at an
-  !> accumulation time) if no sample after it shows a velocity; 0 if nothing ever moved;
-  !> NaN if a body still moves at t_end (last_row: the final sample).
+  !> When every body came to rest for good: the instant from which no sample and no event
+  !> shows a velocity up to t_end: the event that stopped the last body (a stick, a rest at
+  !> an accumulation time, an impact leaving both still), or without one (a stop by the
+  !> vissim method's threshold) the first sample at rest; NaN if a body moves at t_end.
   real(wp) function rest_time(self, last_row)
     class(summary_sink), intent(in) :: self
     real(wp), intent(in) :: last_row(n_columns)
     rest_time = ieee_value(1.0_wp, ieee_quiet_nan)
     if (last_row(3) /= 0.0_wp .or. last_row(5) /= 0.0_wp) return
-    if (.not. self%any_event) then
-      if (self%last_moving < 0.0_wp) rest_time = 0.0_wp
-      return
-    end if
-    if (self%last_event >= self%last_moving) rest_time = self%last_event
+    rest_time = min(self%rest_event, self%rest_sample)
   end function rest_time
 
   subroutine memory_put_sample(self, row)

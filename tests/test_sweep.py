@@ -157,3 +157,17 @@ def test_runs_the_batch_entry_cannot_take(case5):
     assert methods.loc[0, "x2_end"] == impact1d.simulate(case5).x2[-1]
     absent = impact1d.sweep(case5, [{"dt_out": None}, {"dt_out": 0.01}])
     assert (absent["error"] == "").all() and absent.loc[0, "steps"] == impact1d.simulate(case5).steps
+
+
+def test_t_rest_without_a_stopping_event(case5):
+    """The vissim method stops bodies by its velocity threshold and logs no rest: t_rest is
+    then the first sample from which both stay at rest (it was NaN)."""
+    table = impact1d.sweep(case5, [{"method": "vissim", "r_left": 0.5}, {"method": "vissim", "dt": 1e-3}])
+    res = impact1d.simulate(case5, method="vissim")
+    moving = (res.v1 != 0) | (res.v2 != 0)
+    assert not moving[-1]
+    first_still = res.t[np.flatnonzero(moving)[-1] + 1]
+    assert table.loc[1, "t_rest"] == first_still and abs(first_still - 3.0) < 0.05
+    # Batch (numbers only) and per-run (a text field) paths give the same rule.
+    batch = impact1d.sweep(case5.__class__(**{**vars(case5), "method": "vissim"}), [{"dt": 1e-3}])
+    assert batch.loc[0, "t_rest"] == first_still

@@ -37,11 +37,13 @@ _CHUNK = 64
 
 
 def summarize(result) -> dict:
-    """The summary row of one Result.
+    """The summary row of one Result (as the core's summary sink computes it).
 
-    t_rest is when every body came to rest for good: the time of the last logged event
-    (a stick, or a rest at an accumulation time) if from then on to t_end no sample shows
-    a velocity; 0 if nothing ever moved; NaN if a body still moves at t_end."""
+    t_rest is when every body came to rest for good: the instant from which no sample and
+    no event shows a velocity up to t_end: the event that stopped the last body (a stick,
+    a rest at an accumulation time, an impact leaving both still), or without one (a stop
+    by the vissim method's threshold) the first sample at rest; NaN if a body still moves
+    at t_end."""
     events = result.events
     kinds = events["kind"]
     counts = {kind: int(np.count_nonzero(kinds == kind)) for kind in _IMPACT_KINDS}
@@ -49,10 +51,15 @@ def summarize(result) -> dict:
     if moving[-1]:
         t_rest = math.nan
     else:
-        last_moving = result.t[np.flatnonzero(moving)[-1]] if moving.any() else -math.inf
-        t_rest = float(events["t"][-1]) if len(events) else 0.0
-        if t_rest < last_moving:     # moved after its last event: no event marks the stop
-            t_rest = math.nan
+        # The core's order: events at a sample's time come before that sample, and events
+        # at one instant in the order logged.
+        t_sample_moved = result.t[np.flatnonzero(moving)[-1]] if moving.any() else -math.inf
+        leaves_moving = (events["v1_after"] != 0.0) | (events["v2_after"] != 0.0)
+        after = np.arange(len(events)) > (np.flatnonzero(leaves_moving)[-1] if leaves_moving.any() else -1)
+        t_event_moved = events["t"][~after].max() if (~after).any() and leaves_moving.any() else -math.inf
+        still = events["t"][after & (events["t"] > t_sample_moved)]
+        at_rest = result.t[(result.t > t_sample_moved) & (result.t >= t_event_moved)]
+        t_rest = float(min(still.min() if len(still) else math.inf, at_rest.min()))
     row = {"x1_end": result.x1[-1], "v1_end": result.v1[-1], "x2_end": result.x2[-1],
            "v2_end": result.v2[-1], "ke_end": result.ke[-1],
            "n_impacts": sum(counts.values()), **{f"n_{k}": counts[k] for k in _IMPACT_KINDS},
