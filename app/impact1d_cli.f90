@@ -9,7 +9,8 @@ program impact1d_cli
   use impact1d_scene, only: scene_input, scene_type, i_t_end, i_dt, i_dt_out, i_method, i_title, &
     i_f1_table, i_f2_table
   use impact1d_io, only: read_scene_file, prepare_scene, lower
-  use impact1d_output, only: file_sink, make_folder, event_names, n_event_kinds, events_path
+  use impact1d_output, only: file_sink, make_folder, event_names, n_event_kinds, events_path, i_pe, i_work, &
+    i_friction_loss, i_impact_loss, i_damping_loss
   use impact1d_solver, only: run, run_stats
   use impact1d_version, only: version
   implicit none
@@ -180,10 +181,17 @@ contains
     write(output_unit, '(a)') '  events   ' // line
     write(output_unit, '(a, 5(a, es12.5))') '  final    ', ' t =', stats%last_row(1), '  x1 =', stats%last_row(2), &
       '  v1 =', stats%last_row(3), '  x2 =', stats%last_row(4), '  v2 =', stats%last_row(5)
-    write(output_unit, '(a, es12.5, a)') '  energy    KE =', stats%last_row(6), ' J'
-    write(output_unit, '(a, 3(a, es12.5), a, es9.2, a)') '  ledger   ', ' work =', stats%last_row(7), &
-      '  friction loss =', stats%last_row(8), '  impact loss =', stats%last_row(9), &
-      '  |residual| <=', stats%max_residual, ' J'
+    if (scene%springs%has_spring) then
+      write(output_unit, '(2(a, es12.5), a)') '  energy    KE =', stats%last_row(6), '  PE =', &
+        stats%last_row(i_pe), ' J'
+    else
+      write(output_unit, '(a, es12.5, a)') '  energy    KE =', stats%last_row(6), ' J'
+    end if
+    write(output_unit, '(a, 3(a, es12.5))', advance='no') '  ledger   ', ' work =', stats%last_row(i_work), &
+      '  friction loss =', stats%last_row(i_friction_loss), '  impact loss =', stats%last_row(i_impact_loss)
+    if (scene%springs%has_damper) write(output_unit, '(a, es12.5)', advance='no') '  damping loss =', &
+      stats%last_row(i_damping_loss)
+    write(output_unit, '(a, es9.2, a)') '  |residual| <=', stats%max_residual, ' J'
     write(output_unit, '(a)') '  steps     ' // fmt(stats%steps) // ' RK4 steps'
   end subroutine summary
 

@@ -12,7 +12,7 @@ module impact1d_api
     i_title, i_f1_table, i_f2_table, i_method, n_contacts
   use impact1d_io, only: read_scene_file, prepare_scene
   use impact1d_output, only: memory_sink, summary_sink, column_names_text => column_names, event_names, &
-    n_columns, event_impact
+    n_columns, event_impact, present_columns, i_impact_loss, i_friction_loss
   use impact1d_solver, only: run, run_stats
   implicit none
   private
@@ -80,9 +80,10 @@ contains
   !> Check and run a scene given as flat fields. The samples fill samples(:n_samples, :) and
   !> the events the event arrays up to n_events; when either needs more room than the caller
   !> gave (max_samples, max_events), status is 3 and n_samples, n_events are the sizes needed:
-  !> call again with them.
+  !> call again with them. has_column(k) is 1 for the columns the scene has (column_names
+  !> lists all of them; pe and damping_loss only exist with springs and dampers).
   subroutine simulate(n, values, given, title, f1_table, f2_table, method, progress, max_samples, &
-      n_cols, max_events, samples, event_t, event_kind, event_v, n_samples, n_events, steps, &
+      n_cols, max_events, samples, has_column, event_t, event_kind, event_v, n_samples, n_events, steps, &
       energy_residual, status, message)
     !f2py threadsafe
     integer(c_int), intent(in) :: n
@@ -92,6 +93,7 @@ contains
     integer(c_int), intent(in) :: progress    !< non-zero: show progress on stderr after 1 s
     integer(c_int), intent(in) :: max_samples, n_cols, max_events
     real(c_double), intent(out) :: samples(max_samples, n_cols)
+    integer(c_int), intent(out) :: has_column(n_cols)
     real(c_double), intent(out) :: event_t(max_events), event_v(4, max_events)
     integer(c_int), intent(out) :: event_kind(max_events)
     integer(c_int), intent(out) :: n_samples, n_events, steps
@@ -106,6 +108,7 @@ contains
 
     n_samples = 0
     n_events = 0
+    has_column = 0
     steps = 0
     energy_residual = 0.0_c_double
     if (.not. field_count_ok(n, status, message)) return
@@ -117,6 +120,7 @@ contains
     input = flat_input(values, given, title, f1_table, f2_table, method)
     call prepare_scene(input, scene, error)
     if (failed(error, status, message)) return
+    has_column(present_columns(input)) = 1
     call sink%reserve(scene%n_samples)
     sink%show_progress = progress /= 0
     call run(scene, sink, stats, error)
@@ -189,7 +193,7 @@ contains
       summary(:, j) = [stats%last_row([2, 3, 4, 5, 6]), &
         real(sum(stats%events(event_impact + 1:event_impact + n_contacts)), wp), &
         real(stats%events(event_impact + 1:event_impact + n_contacts), wp), &
-        sink%rest_time(stats%last_row), stats%last_row([9, 8]), stats%max_residual, real(stats%steps, wp)]
+        sink%rest_time(stats%last_row), stats%last_row([i_impact_loss, i_friction_loss]), stats%max_residual, real(stats%steps, wp)]
     end do
   end subroutine simulate_summaries
 

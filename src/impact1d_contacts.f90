@@ -7,6 +7,7 @@ module impact1d_contacts
   use impact1d_state, only: state_type, add_compensated
   use impact1d_yardsticks, only: gap_rounding, time_rounding, velocity_rounding
   use impact1d_modes, only: mode_type
+  use impact1d_loads, only: state_force
   implicit none
   private
   public :: gap, gap_tolerance, gap_tolerance_along, displacement, snap, rigid_pair, u_tolerance
@@ -112,7 +113,7 @@ contains
     integer, intent(in) :: k
     real(wp), intent(in) :: entry_scale(2)
     real(wp) :: acc(2)
-    acc = mode%acceleration(scene%forcing%force(s%t))
+    acc = mode%acceleration(state_force(scene, s))
     u_tolerance = velocity_rounding * dot_product(abs(normal(:, k)), &
       max(abs(s%v) + abs(acc) * scene%dt, entry_scale))
   end function u_tolerance

@@ -15,6 +15,7 @@ module impact1d_event_point
   use impact1d_contacts, only: gap, gap_tolerance, snap, rigid_pair, u_tolerance
   use impact1d_stepping, only: rk4_type
   use impact1d_location, only: watch_type
+  use impact1d_loads, only: state_force, state_rate
   use impact1d_event_log, only: event_log_type, log_event
   implicit none
   private
@@ -47,8 +48,8 @@ contains
     integer :: k, i, n_impulses
     type(mode_type) :: new_mode
 
-    f = scene%forcing%force(s%t)
-    df = scene%forcing%rate(s%t)
+    f = state_force(scene, s)
+    df = state_rate(scene, s)
     do k = 1, n_contacts
       closed(k) = scene%has_contact(k)
       if (closed(k)) closed(k) = k == which .or. gap(scene, k, s) <= gap_tolerance(scene, k, s, 0.0_wp)
@@ -73,7 +74,7 @@ contains
     if (initial) acc = f / scene%mass     ! no mode yet: the free accelerations set the scale
     entry_scale = abs(s%v) + abs(acc) * scene%dt
     do i = 1, 2
-      if (scene%friction(i) == 0.0_wp) cycle
+      if (scene%static_friction(i) == 0.0_wp) cycle
       if (i == which - 100 .or. abs(s%v(i)) <= velocity_rounding * abs(acc(i)) * scene%dt) &
         call zero_velocity(scene, s, i)
     end do
@@ -137,6 +138,11 @@ contains
       end do
     end do
 
+    ! Dampers pull with the velocities the impacts left.
+    if (scene%springs%has_damper) then
+      f = state_force(scene, s)
+      df = state_rate(scene, s)
+    end if
     call candidates(scene, mode, s, entry_scale, closed, candidate, resting, moving_sign)
     call solve_mode(scene, f, df, candidate, resting, moving_sign, new_mode, found, force_scale(scene, f, df))
     if (.not. found) then
@@ -153,7 +159,7 @@ contains
       call watch%find_quiet_times(scene, mode, s, rk%constant_acceleration)
     end if
     watch%watching = mode%n_hold > 0 .or. any(scene%has_contact .and. .not. mode%active) .or. &
-      any(scene%friction > 0.0_wp .and. mode%sgn /= 0.0_wp)
+      any(scene%static_friction > 0.0_wp .and. mode%sgn /= 0.0_wp)
   end subroutine event_point
 
   !> Log what a user can see change between the old mode and new_mode: contacts that start
@@ -197,7 +203,7 @@ contains
     ! exactly at the bound) the acceleration's rate, points along its sliding direction.
     acc_rate = matmul(new_mode%gain, df)
     do i = 1, 2
-      if (scene%friction(i) == 0.0_wp) cycle
+      if (scene%static_friction(i) == 0.0_wp) cycle
       leaving = new_mode%sgn(i) * acc(i) > tol_a(i) .or. (new_mode%sgn(i) * acc(i) >= -tol_a(i) .and. &
         new_mode%sgn(i) * acc_rate(i) > 1.0e3_wp * eps_wp * sum(abs(df)) / scene%mass(i))
       resting_now = s%v(i) == 0.0_wp .and. .not. leaving
@@ -309,7 +315,7 @@ contains
     type(scene_type), intent(in) :: scene
     type(state_type), intent(inout) :: s
     integer, intent(in) :: i
-    if (scene%friction(i) > 0.0_wp) then
+    if (scene%static_friction(i) > 0.0_wp) then
       call add_compensated(s%friction_loss, s%friction_lo, 0.5_wp * scene%mass(i) * s%v(i)**2)
     else
       s%impact_loss = s%impact_loss + 0.5_wp * scene%mass(i) * s%v(i)**2
@@ -342,9 +348,9 @@ contains
       candidate(k) = closed(k)
       if (candidate(k)) candidate(k) = abs(normal_velocity(k, s%v)) <= u_tolerance(scene, mode, s, k, entry_scale)
     end do
-    resting = scene%friction > 0.0_wp .and. s%v == 0.0_wp
+    resting = scene%static_friction > 0.0_wp .and. s%v == 0.0_wp
     moving_sign = 0.0_wp
-    where (scene%friction > 0.0_wp .and. s%v /= 0.0_wp) moving_sign = sign(1.0_wp, s%v)
+    where (scene%static_friction > 0.0_wp .and. s%v /= 0.0_wp) moving_sign = sign(1.0_wp, s%v)
   end subroutine candidates
 
   pure function u_tolerances(scene, mode, s, entry_scale) result(tol)

@@ -16,12 +16,13 @@ module impact1d_io
   !> its fill after either of two reads over different fills (see read_namelist).
   real(wp), parameter :: absent = huge(1.0_wp)
   character(len=*), parameter :: absent_text = achar(1), absent_text_other = achar(2)
-  character(len=*), parameter :: known_groups(7) = [character(len=7) :: &
-    'scene', 'bodies', 'walls', 'link', 'initial', 'forces', 'run']
+  character(len=*), parameter :: known_groups(8) = [character(len=7) :: &
+    'scene', 'bodies', 'walls', 'link', 'initial', 'forces', 'springs', 'run']
   !> Each group's variables, for the message about a misspelt one (as the namelists below).
   character(len=*), parameter :: group_variables(size(known_groups)) = [character(len=96) :: &
-    'title', 'm1, m2, mu1, mu2, g', 'x_left, r_left, x_right, r_right', 'd_min, r_min, d_max, r_max', &
+    'title', 'm1, m2, mu1, mu2, mus1, mus2, g', 'x_left, r_left, x_right, r_right', 'd_min, r_min, d_max, r_max', &
     'x1, v1, x2, v2', 'f1, f2, f1_table, f2_table, f1_amp, f1_period, f1_phase, f2_amp, f2_period, f2_phase', &
+    'k1, x1_rest, c1, k2, x2_rest, c2, k12, d_rest, c12', &
     't_end, dt, dt_out, method, zero_vel, max_rows, max_impulses, max_step_events']
   !> The tutorial's parameter files list these, in its Table 1 order; g is 10 there.
   integer, parameter :: dat_order(17) = [i_m1, i_m2, i_mu1, i_r_left, i_r_right, i_r_min, &
@@ -82,13 +83,15 @@ contains
     real(wp) :: m1, m2, mu1, mu2, g, x_left, r_left, x_right, r_right, d_min, r_min, d_max, r_max
     real(wp) :: x1, v1, x2, v2, f1, f2, f1_amp, f1_period, f1_phase, f2_amp, f2_period, f2_phase
     real(wp) :: t_end, dt, dt_out, zero_vel, max_rows, max_impulses, max_step_events
+    real(wp) :: mus1, mus2, k1, x1_rest, c1, k2, x2_rest, c2, k12, d_rest, c12
     character(len=1024) :: title, f1_table, f2_table, method
     namelist /scene/ title
-    namelist /bodies/ m1, m2, mu1, mu2, g
+    namelist /bodies/ m1, m2, mu1, mu2, mus1, mus2, g
     namelist /walls/ x_left, r_left, x_right, r_right
     namelist /link/ d_min, r_min, d_max, r_max
     namelist /initial/ x1, v1, x2, v2
     namelist /forces/ f1, f2, f1_table, f2_table, f1_amp, f1_period, f1_phase, f2_amp, f2_period, f2_phase
+    namelist /springs/ k1, x1_rest, c1, k2, x2_rest, c2, k12, d_rest, c12
     namelist /run/ t_end, dt, dt_out, method, zero_vel, max_rows, max_impulses, max_step_events
     logical :: present(size(known_groups))
     integer :: unit, ios, j
@@ -151,6 +154,8 @@ contains
       f2_amp = fill; f2_period = fill; f2_phase = fill
       t_end = fill; dt = fill; dt_out = fill; zero_vel = fill
       max_rows = fill; max_impulses = fill; max_step_events = fill
+      mus1 = fill; mus2 = fill; k1 = fill; x1_rest = fill; c1 = fill; k2 = fill; x2_rest = fill
+      c2 = fill; k12 = fill; d_rest = fill; c12 = fill
       title = text_fill; f1_table = text_fill; f2_table = text_fill; method = text_fill
       do j = 1, size(known_groups)
         if (.not. present(j)) cycle
@@ -161,6 +166,7 @@ contains
         case ('link'); read(lines, nml=link, iostat=ios, iomsg=message)
         case ('initial'); read(lines, nml=initial, iostat=ios, iomsg=message)
         case ('forces'); read(lines, nml=forces, iostat=ios, iomsg=message)
+        case ('springs'); read(lines, nml=springs, iostat=ios, iomsg=message)
         case ('run'); read(lines, nml=run, iostat=ios, iomsg=message)
         end select
         if (ios /= 0) then
@@ -171,7 +177,8 @@ contains
       end do
       values = [m1, m2, mu1, mu2, g, x_left, r_left, x_right, r_right, d_min, r_min, d_max, r_max, &
         x1, v1, x2, v2, f1, f2, f1_amp, f1_period, f1_phase, f2_amp, f2_period, f2_phase, t_end, dt, &
-        dt_out, zero_vel, max_rows, max_impulses, max_step_events]
+        dt_out, zero_vel, max_rows, max_impulses, max_step_events, mus1, mus2, k1, x1_rest, c1, k2, &
+        x2_rest, c2, k12, d_rest, c12]
       texts = [title, f1_table, f2_table, method]
     end subroutine read_groups
   end subroutine read_namelist
@@ -272,7 +279,7 @@ contains
               if (trim(known_groups(k)) == name) group = k
             end do
             if (group == 0) then
-              call fail('unknown group &' // name // ' (groups: &scene &bodies &walls &link &initial &forces &run)')
+              call fail('unknown group &' // name // ' (groups: &scene &bodies &walls &link &initial &forces &springs &run)')
               return
             end if
             if (present(group)) then

@@ -11,6 +11,7 @@ module impact1d_location
   use impact1d_yardsticks, only: velocity_rounding, force_scale
   use impact1d_contacts, only: gap, gap_tolerance, gap_tolerance_along, displacement
   use impact1d_stepping, only: rk4_type, dense_output
+  use impact1d_loads, only: applied_force, state_force, state_rate
   implicit none
   private
   public :: watch_type, hold_crossing, refine, constraints_hold, first_negative
@@ -58,7 +59,7 @@ contains
       if (p(0) - step * (abs(p(1)) + step * (abs(p(2)) + step * abs(p(3)))) > 0.0_wp) cycle
       ! Only a gap that may close needs the forces' rounding (a sine costs two evaluations).
       if (.not. have_acc_rounding) acc_rounding = 1.0e3_wp * eps_wp * &
-        force_scale(scene, scene%forcing%force(a%t), scene%forcing%rate(a%t)) / scene%mass
+        force_scale(scene, state_force(scene, a), state_rate(scene, a)) / scene%mass
       have_acc_rounding = .true.
       candidate = earliest_crossing(p, step, gap_tolerance_along(scene, k, a, c, acc_rounding))
       if (candidate < theta) then
@@ -67,7 +68,7 @@ contains
       end if
     end do
     do i = 1, 2
-      if (scene%friction(i) == 0.0_wp .or. mode%sgn(i) == 0.0_wp) cycle
+      if (scene%static_friction(i) == 0.0_wp .or. mode%sgn(i) == 0.0_wp) cycle
       if (a%t + step < self%quiet_until(n_contacts + i)) cycle
       if (.not. have_dense) c = dense_output(a, b, step)
       have_dense = .true.
@@ -82,7 +83,8 @@ contains
     end do
     ! Under constant forces the mode's conditions are constant: they held when it began.
     if (mode%n_hold > 0 .and. .not. constant_forcing) then
-      candidate = hold_crossing(scene, mode, a%t, step)
+      if (scene%springs%present .and. .not. have_dense) c = dense_output(a, b, step)
+      candidate = hold_crossing(scene, mode, a, c, step)
       if (candidate < theta) then
         theta = candidate
         which = -1
@@ -91,32 +93,39 @@ contains
   end subroutine locate
 
   !> Earliest time in [0, step] at which a condition of the mode (a contact force, a static
-  !> friction margin) has turned negative. They depend on time only: linear within a step under
-  !> piecewise-linear forcing, so the ends decide; a sine is sampled finer before bisection.
-  real(wp) function hold_crossing(scene, mode, t0, step) result(theta)
+  !> friction margin) has turned negative, for the step from state a with dense output c.
+  !> Without springs they depend on time only: linear within a step under piecewise-linear
+  !> forcing, so the ends decide; a sine is sampled finer before bisection. With springs they
+  !> follow the state, read on the dense output, sampled as finely as the springs' frequency asks.
+  real(wp) function hold_crossing(scene, mode, a, c, step) result(theta)
     type(scene_type), intent(in) :: scene
     type(mode_type), intent(in) :: mode
-    real(wp), intent(in) :: t0, step
-    real(wp) :: lo, hi, mid, tol
+    type(state_type), intent(in) :: a
+    real(wp), intent(in) :: c(3, 2), step
+    real(wp) :: lo, hi, mid, tol, t0
     integer :: n_sub, j
+    real(wp), parameter :: two_pi = 2.0_wp * acos(-1.0_wp)
     theta = huge(1.0_wp)
-    tol = hold_tolerance(scene, t0)
+    t0 = a%t
+    tol = hold_tolerance(scene, a)
     n_sub = 1
     do j = 1, 2
       if (scene%forcing%has_sine(j)) n_sub = max(n_sub, &
-        ceiling(16.0_wp * step * scene%forcing%omega(j) / (2.0_wp * acos(-1.0_wp))))
+        ceiling(16.0_wp * step * scene%forcing%omega(j) / two_pi))
     end do
+    if (scene%springs%present) n_sub = max(n_sub, &
+      ceiling(16.0_wp * step * scene%springs%frequency(scene%mass) / two_pi))
     lo = 0.0_wp
     do j = 1, n_sub
       hi = step * real(j, wp) / real(n_sub, wp)
-      if (worst_hold(scene, mode, t0 + hi) < -tol) then
+      if (worst_hold(scene, mode, a, c, hi) < -tol) then
         ! Bisection to the first instant at which a condition has failed (within rounding):
         ! there the new mode's accelerations have the sign of the change. At the last
         ! instant that held, a released contact would be left a rounding-level acceleration
         ! back into it and close again at once, for ever.
         do while (hi - lo > 2.0_wp * eps_wp * max(abs(t0 + hi), step))
           mid = 0.5_wp * (lo + hi)
-          if (worst_hold(scene, mode, t0 + mid) < 0.0_wp) then
+          if (worst_hold(scene, mode, a, c, mid) < 0.0_wp) then
             hi = mid
           else
             lo = mid
@@ -129,19 +138,28 @@ contains
     end do
   end function hold_crossing
 
-  real(wp) function worst_hold(scene, mode, t)
+  !> The mode's weakest condition theta into the step from a (dense output c).
+  real(wp) function worst_hold(scene, mode, a, c, theta)
     type(scene_type), intent(in) :: scene
     type(mode_type), intent(in) :: mode
-    real(wp), intent(in) :: t
-    real(wp) :: values(max_holds)
-    values = mode%holds(scene%forcing%force(t))
+    type(state_type), intent(in) :: a
+    real(wp), intent(in) :: c(3, 2), theta
+    real(wp) :: values(max_holds), f(2), dx(2), v(2)
+    if (scene%springs%present) then
+      dx = a%x_lo + theta * (c(1, :) + theta * (c(2, :) + theta * c(3, :)))
+      v = c(1, :) + theta * (2.0_wp * c(2, :) + 3.0_wp * theta * c(3, :))
+      f = applied_force(scene, a%t + theta, a%x, dx, v)
+    else
+      f = scene%forcing%force(a%t + theta)
+    end if
+    values = mode%holds(f)
     worst_hold = minval(values(1:mode%n_hold))
   end function worst_hold
 
-  real(wp) function hold_tolerance(scene, t)
+  real(wp) function hold_tolerance(scene, a)
     type(scene_type), intent(in) :: scene
-    real(wp), intent(in) :: t
-    hold_tolerance = 1.0e3_wp * eps_wp * force_scale(scene, scene%forcing%force(t), scene%forcing%rate(t)) &
+    type(state_type), intent(in) :: a
+    hold_tolerance = 1.0e3_wp * eps_wp * force_scale(scene, state_force(scene, a), state_rate(scene, a)) &
       + tiny(1.0_wp)
   end function hold_tolerance
 
@@ -164,7 +182,7 @@ contains
     do iteration = 1, 8
       if (which > 100) then
         value = b%v(which - 100)
-        acc = mode%acceleration(scene%forcing%force(b%t))
+        acc = mode%acceleration(state_force(scene, b))
         slope = acc(which - 100)
         tol = velocity_rounding * max(abs(a%v(which - 100)), abs(value))
       else
@@ -195,7 +213,7 @@ contains
       if (gap(scene, k, b) < -gap_tolerance(scene, k, b, displacement(k, s, b))) constraints_hold = .false.
     end do
     do i = 1, 2
-      if (scene%friction(i) == 0.0_wp .or. mode%sgn(i) == 0.0_wp) cycle
+      if (scene%static_friction(i) == 0.0_wp .or. mode%sgn(i) == 0.0_wp) cycle
       if (mode%sgn(i) * b%v(i) < -velocity_rounding * max(abs(s%v(i)), abs(b%v(i)), &
           abs(b%v(i) - s%v(i)))) constraints_hold = .false.
     end do
@@ -219,7 +237,7 @@ contains
         dot_product(normal(:, k), constant_acceleration))
     end do
     do i = 1, 2
-      if (scene%friction(i) == 0.0_wp .or. mode%sgn(i) == 0.0_wp) cycle
+      if (scene%static_friction(i) == 0.0_wp .or. mode%sgn(i) == 0.0_wp) cycle
       self%quiet_until(n_contacts + i) = s%t + 0.99_wp * first_negative(mode%sgn(i) * s%v(i), &
         mode%sgn(i) * constant_acceleration(i), 0.0_wp)
     end do

@@ -73,7 +73,7 @@ contains
     logical :: active(n_contacts)
 
     found = .false.
-    scale = sum(abs(f)) + 2.0_wp * sum(scene%friction)
+    scale = sum(abs(f)) + 2.0_wp * sum(scene%static_friction)
     if (present(force_scale)) scale = max(scale, force_scale)
     do target_stuck = 2, 0, -1
       do o1 = 0, 2
@@ -185,8 +185,8 @@ contains
         call add_hold(k_gain(p, :), 0.0_wp)                       ! contact force >= 0
       else
         i = row_body(p)
-        call add_hold(-k_gain(p, :), scene%friction(i))           ! static friction <= c_i
-        call add_hold(k_gain(p, :), scene%friction(i))            ! static friction >= -c_i
+        call add_hold(-k_gain(p, :), scene%static_friction(i))    ! static friction <= mus_i m_i g
+        call add_hold(k_gain(p, :), scene%static_friction(i))     ! static friction >= -mus_i m_i g
       end if
     end do
     do p = 1, mode%n_hold

@@ -7,16 +7,22 @@ module impact1d_output
   use impact1d_kinds, only: wp
   use impact1d_error, only: error_type, raise, status_input, status_simulation, fmt
   use impact1d_scene, only: scene_input, real_names, n_real, i_title, i_method, i_g, i_dt_out, &
-    i_dt, default_gravity
+    i_dt, default_gravity, i_k1, i_k2, i_k12, i_c1, i_c2, i_c12
   implicit none
   private
   public :: sink_type, memory_sink, summary_sink, file_sink, n_columns, column_names, n_event_kinds, event_names
   public :: event_impact, event_rest, event_release, event_stick, event_slip, make_folder, run_stats
-  public :: emit_sample, events_path
+  public :: emit_sample, events_path, present_columns, i_pe, i_work, i_friction_loss, i_impact_loss, &
+    i_damping_loss
 
-  integer, parameter :: n_columns = 10
+  !> Every column a run can have; a scene's output carries those it has (present_columns):
+  !> pe only with springs, damping_loss only with dampers.
+  integer, parameter :: n_columns = 12, i_pe = 7, i_work = 8, i_friction_loss = 9, i_impact_loss = 10, &
+    i_damping_loss = 11
   character(len=*), parameter :: column_names = &
-    't x1 v1 x2 v2 ke work friction_loss impact_loss residual'
+    't x1 v1 x2 v2 ke pe work friction_loss impact_loss damping_loss residual'
+  character(len=*), parameter :: column_words(n_columns) = [character(len=13) :: 't', 'x1', 'v1', &
+    'x2', 'v2', 'ke', 'pe', 'work', 'friction_loss', 'impact_loss', 'damping_loss', 'residual']
 
   !> Event kinds: impact on contact k is code k; rest, release add 4 and 8; stick, slip of
   !> body i are 12 + i and 14 + i.
@@ -99,6 +105,8 @@ module impact1d_output
     character(len=:), allocatable :: path, event_path
     !> The first failed write ('file: reason'); nothing more is written after it.
     character(len=:), allocatable :: write_failure
+    !> The columns this scene has, in order.
+    integer, allocatable :: columns(:)
     !> Bytes written to each file, and the fixed length of a sample and an event line: the
     !> Fortran runtime may drop a full disk's error (gfortran 12 does, on write, flush and
     !> close alike), so a file is only trusted once its size on disk is what was written.
@@ -142,15 +150,23 @@ contains
   !> both methods report through here, so their columns cannot drift apart. A row that is not
   !> finite (v = 1e300 squares to an infinite KE, and the residual becomes NaN) is an error,
   !> never a result: a NaN would also slip through the max of the residuals.
-  subroutine emit_sample(sink, stats, t, x, v, mass, ke0, work, friction_loss, impact_loss, error)
+  !> springs: [pe, pe0, damping_loss] for a scene with springs or dampers (the residual then
+  !> counts the potential energy and the dampers' loss).
+  subroutine emit_sample(sink, stats, t, x, v, mass, ke0, work, friction_loss, impact_loss, error, springs)
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
     real(wp), intent(in) :: t, x(2), v(2), mass(2), ke0, work, friction_loss, impact_loss
     type(error_type), allocatable, intent(out) :: error
+    real(wp), intent(in), optional :: springs(3)
     real(wp) :: row(n_columns), ke
     ke = 0.5_wp * dot_product(mass, v**2)
-    row = [t, x(1), v(1), x(2), v(2), ke, work, friction_loss, impact_loss, &
-      ke - ke0 - work + friction_loss + impact_loss]
+    if (present(springs)) then
+      row = [t, x(1), v(1), x(2), v(2), ke, springs(1), work, friction_loss, impact_loss, springs(3), &
+        ((ke + springs(1)) - (ke0 + springs(2))) - work + friction_loss + impact_loss + springs(3)]
+    else
+      row = [t, x(1), v(1), x(2), v(2), ke, 0.0_wp, work, friction_loss, impact_loss, 0.0_wp, &
+        ke - ke0 - work + friction_loss + impact_loss]
+    end if
     if (.not. all(abs(row) <= huge(1.0_wp))) then
       call raise(error, status_simulation, 'at t = ' // fmt(t) // ': the kinetic energy or the ' // &
         'energy ledger is no longer finite (KE = ' // fmt(ke) // ', KE0 = ' // fmt(ke0) // ' J)')
@@ -160,6 +176,31 @@ contains
     stats%last_row = row
     call sink%put_sample(row)
   end subroutine emit_sample
+
+  !> The columns a scene's output has, as indices into the full row: all but pe when it names
+  !> no spring and damping_loss when it names no damper (a component a scene does not name
+  !> is absent from its output too).
+  function present_columns(input) result(columns)
+    type(scene_input), intent(in) :: input
+    integer, allocatable :: columns(:)
+    logical :: keep(n_columns)
+    integer :: k
+    keep = .true.
+    keep(i_pe) = any(input%given([i_k1, i_k2, i_k12]))
+    keep(i_damping_loss) = any(input%given([i_c1, i_c2, i_c12]))
+    columns = pack([(k, k = 1, n_columns)], keep)
+  end function present_columns
+
+  !> The names of the given columns, each after a space.
+  function names_of(columns) result(text)
+    integer, intent(in) :: columns(:)
+    character(len=:), allocatable :: text
+    integer :: k
+    text = ''
+    do k = 1, size(columns)
+      text = text // ' ' // trim(column_words(columns(k)))
+    end do
+  end function names_of
 
   !> Called by the stepping loop every few thousand steps: cheap unless a line is due.
   subroutine progress(self, t, t_end)
@@ -303,8 +344,9 @@ contains
     end if
     self%is_open = .true.
     self%bytes = 0
-    self%sample_bytes = line_bytes(row_format, 0.0_wp)
-    self%event_bytes = line_bytes(event_format, 0.0_wp, event_names(1))
+    self%columns = present_columns(input)
+    self%sample_bytes = line_bytes(row_format, 0.0_wp, size(self%columns))
+    self%event_bytes = line_bytes(event_format, 0.0_wp, 4, event_names(1))
     call self%put_line(self%unit, '# impact1d output')
     call self%put_line(self%unit, '# title = ' // trim(input%text(i_title)))
     if (allocated(input%source)) call self%put_line(self%unit, '# scene = ' // input%source)
@@ -322,7 +364,7 @@ contains
         call self%put_line(self%unit, '# dt_out = ' // fmt(input%value(i_dt)))
       end if
     end do
-    call self%put_line(self%unit, '# ' // column_names)
+    call self%put_line(self%unit, '#' // names_of(self%columns))
     call self%put_line(self%event_unit, '# impact1d events')
     call self%put_line(self%event_unit, '# t kind v1_before v2_before v1_after v2_after')
   end subroutine file_open
@@ -333,7 +375,7 @@ contains
     integer :: ios
     character(len=512) :: message
     if (allocated(self%write_failure)) return
-    write(self%unit, row_format, iostat=ios, iomsg=message) row
+    write(self%unit, row_format, iostat=ios, iomsg=message) row(self%columns)
     if (ios /= 0) self%write_failure = self%path // ': ' // reason(message)
     self%bytes(1) = self%bytes(1) + self%sample_bytes
   end subroutine file_put_sample
@@ -420,12 +462,13 @@ contains
   end subroutine finish_file
 
   !> Length in bytes (with its newline) of a line written with a fixed-width format.
-  integer function line_bytes(format, value, name)
+  integer function line_bytes(format, value, n_values, name)
     character(len=*), intent(in) :: format
     real(wp), intent(in) :: value
+    integer, intent(in) :: n_values
     character(len=*), intent(in), optional :: name
     character(len=1024) :: line
-    real(wp) :: values(n_columns)
+    real(wp) :: values(n_values)
     values = value
     if (present(name)) then
       write(line, format) value, name, values(:4)

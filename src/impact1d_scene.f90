@@ -5,23 +5,26 @@ module impact1d_scene
   use impact1d_kinds, only: wp, eps_wp
   use impact1d_error, only: error_type, raise, status_input, fmt
   use impact1d_forcing, only: forcing_type, table_type
+  use impact1d_springs, only: springs_type, n_elements
   implicit none
   private
   public :: n_real, n_text, real_names, text_names, scene_input, scene_type, build_scene, validate
   public :: n_contacts, normal, i_left, i_right, i_slot_min, i_slot_max
   public :: i_m1, i_m2, i_mu1, i_mu2, i_g, i_x_left, i_r_left, i_x_right, i_r_right, i_d_min, &
     i_r_min, i_d_max, i_r_max, i_x1, i_v1, i_x2, i_v2, i_f1, i_f2, i_f1_amp, i_f1_period, &
-    i_f1_phase, i_f2_amp, i_f2_period, i_f2_phase, i_t_end, i_dt, i_dt_out
+    i_f1_phase, i_f2_amp, i_f2_period, i_f2_phase, i_t_end, i_dt, i_dt_out, i_mus1, i_mus2, &
+    i_k1, i_x1_rest, i_c1, i_k2, i_x2_rest, i_c2, i_k12, i_d_rest, i_c12
   public :: sample_time
   public :: i_title, i_f1_table, i_f2_table, i_method, default_gravity
 
-  integer, parameter :: n_real = 32, n_text = 4
+  integer, parameter :: n_real = 43, n_text = 4
   !> Names of the real inputs, as in the namelist and in Python's Scene, in this order.
   character(len=*), parameter :: real_names(n_real) = [character(len=15) :: &
     'm1', 'm2', 'mu1', 'mu2', 'g', 'x_left', 'r_left', 'x_right', 'r_right', &
     'd_min', 'r_min', 'd_max', 'r_max', 'x1', 'v1', 'x2', 'v2', 'f1', 'f2', &
     'f1_amp', 'f1_period', 'f1_phase', 'f2_amp', 'f2_period', 'f2_phase', 't_end', 'dt', 'dt_out', &
-    'zero_vel', 'max_rows', 'max_impulses', 'max_step_events']
+    'zero_vel', 'max_rows', 'max_impulses', 'max_step_events', 'mus1', 'mus2', &
+    'k1', 'x1_rest', 'c1', 'k2', 'x2_rest', 'c2', 'k12', 'd_rest', 'c12']
   character(len=*), parameter :: text_names(n_text) = [character(len=8) :: &
     'title', 'f1_table', 'f2_table', 'method']
   integer, parameter :: i_m1 = 1, i_m2 = 2, i_mu1 = 3, i_mu2 = 4, i_g = 5, i_x_left = 6, &
@@ -29,7 +32,11 @@ module impact1d_scene
     i_r_max = 13, i_x1 = 14, i_v1 = 15, i_x2 = 16, i_v2 = 17, i_f1 = 18, i_f2 = 19, &
     i_f1_amp = 20, i_f1_period = 21, i_f1_phase = 22, i_f2_amp = 23, i_f2_period = 24, &
     i_f2_phase = 25, i_t_end = 26, i_dt = 27, i_dt_out = 28, i_zero_vel = 29, &
-    i_max_rows = 30, i_max_impulses = 31, i_max_step_events = 32
+    i_max_rows = 30, i_max_impulses = 31, i_max_step_events = 32, i_mus1 = 33, i_mus2 = 34, &
+    i_k1 = 35, i_x1_rest = 36, i_c1 = 37, i_k2 = 38, i_x2_rest = 39, i_c2 = 40, i_k12 = 41, &
+    i_d_rest = 42, i_c12 = 43
+  !> Each spring element's stiffness; its rest position and damping follow it.
+  integer, parameter :: spring_index(n_elements) = [i_k1, i_k2, i_k12]
   integer, parameter :: i_title = 1, i_f1_table = 2, i_f2_table = 3, i_method = 4
 
   !> The four optional unilateral constraints: gap_k = normal(:,k) . x + offset_k >= 0.
@@ -62,10 +69,11 @@ module impact1d_scene
     character(len=:), allocatable :: source
   end type scene_input
 
-  !> The checked model. Friction bound c_i = mu_i m_i g.
+  !> The checked model. Friction bounds: sliding c_i = mu_i m_i g, static mus_i m_i g >= c_i.
   type :: scene_type
     character(len=:), allocatable :: title, method
-    real(wp) :: mass(2), friction(2)
+    real(wp) :: mass(2), friction(2), static_friction(2)
+    type(springs_type) :: springs
     logical :: has_contact(n_contacts) = .false.
     real(wp) :: offset(n_contacts) = 0.0_wp, restitution(n_contacts) = 1.0_wp
     real(wp) :: x0(2), v0(2)
@@ -102,7 +110,32 @@ contains
     call positive(i_m1); call positive(i_m2)
     if (allocated(error)) return
     call nonnegative(i_mu1); call nonnegative(i_mu2); call nonnegative(i_zero_vel)
+    call nonnegative(i_mus1); call nonnegative(i_mus2)
+    do k = 1, n_elements
+      call nonnegative(spring_index(k)); call nonnegative(spring_index(k) + 2)
+    end do
     if (allocated(error)) return
+    do k = 0, 1
+      if (input%given(i_mus1 + k) .and. input%value(i_mus1 + k) < value_or(i_mu1 + k, 0.0_wp)) then
+        call raise(error, status_input, trim(real_names(i_mus1 + k)) // ' = ' // fmt(input%value(i_mus1 + k)) // &
+          ' is below ' // trim(real_names(i_mu1 + k)) // ' = ' // fmt(value_or(i_mu1 + k, 0.0_wp)) // &
+          ': static friction is at least the sliding friction')
+        return
+      end if
+    end do
+    ! A spring needs the position at which it is relaxed; a rest position needs its spring.
+    do k = 1, n_elements
+      if (input%given(spring_index(k)) .neqv. input%given(spring_index(k) + 1)) then
+        if (input%given(spring_index(k))) then
+          call raise(error, status_input, trim(real_names(spring_index(k))) // ' is given but ' // &
+            trim(real_names(spring_index(k) + 1)) // ' is not: a spring needs its rest position')
+        else
+          call raise(error, status_input, trim(real_names(spring_index(k) + 1)) // ' is given but ' // &
+            trim(real_names(spring_index(k))) // ' is not: a rest position needs its spring')
+        end if
+        return
+      end if
+    end do
     call count_limit(i_max_rows); call count_limit(i_max_impulses); call count_limit(i_max_step_events)
     if (allocated(error)) return
     if (input%given(i_g) .and. input%value(i_g) < 0.0_wp .and. (value_or(i_mu1, 0.0_wp) > 0.0_wp &
@@ -121,6 +154,11 @@ contains
         return
       end if
     end if
+    if (input%given(i_d_max) .and. .not. input%given(i_d_min) .and. input%value(i_d_max) < 0.0_wp) then
+      call raise(error, status_input, 'd_max = ' // fmt(input%value(i_d_max)) // ' is negative, but ' // &
+        'without d_min the bodies meet at x2 = x1 (d_min = 0): give d_min to let them pass')
+      return
+    end if
     if (input%given(i_d_min) .and. input%given(i_d_max)) then
       if (input%value(i_d_min) > input%value(i_d_max)) then
         call raise(error, status_input, 'd_min = ' // fmt(input%value(i_d_min)) // &
@@ -138,14 +176,15 @@ contains
     ! against cannot be told from contact (case 3 moved to x = 2e14 m got an impact across
     ! its 0.5 m gap): refused, as is a friction bound mu m g that overflows.
     do k = 1, n_contacts
-      if (.not. input%given(limit_index(k))) cycle
+      if (.not. has_limit(input, k)) cycle
       gap = normal(1, k) * input%value(i_x1) + normal(2, k) * input%value(i_x2) + offset_of(k)
       scale = maxval(abs(normal(:, k) * input%value([i_x1, i_x2])))
       if (gap < -16.0_wp * eps_wp * max(scale, abs(offset_of(k)))) then
         call raise(error, status_input, 'the initial state x1 = ' // fmt(input%value(i_x1)) // &
           ', x2 = ' // fmt(input%value(i_x2)) // ' violates the ' // trim(contact_names(k)) // &
           ' constraint (' // trim(real_names(limit_index(k))) // ' = ' // &
-          fmt(input%value(limit_index(k))) // ')')
+          fmt(limit_value(input, k)) // merge(' by default: the bodies meet', '                            ', &
+          .not. input%given(limit_index(k))) // ')')
         return
       end if
       ! Within the rounding of the user's decimals (the contact test below) it is contact.
@@ -163,13 +202,15 @@ contains
     if (input%given(i_d_min) .and. input%given(i_d_max)) &
       call resolvable('the slot''s width d_max - d_min', input%value(i_d_max) - input%value(i_d_min), scale)
     if (allocated(error)) return
-    do k = 0, 1
-      if (.not. input%given(i_mu1 + k)) cycle
-      if (input%value(i_mu1 + k) * input%value(i_m1 + k) * abs(value_or(i_g, default_gravity)) > huge(1.0_wp)) then
-        call raise(error, status_input, trim(real_names(i_mu1 + k)) // ' = ' // fmt(input%value(i_mu1 + k)) // &
-          ': the friction bound mu m g overflows')
-        return
-      end if
+    do k = 0, 3
+      associate (i => merge(i_mu1, i_mus1, k < 2) + mod(k, 2))
+        if (.not. input%given(i)) cycle
+        if (input%value(i) * input%value(i_m1 + mod(k, 2)) * abs(value_or(i_g, default_gravity)) > huge(1.0_wp)) then
+          call raise(error, status_input, trim(real_names(i)) // ' = ' // fmt(input%value(i)) // &
+            ': the friction bound mu m g overflows')
+          return
+        end if
+      end associate
     end do
 
     if (input%given(i_t_end)) then
@@ -261,7 +302,8 @@ contains
       if (input%value(i) < 0.0_wp .or. input%value(i) > 1.0_wp) then
         call raise(error, status_input, trim(real_names(i)) // ' = ' // fmt(input%value(i)) // &
           ' is outside [0, 1]')
-      else if (.not. input%given(owner)) then
+      else if (.not. input%given(owner) .and. i /= i_r_min) then
+        ! (r_min alone is the restitution of the bodies meeting: d_min = 0 by default.)
         call raise(error, status_input, trim(real_names(i)) // ' is given but ' // &
           trim(real_names(owner)) // ' is not: a restitution needs its constraint')
       end if
@@ -303,7 +345,7 @@ contains
 
     real(wp) function offset_of(k)
       integer, intent(in) :: k
-      offset_of = offset_sign(k) * input%value(limit_index(k))
+      offset_of = offset_sign(k) * limit_value(input, k)
     end function offset_of
   end subroutine validate
 
@@ -330,12 +372,27 @@ contains
       if (input%given(i_mu1 + i - 1)) scene%friction(i) = input%value(i_mu1 + i - 1) * scene%mass(i) * g
     end do
     scene%friction = max(scene%friction, 0.0_wp)
+    scene%static_friction = scene%friction
+    do i = 1, 2
+      if (input%given(i_mus1 + i - 1)) scene%static_friction(i) = input%value(i_mus1 + i - 1) * scene%mass(i) * g
+    end do
+    scene%static_friction = max(scene%static_friction, scene%friction)
     do k = 1, n_contacts
-      scene%has_contact(k) = input%given(limit_index(k))
+      scene%has_contact(k) = has_limit(input, k)
       if (.not. scene%has_contact(k)) cycle
-      scene%offset(k) = offset_sign(k) * input%value(limit_index(k))
+      scene%offset(k) = offset_sign(k) * limit_value(input, k)
       if (input%given(limit_index(k) + 1)) scene%restitution(k) = input%value(limit_index(k) + 1)
     end do
+    do k = 1, n_elements
+      if (input%given(spring_index(k))) then
+        scene%springs%k(k) = input%value(spring_index(k))
+        scene%springs%rest(k) = input%value(spring_index(k) + 1)
+      end if
+      if (input%given(spring_index(k) + 2)) scene%springs%c(k) = input%value(spring_index(k) + 2)
+    end do
+    scene%springs%has_spring = any(input%given(spring_index))
+    scene%springs%has_damper = any(input%given(spring_index + 2))
+    scene%springs%present = scene%springs%has_spring .or. scene%springs%has_damper
     scene%x0 = input%value([i_x1, i_x2])
     scene%v0 = 0.0_wp
     if (input%given(i_v1)) scene%v0(1) = input%value(i_v1)
@@ -377,6 +434,22 @@ contains
       sample_time = j * scene%dt_out
     end if
   end function sample_time
+
+  !> Whether constraint k exists: as the scene names it, and the bodies' meeting (the link's
+  !> lower limit at d_min = 0) always: two bodies on one line cannot pass each other.
+  pure logical function has_limit(input, k)
+    type(scene_input), intent(in) :: input
+    integer, intent(in) :: k
+    has_limit = input%given(limit_index(k)) .or. k == i_slot_min
+  end function has_limit
+
+  !> Limit of constraint k: as given, or 0 for the bodies' meeting.
+  pure real(wp) function limit_value(input, k)
+    type(scene_input), intent(in) :: input
+    integer, intent(in) :: k
+    limit_value = 0.0_wp
+    if (input%given(limit_index(k))) limit_value = input%value(limit_index(k))
+  end function limit_value
 
   !> Index of the variable that names constraint k (its limit); the restitution follows it.
   pure integer function limit_index(k)

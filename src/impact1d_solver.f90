@@ -41,7 +41,7 @@ contains
     type(rk4_type) :: rk
     type(watch_type) :: watch
     type(event_log_type) :: event_log
-    real(wp) :: ke0, t_stop, t_break, t_rest, sample_t, window_start
+    real(wp) :: ke0, pe0, t_stop, t_break, t_rest, sample_t, window_start
     logical :: located, at_stop, glided, event_due
     integer :: j_sample, watched, window_events
 
@@ -49,19 +49,23 @@ contains
       call run_vissim(scene, sink, stats, error)
       return
     end if
-    rk%polynomial_forcing = scene%forcing%is_polynomial()
-    rk%constant_forcing = .not. (any(scene%forcing%has_table) .or. any(scene%forcing%has_sine))
+    ! Springs and dampers make the forces depend on the state: no closed forms then.
+    rk%polynomial_forcing = scene%forcing%is_polynomial() .and. .not. scene%springs%present
+    rk%constant_forcing = .not. (any(scene%forcing%has_table) .or. any(scene%forcing%has_sine) .or. &
+      scene%springs%present)
     s%t = 0.0_wp
     s%x = scene%x0
     s%v = scene%v0
     ke0 = kinetic_energy(scene, s%v)
+    pe0 = 0.0_wp
+    if (scene%springs%present) pe0 = scene%springs%potential(s%x, s%x_lo)
     window_events = 0
     window_start = 0.0_wp
 
     call event_point(scene, .true., 0, s, mode, event_log, watch, rk, sink, stats, error)
     if (allocated(error)) return
     j_sample = 0
-    call emit(scene, s, ke0, j_sample, sink, stats, error)
+    call emit(scene, s, ke0, pe0, j_sample, sink, stats, error)
     if (allocated(error)) return
 
     t_break = scene%forcing%next_breakpoint(s%t)
@@ -115,7 +119,7 @@ contains
       end if
       ! Emit.
       if (at_stop .and. s%t == sample_t) then
-        call emit(scene, s, ke0, j_sample, sink, stats, error)
+        call emit(scene, s, ke0, pe0, j_sample, sink, stats, error)
         if (allocated(error)) return
       end if
     end do
@@ -124,16 +128,21 @@ contains
   end subroutine run
 
   !> Sample j_sample of the run (then the next one is due); a row that is not finite is an error.
-  subroutine emit(scene, s, ke0, j_sample, sink, stats, error)
+  subroutine emit(scene, s, ke0, pe0, j_sample, sink, stats, error)
     type(scene_type), intent(in) :: scene
     type(state_type), intent(in) :: s
-    real(wp), intent(in) :: ke0
+    real(wp), intent(in) :: ke0, pe0
     integer, intent(inout) :: j_sample
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
     type(error_type), allocatable, intent(out) :: error
-    call emit_sample(sink, stats, s%t, s%x, s%v, scene%mass, ke0, s%work, s%friction_loss, s%impact_loss, &
-      error)
+    if (scene%springs%present) then
+      call emit_sample(sink, stats, s%t, s%x, s%v, scene%mass, ke0, s%work, s%friction_loss, s%impact_loss, &
+        error, [scene%springs%potential(s%x, s%x_lo), pe0, s%damping_loss])
+    else
+      call emit_sample(sink, stats, s%t, s%x, s%v, scene%mass, ke0, s%work, s%friction_loss, s%impact_loss, &
+        error)
+    end if
     j_sample = j_sample + 1
   end subroutine emit
 

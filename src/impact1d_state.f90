@@ -16,6 +16,8 @@ module impact1d_state
     real(wp) :: x(2) = 0.0_wp, x_lo(2) = 0.0_wp, v(2) = 0.0_wp, v_lo(2) = 0.0_wp
     real(wp) :: work = 0.0_wp, work_lo = 0.0_wp, friction_loss = 0.0_wp, friction_lo = 0.0_wp
     real(wp) :: impact_loss = 0.0_wp
+    !> What the dampers dissipated (scenes with dampers only).
+    real(wp) :: damping_loss = 0.0_wp, damping_lo = 0.0_wp
   end type state_type
 
 contains

@@ -6,6 +6,7 @@ module impact1d_stepping
   use impact1d_modes, only: mode_type
   use impact1d_events, only: hermite
   use impact1d_state, only: state_type, add_compensated
+  use impact1d_loads, only: applied_force
   implicit none
   private
   public :: rk4_type, book_constant_ledger, dense_output
@@ -20,6 +21,8 @@ module impact1d_stepping
     real(wp) :: constant_acceleration(2) = 0.0_wp
     !> The force at the end of the last step taken, and when: the next step's start force.
     real(wp) :: end_force(2) = 0.0_wp, end_force_t = -huge(1.0_wp)
+    !> With springs the force depends on the state too: the state it was evaluated in.
+    real(wp) :: end_x(2) = 0.0_wp, end_x_lo(2) = 0.0_wp, end_v(2) = 0.0_wp, end_v_lo(2) = 0.0_wp
   contains
     procedure :: step => rk4_step
     procedure :: advance_constant
@@ -63,6 +66,10 @@ contains
     type(state_type), intent(inout) :: b     ! all of it is set (inout: no default init)
     real(wp) :: f0(2), fm(2), f1(2), a0(2), am(2), a1(2)
     real(wp) :: v0(2), vm(2)
+    if (scene%springs%present) then
+      call state_dependent_step(self, scene, mode, a, step, b)
+      return
+    end if
     b = a
     if (self%constant_forcing) then
       ! The mode's acceleration was worked out once, at the event point.
@@ -96,6 +103,65 @@ contains
     call add_compensated(b%friction_loss, b%friction_lo, step / 6.0_wp * &
       dot_product(-mode%f_slide, a%v + 4.0_wp * vm + b%v))
   end subroutine rk4_step
+
+  !> One classical RK4 step when the forces depend on the state (springs, dampers): the four
+  !> stages in full, a = gain (F(t, x, v) + f_slide) within the mode. The ledger as for
+  !> time-only forces, by Simpson's rule on the step's Hermite velocity (order 4): the external
+  !> forces' work, the sliding friction's loss and the dampers' dissipation.
+  subroutine state_dependent_step(self, scene, mode, a, step, b)
+    class(rk4_type), intent(inout) :: self
+    type(scene_type), intent(in) :: scene
+    type(mode_type), intent(in) :: mode
+    type(state_type), intent(in) :: a
+    real(wp), intent(in) :: step
+    type(state_type), intent(inout) :: b
+    real(wp), parameter :: node(4) = [0.0_wp, 0.5_wp, 0.5_wp, 1.0_wp]
+    real(wp) :: kx(2, 4), kv(2, 4), v0(2), vs(2), dx(2), f(2), acc_end(2), vm(2)
+    real(wp) :: f0(2), fm(2), f1(2)
+    integer :: stage
+    v0 = a%v + a%v_lo
+    do stage = 1, 4
+      if (stage == 1) then
+        vs = v0
+        dx = a%x_lo
+        if (a%t == self%end_force_t .and. all(a%x == self%end_x) .and. all(a%x_lo == self%end_x_lo) &
+            .and. all(a%v == self%end_v) .and. all(a%v_lo == self%end_v_lo)) then
+          f = self%end_force
+        else
+          f = applied_force(scene, a%t, a%x, dx, vs)
+        end if
+      else
+        vs = v0 + (node(stage) * step) * kv(:, stage - 1)
+        dx = a%x_lo + (node(stage) * step) * kx(:, stage - 1)
+        f = applied_force(scene, a%t + node(stage) * step, a%x, dx, vs)
+      end if
+      kx(:, stage) = vs
+      kv(:, stage) = mode%acceleration(f)
+    end do
+    b = a
+    call add_compensated(b%t, b%t_lo, step)
+    call add_compensated(b%x, b%x_lo, (step / 6.0_wp) * (kx(:, 1) + 2.0_wp * (kx(:, 2) + kx(:, 3)) + kx(:, 4)))
+    call add_compensated(b%v, b%v_lo, (step / 6.0_wp) * (kv(:, 1) + 2.0_wp * (kv(:, 2) + kv(:, 3)) + kv(:, 4)))
+    ! The end force is the next step's start force.
+    f = applied_force(scene, b%t, b%x, b%x_lo, b%v + b%v_lo)
+    self%end_force = f
+    self%end_force_t = b%t
+    self%end_x = b%x
+    self%end_x_lo = b%x_lo
+    self%end_v = b%v
+    self%end_v_lo = b%v_lo
+    acc_end = mode%acceleration(f)
+    vm = 0.5_wp * (v0 + (b%v + b%v_lo)) + 0.125_wp * step * (kv(:, 1) - acc_end)
+    f0 = scene%forcing%force(a%t)
+    fm = scene%forcing%force(a%t + 0.5_wp * step)
+    f1 = scene%forcing%force(b%t)
+    call add_compensated(b%work, b%work_lo, step / 6.0_wp * (dot_product(f0, v0) + &
+      4.0_wp * dot_product(fm, vm) + dot_product(f1, b%v)))
+    call add_compensated(b%friction_loss, b%friction_lo, step / 6.0_wp * &
+      dot_product(-mode%f_slide, v0 + 4.0_wp * vm + b%v))
+    call add_compensated(b%damping_loss, b%damping_lo, step / 6.0_wp * (scene%springs%damping_power(v0) + &
+      4.0_wp * scene%springs%damping_power(vm) + scene%springs%damping_power(b%v)))
+  end subroutine state_dependent_step
 
   !> The step's dense output: Hermite coefficients of both bodies' displacements.
   pure function dense_output(a, b, step) result(c)

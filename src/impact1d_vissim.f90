@@ -3,7 +3,8 @@
 !> same scenes. Fixed-step RK4 with no event location; collisions are seen as sign changes
 !> of a gap at step ends and applied with the velocities of the step before (the diagram's
 !> one-step delay); walls are limited integrators (positions clamped); friction follows the
-!> diagram's rules with a zero-velocity threshold. Its errors are O(dt) by design.
+!> diagram's rules with a zero-velocity threshold (static friction's bound when at rest).
+!> Springs and dampers add their forces to the applied ones. Its errors are O(dt) by design.
 module impact1d_vissim
   use, intrinsic :: iso_fortran_env, only: int64
   use impact1d_kinds, only: wp
@@ -12,6 +13,7 @@ module impact1d_vissim
     sample_time
   use impact1d_impacts, only: impulse, kinetic_energy
   use impact1d_output, only: sink_type, run_stats, emit_sample, event_impact
+  use impact1d_loads, only: applied_force
   implicit none
   private
   public :: run_vissim
@@ -24,7 +26,8 @@ contains
     type(run_stats), intent(out) :: stats
     type(error_type), allocatable, intent(out) :: error
     real(wp) :: t, x(2), v(2), v_prev(2), x_new(2), v_new(2), work, friction_loss, impact_loss
-    real(wp) :: ke0, h, t_sample, gap_before(n_contacts), v_hit(2), dwork, dfriction
+    real(wp) :: ke0, pe0, h, t_sample, gap_before(n_contacts), v_hit(2), dwork, dfriction
+    real(wp) :: damping_loss, ddamping
     integer :: j_sample, k
     integer, parameter :: slot_first(n_contacts) = [i_slot_min, i_slot_max, i_left, i_right]
 
@@ -36,7 +39,9 @@ contains
     work = 0.0_wp
     friction_loss = 0.0_wp
     impact_loss = 0.0_wp
+    damping_loss = 0.0_wp
     ke0 = kinetic_energy(scene, threshold(v))
+    pe0 = scene%springs%potential(x, [0.0_wp, 0.0_wp])
     j_sample = 0
     call emit()
     if (allocated(error)) return
@@ -46,13 +51,14 @@ contains
       if (t_sample - t - h <= 1.0e-9_wp * scene%dt) h = t_sample - t
       v_prev = v
       gap_before = [(gap(k, x), k = 1, n_contacts)]
-      call rk4(t, x, v, h, x_new, v_new, dwork, dfriction)
+      call rk4(t, x, v, h, x_new, v_new, dwork, dfriction, ddamping)
       t = t + h
       if (t_sample - t <= 1.0e-9_wp * scene%dt) t = t_sample
       x = x_new
       v = v_new
       work = work + dwork
       friction_loss = friction_loss + dfriction
+      damping_loss = damping_loss + ddamping
       stats%steps = stats%steps + 1
       if (iand(stats%steps, 4095_int64) == 0) call sink%progress(t, scene%t_end)
       if (.not. all(abs([x, v]) <= huge(1.0_wp))) then
@@ -86,7 +92,12 @@ contains
   contains
 
     subroutine emit()
-      call emit_sample(sink, stats, t, x, threshold(v), scene%mass, ke0, work, friction_loss, impact_loss, error)
+      if (scene%springs%present) then
+        call emit_sample(sink, stats, t, x, threshold(v), scene%mass, ke0, work, friction_loss, impact_loss, &
+          error, [scene%springs%potential(x, [0.0_wp, 0.0_wp]), pe0, damping_loss])
+      else
+        call emit_sample(sink, stats, t, x, threshold(v), scene%mass, ke0, work, friction_loss, impact_loss, error)
+      end if
       j_sample = j_sample + 1
     end subroutine emit
 
@@ -111,30 +122,35 @@ contains
       where (abs(velocity) > scene%zero_velocity)
         force = -scene%friction * sign(1.0_wp, velocity)
       elsewhere
-        force = -sign(min(scene%friction, abs(f)), f)
+        force = -sign(min(scene%static_friction, abs(f)), f)
       end where
     end function friction
 
-    !> Classical RK4 on x' = thr(v), v' = (f + friction(thr(v), f)) / m, with the work and friction
-    !> dissipation integrated by the same stages.
-    subroutine rk4(t0, x0, v0, step, x1, v1, dw, dd)
+    !> Classical RK4 on x' = thr(v), v' = (f + friction(thr(v), f)) / m, with the work, friction
+    !> and damping dissipation integrated by the same stages (f: the applied forces, springs'
+    !> and dampers' included; the work is the external forces' only).
+    subroutine rk4(t0, x0, v0, step, x1, v1, dw, dd, dc)
       real(wp), intent(in) :: t0, x0(2), v0(2), step
-      real(wp), intent(out) :: x1(2), v1(2), dw, dd
-      real(wp) :: kx(2, 4), kv(2, 4), kw(4), kd(4), f(2), fr(2), vs(2), ts
+      real(wp), intent(out) :: x1(2), v1(2), dw, dd, dc
+      real(wp) :: kx(2, 4), kv(2, 4), kw(4), kd(4), kc(4), f(2), fr(2), vs(2), ts, dx(2)
       integer :: stage
       real(wp), parameter :: c(4) = [0.0_wp, 0.5_wp, 0.5_wp, 1.0_wp], b(4) = [1.0_wp, 2.0_wp, 2.0_wp, 1.0_wp]
       do stage = 1, 4
         ts = t0 + c(stage) * step
         vs = v0
+        dx = 0.0_wp
         if (stage > 1) vs = v0 + c(stage) * step * kv(:, stage - 1)
+        if (stage > 1) dx = c(stage) * step * kx(:, stage - 1)
         vs = threshold(vs)
-        f = scene%forcing%force(ts)
+        f = applied_force(scene, ts, x0, dx, vs)
         fr = friction(vs, f)
         kx(:, stage) = vs
         kv(:, stage) = (f + fr) / scene%mass
-        kw(stage) = dot_product(f, vs)
+        kw(stage) = dot_product(scene%forcing%force(ts), vs)
         kd(stage) = -dot_product(fr, vs)
+        kc(stage) = scene%springs%damping_power(vs)
       end do
+      dc = step / 6.0_wp * dot_product(kc, b)
       x1 = x0 + step / 6.0_wp * matmul(kx, b)
       v1 = v0 + step / 6.0_wp * matmul(kv, b)
       dw = step / 6.0_wp * dot_product(kw, b)

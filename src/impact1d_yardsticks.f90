@@ -23,7 +23,7 @@ contains
   pure real(wp) function force_scale(scene, f, df)
     type(scene_type), intent(in) :: scene
     real(wp), intent(in) :: f(2), df(2)
-    force_scale = sum(abs(f)) + 2.0_wp * sum(scene%friction) + sum(abs(df)) * scene%dt
+    force_scale = sum(abs(f)) + 2.0_wp * sum(scene%static_friction) + sum(abs(df)) * scene%dt
   end function force_scale
 
   !> Instants closer than the clock resolves are one (t_later >= t_earlier).

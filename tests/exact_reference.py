@@ -253,8 +253,9 @@ class Model:
         self.m = (float(_field(scene, "m1")), float(_field(scene, "m2")))
         g = float(_field(scene, "g", DEFAULT_G))
         self.c = tuple(float(_field(scene, f"mu{i}", 0.0)) * self.m[i - 1] * g for i in (1, 2))
-        self.contacts = [k for k in CONTACTS if _field(scene, LIMIT[k]) is not None]
-        self.limit = {k: float(_field(scene, LIMIT[k])) for k in self.contacts}
+        # Two bodies on one line meet: without d_min the link's lower limit is at 0.
+        self.contacts = [k for k in CONTACTS if _field(scene, LIMIT[k]) is not None or k == "slot_min"]
+        self.limit = {k: float(_field(scene, LIMIT[k], 0.0)) for k in self.contacts}
         self.r = {k: float(_field(scene, RESTITUTION[k], 1.0)) for k in self.contacts}
         tables = []
         for i in (1, 2):

@@ -115,7 +115,10 @@ def test_result_arrays_and_scene():
     scene = impact1d.load_scene(INPUT / "case3.nml")
     res = impact1d.simulate(scene, t_end=0.5, dt_out=0.01)
     n = 51
-    for name in impact1d.COLUMNS:
+    # A scene without springs or dampers has no pe and no damping_loss columns.
+    assert res.columns == tuple(c for c in impact1d.COLUMNS if c not in ("pe", "damping_loss"))
+    assert res.pe is None and res.damping_loss is None
+    for name in res.columns:
         column = getattr(res, name)
         assert isinstance(column, np.ndarray) and column.dtype == np.float64, name
         assert column.shape == (n,), name
@@ -142,8 +145,9 @@ def test_results_do_not_share_storage():
 
 
 def test_scene_built_in_python_free_flight():
-    """No constraints named: no walls and no slot; the bodies fly through each other."""
-    scene = impact1d.Scene(m1=1.0, m2=2.0, x1=0.0, v1=1.0, x2=5.0, v2=-0.5,
+    """No walls, and a link whose lower limit is far beyond reach: the bodies fly through
+    each other (without d_min they would meet, tests/test_model_widening.py)."""
+    scene = impact1d.Scene(m1=1.0, m2=2.0, x1=0.0, v1=1.0, x2=5.0, v2=-0.5, d_min=-1.0e9,
                            t_end=20.0, dt=0.01, dt_out=0.5)
     res = impact1d.simulate(scene)
     assert res.t[-1] == pytest.approx(20.0, abs=FREE_FLIGHT_TOL)

@@ -333,10 +333,10 @@ def test_cli_option_override_is_validated(cli, tmp_path):
 
 # --- runtime failures -----------------------------------------------------------------
 
-# x1 = 1e308 moving at 1e308 m/s: after one step of 0.5 s the position overflows.
+# x2 = 1e308 moving at 1e308 m/s: after one step of 0.5 s the position overflows.
 OVERFLOW = """\
 &bodies  m1 = 1.0, m2 = 2.0 /
-&initial x1 = 1.0e308, v1 = 1.0e308, x2 = 2.0 /
+&initial x1 = 2.0, x2 = 1.0e308, v2 = 1.0e308 /
 &run     t_end = 10.0, dt = 0.5 /
 """
 

@@ -100,7 +100,7 @@ def test_stray_text_is_refused(tmp_path):
 
 def test_misspelt_variable_lists_the_group(tmp_path):
     refused(tmp_path, CASE3.replace("mu1 =", "mu_1 ="),
-            r"unknown variable 'mu_1' \(&bodies has: m1, m2, mu1, mu2, g\)")
+            r"unknown variable 'mu_1' \(&bodies has: m1, m2, mu1, mu2, mus1, mus2, g\)")
 
 
 def test_missing_slash_says_so(tmp_path):

@@ -59,7 +59,8 @@ def scenes(draw, forces=True, friction=True):
     # limit is refused as input (test_bad_input.py), not a scene to simulate.
     d_min = draw(st.one_of(st.just(0.0), st.floats(1e-9, 2.0))) if has_min else None
     d_max = (d_min or 0.0) + draw(st.floats(0.1, 3.0, allow_subnormal=False)) if has_max else None
-    lo = d_min if d_min is not None else -2.0
+    # Without d_min the bodies meet at x2 = x1 (the link's lower limit at 0, r_min or 1).
+    lo = d_min if d_min is not None else 0.0
     hi = d_max if d_max is not None else 4.0
     diff = draw(st.floats(lo, hi, allow_subnormal=False))
     x1 = draw(st.floats(0.0, 10.0 - max(diff, 0.0), allow_subnormal=False))
@@ -72,6 +73,8 @@ def scenes(draw, forces=True, friction=True):
         kw.update(x_right=10.0, r_right=draw(restitution))
     if has_min:
         kw.update(d_min=d_min, r_min=draw(restitution))
+    elif draw(st.booleans()):
+        kw.update(r_min=draw(restitution))
     if has_max:
         kw.update(d_max=d_max, r_max=draw(restitution))
     return impact1d.Scene(**kw)

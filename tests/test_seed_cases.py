@@ -107,7 +107,7 @@ def test_output_grid(case):
     n = round(s.t_end / s.dt_out) + 1
     assert len(res.t) == n
     assert_close(res.t, np.arange(n) * s.dt_out, GRID_TOL, "sample times")
-    for name in impact1d.COLUMNS:
+    for name in res.columns:
         column = getattr(res, name)
         assert column.dtype == np.float64 and column.shape == (n,), name
         assert np.all(np.isfinite(column)), name

@@ -26,7 +26,7 @@ def scenes():
 
 
 def same(a, b):
-    return (all(np.array_equal(getattr(a, c), getattr(b, c)) for c in impact1d.COLUMNS)
+    return (a.columns == b.columns and all(np.array_equal(getattr(a, c), getattr(b, c)) for c in a.columns)
             and np.array_equal(a.events, b.events) and a.steps == b.steps
             and a.energy_residual == b.energy_residual)
 

@@ -5,6 +5,7 @@ program test_location
   use impact1d_scene, only: scene_type
   use impact1d_modes, only: mode_type, solve_mode
   use impact1d_location, only: hold_crossing, first_negative
+  use impact1d_state, only: state_type
   use testing, only: check, finish
   implicit none
   ! Bisection stops within 2 eps of the clock: a few ulps of t = 0.5.
@@ -12,10 +13,12 @@ program test_location
   type(scene_type) :: scene
   type(mode_type) :: mode
   logical :: found
-  real(wp) :: theta
+  real(wp) :: theta, c(3, 2) = 0.0_wp
+  type(state_type) :: a
 
   scene%mass = [1.0_wp, 2.0_wp]
   scene%friction = [10.0_wp, 20.0_wp]
+  scene%static_friction = scene%friction
   scene%has_contact = .false.
   scene%dt = 0.2_wp
   ! Body 1 pushed by f = 20 t: its friction bound 10 is reached at t = 0.5.
@@ -25,9 +28,11 @@ program test_location
   call solve_mode(scene, [0.0_wp, 0.0_wp], [20.0_wp, 0.0_wp], [.false., .false., .false., .false.], &
     [.true., .true.], [0.0_wp, 0.0_wp], mode, found)
   call check(found .and. all(mode%stuck) .and. mode%n_hold > 0, 'both bodies stuck at t = 0')
-  theta = hold_crossing(scene, mode, 0.4_wp, 0.2_wp)
+  a%t = 0.4_wp
+  theta = hold_crossing(scene, mode, a, c, 0.2_wp)
   call check(abs(theta - 0.1_wp) <= tol, 'the bound is crossed 0.1 s into the step from 0.4')
-  call check(hold_crossing(scene, mode, 0.1_wp, 0.2_wp) == huge(1.0_wp), 'no crossing in [0.1, 0.3]')
+  a%t = 0.1_wp
+  call check(hold_crossing(scene, mode, a, c, 0.2_wp) == huge(1.0_wp), 'no crossing in [0.1, 0.3]')
 
   ! A gap of 5 closing at 1 m/s under -2 m/s^2: 5 - t - t^2 = 0 at t = (sqrt(21) - 1) / 2.
   call check(abs(first_negative(5.0_wp, -1.0_wp, -2.0_wp) - (sqrt(21.0_wp) - 1.0_wp) / 2.0_wp) <= tol * 4.0_wp, &

@@ -16,6 +16,7 @@ program test_modes
 
   scene%mass = [1.0_wp, 2.0_wp]
   scene%friction = [10.0_wp, 20.0_wp]      ! mu = 1, g = 10
+  scene%static_friction = scene%friction
   scene%has_contact = .true.
 
   ! Test case 1: forces 6 and -10 below the bounds 10 and 20: both stick.
@@ -54,6 +55,7 @@ program test_modes
 
   ! Frictionless bodies locked by a closed slot_min and pushed together: they move as one.
   scene%friction = 0.0_wp
+  scene%static_friction = scene%friction
   call solve_mode(scene, [6.0_wp, -3.0_wp], no_rate, [.false., .false., .true., .false.], &
     [.false., .false.], [0.0_wp, 0.0_wp], mode, found)
   a = mode%acceleration([6.0_wp, -3.0_wp])

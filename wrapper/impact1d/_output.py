@@ -7,7 +7,7 @@ import os
 import numpy as np
 
 from ._scene import REAL_FIELDS, TEXT_FIELDS, Scene, InputError
-from ._simulate import COLUMNS, EVENT_DTYPE, Result, result_from_columns
+from ._simulate import COLUMNS, OPTIONAL_COLUMNS, EVENT_DTYPE, Result, result_from_columns
 
 __all__ = ["read_output", "events_path"]
 
@@ -59,12 +59,19 @@ def read_output(path) -> Result:
     if not os.path.isfile(path):
         raise InputError(f"cannot open output file '{path}': no such file")
     header, columns = _read_header(path)
-    if columns is None or tuple(columns.split()) != COLUMNS:
+    names = tuple(columns.split()) if columns is not None else ()
+    required = tuple(name for name in COLUMNS if name not in OPTIONAL_COLUMNS)
+    if tuple(name for name in names if name not in OPTIONAL_COLUMNS) != required or \
+            names != tuple(name for name in COLUMNS if name in names):
         raise InputError(f"{path}: the last header line must name the columns "
-                         f"'{' '.join(COLUMNS)}', got {columns!r}")
+                         f"'{' '.join(required)}' (with pe after ke and damping_loss after "
+                         f"impact_loss when the scene has them), got {columns!r}")
     samples = np.loadtxt(path, comments="#", ndmin=2)
     if samples.size == 0:
-        samples = np.empty((0, len(COLUMNS)))
+        samples = np.empty((0, len(names)))
+    if samples.shape[1] != len(names):
+        raise InputError(f"{path}: the header names {len(names)} columns, the rows have "
+                         f"{samples.shape[1]}")
 
     kwargs = {}
     for name in REAL_FIELDS:
@@ -78,7 +85,7 @@ def read_output(path) -> Result:
     events_file = events_path(path)
     events = (_read_events(events_file) if os.path.isfile(events_file)
               else np.empty(0, dtype=EVENT_DTYPE))
-    residual = samples[:, COLUMNS.index("residual")]
+    residual = samples[:, names.index("residual")]
     energy_residual = float(np.max(np.abs(residual))) if residual.size else 0.0
-    return result_from_columns(samples, events, energy_residual=energy_residual,
+    return result_from_columns(samples, events, names, energy_residual=energy_residual,
                                steps=None, scene=scene)

@@ -42,6 +42,7 @@ REAL_FIELDS = (
     "x1", "v1", "x2", "v2",
     "f1", "f2", "f1_amp", "f1_period", "f1_phase", "f2_amp", "f2_period", "f2_phase",
     "t_end", "dt", "dt_out", "zero_vel", "max_rows", "max_impulses", "max_step_events",
+    "mus1", "mus2", "k1", "x1_rest", "c1", "k2", "x2_rest", "c2", "k12", "d_rest", "c12",
 )
 TEXT_FIELDS = ("title", "f1_table", "f2_table", "method")
 
@@ -87,6 +88,17 @@ class Scene:
     max_rows: Optional[float] = None
     max_impulses: Optional[float] = None
     max_step_events: Optional[float] = None
+    mus1: Optional[float] = None
+    mus2: Optional[float] = None
+    k1: Optional[float] = None
+    x1_rest: Optional[float] = None
+    c1: Optional[float] = None
+    k2: Optional[float] = None
+    x2_rest: Optional[float] = None
+    c2: Optional[float] = None
+    k12: Optional[float] = None
+    d_rest: Optional[float] = None
+    c12: Optional[float] = None
     title: Optional[str] = None
     f1_table: Optional[str] = None
     f2_table: Optional[str] = None

@@ -13,9 +13,12 @@ from ._scene import REAL_FIELDS, Scene, InputError, decode, raise_for_status, to
 
 __all__ = ["Result", "simulate", "COLUMNS", "EVENT_DTYPE"]
 
-# The sample columns of the api (and of the CLI output), checked against the core below.
-COLUMNS = ("t", "x1", "v1", "x2", "v2", "ke", "work", "friction_loss",
-           "impact_loss", "residual")
+# Every sample column the api (and the CLI output) can have, checked against the core
+# below. A run has those its scene has: pe only with springs, damping_loss only with
+# dampers (Result.columns); the others always.
+COLUMNS = ("t", "x1", "v1", "x2", "v2", "ke", "pe", "work", "friction_loss",
+           "impact_loss", "damping_loss", "residual")
+OPTIONAL_COLUMNS = ("pe", "damping_loss")
 
 # Longest event kind is "release_slot_min" (16 characters).
 EVENT_DTYPE = np.dtype([("t", "f8"), ("kind", "U20"), ("v1_before", "f8"),
@@ -95,7 +98,9 @@ def _empty():
 @dataclass
 class Result:
     """One run: the samples as float64 arrays (one entry per output time), the event
-    log, the run's accuracy monitor and the scene actually run."""
+    log, the run's accuracy monitor and the scene actually run. pe (the springs' potential
+    energy) and damping_loss (what the dampers dissipated) are None for a scene without
+    springs or dampers: `columns` names the columns the run has."""
 
     t: np.ndarray = field(default_factory=_empty)
     x1: np.ndarray = field(default_factory=_empty)
@@ -103,9 +108,11 @@ class Result:
     x2: np.ndarray = field(default_factory=_empty)
     v2: np.ndarray = field(default_factory=_empty)
     ke: np.ndarray = field(default_factory=_empty)
+    pe: Optional[np.ndarray] = None
     work: np.ndarray = field(default_factory=_empty)
     friction_loss: np.ndarray = field(default_factory=_empty)
     impact_loss: np.ndarray = field(default_factory=_empty)
+    damping_loss: Optional[np.ndarray] = None
     residual: np.ndarray = field(default_factory=_empty)
     events: np.ndarray = field(default_factory=lambda: np.empty(0, dtype=EVENT_DTYPE))
     energy_residual: float = 0.0       # max |residual| over the samples
@@ -113,9 +120,14 @@ class Result:
     scene: Optional[Scene] = None
 
     @property
+    def columns(self) -> tuple:
+        """The names of the columns this run has, in COLUMNS order."""
+        return tuple(name for name in COLUMNS if getattr(self, name) is not None)
+
+    @property
     def samples(self) -> np.ndarray:
-        """All sample columns as one (n, 10) array, in COLUMNS order."""
-        return np.column_stack([getattr(self, name) for name in COLUMNS])
+        """The run's sample columns as one (n, len(columns)) array, in `columns` order."""
+        return np.column_stack([getattr(self, name) for name in self.columns])
 
     def __repr__(self) -> str:
         title = self.scene.title if self.scene is not None else None
@@ -123,12 +135,14 @@ class Result:
                 f"steps={self.steps}, energy_residual={self.energy_residual:.3g})")
 
 
-def result_from_columns(samples: np.ndarray, events: np.ndarray, **extra) -> Result:
-    """Build a Result from an (n, 10) sample array in COLUMNS order."""
-    samples = np.asarray(samples, dtype=np.float64).reshape(-1, len(COLUMNS))
+def result_from_columns(samples: np.ndarray, events: np.ndarray, names=COLUMNS, **extra) -> Result:
+    """Build a Result from an (n, len(names)) sample array whose columns are `names`
+    (in COLUMNS order; the optional ones may be missing)."""
+    names = tuple(names)
+    samples = np.asarray(samples, dtype=np.float64).reshape(-1, len(names))
     # Column-major (as f2py returns it, a copy otherwise): each column is a contiguous row
     # of the transpose, shared rather than copied.
-    columns = dict(zip(COLUMNS, np.asfortranarray(samples).T))
+    columns = dict(zip(names, np.asfortranarray(samples).T))
     return Result(**columns, events=events, **extra)
 
 
@@ -151,8 +165,8 @@ def simulate(scene: Scene, *, progress: bool = False, **overrides) -> Result:
     global _event_capacity
     sample_capacity, event_capacity = _sample_capacity(scene), _event_capacity
     while True:
-        (samples, event_t, event_kind, event_v, n_samples, n_events, steps, energy_residual,
-         status, message) = _api.simulate(values, given, title, f1_table, f2_table, method,
+        (samples, has_column, event_t, event_kind, event_v, n_samples, n_events, steps,
+         energy_residual, status, message) = _api.simulate(values, given, title, f1_table, f2_table, method,
                                           1 if progress else 0, sample_capacity, len(COLUMNS),
                                           event_capacity)
         if int(status) != _STATUS_TOO_SMALL:
@@ -163,7 +177,9 @@ def simulate(scene: Scene, *, progress: bool = False, **overrides) -> Result:
     n_samples, n_events = int(n_samples), int(n_events)
     # Event-heavy scenes tend to come in series (sweeps): start the next one with room.
     _event_capacity = max(_EVENT_CAPACITY, min(n_events + n_events // 8, _EVENT_CAPACITY_MAX))
-    samples = samples[:n_samples]
+    present = np.flatnonzero(has_column)
+    column_names = tuple(COLUMNS[k] for k in present)
+    samples = samples[:n_samples] if len(present) == len(COLUMNS) else samples[:n_samples, present]
     events = np.empty(n_events, dtype=EVENT_DTYPE)
     if n_events > 0:
         names = _kind_names()
@@ -172,5 +188,5 @@ def simulate(scene: Scene, *, progress: bool = False, **overrides) -> Result:
         events["kind"] = names[np.where((kind >= 1) & (kind < len(names)), kind, 0)]
         events["v1_before"], events["v2_before"] = event_v[0, :n_events], event_v[1, :n_events]
         events["v1_after"], events["v2_after"] = event_v[2, :n_events], event_v[3, :n_events]
-    return result_from_columns(samples, events, energy_residual=float(energy_residual),
+    return result_from_columns(samples, events, column_names, energy_residual=float(energy_residual),
                                steps=int(steps), scene=scene)
