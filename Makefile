@@ -17,7 +17,8 @@ export MPLBACKEND ?= Agg
 # Persistent meson build dir shared by `pip install` and `meson test`: one
 # compile serves the wheel and the Fortran unit tests, and re-runs are no-ops.
 BUILDDIR := $(CURDIR)/build/py
-CASES    := 1 2 3 4 5 6
+# The tutorial's six cases, then the mechanisms beyond it (springs, dampers, static friction).
+SCENES   := case1 case2 case3 case4 case5 case6 impact_oscillator stick_slip gear_rattle breakaway
 
 # What the installed package is made of: a change re-installs it (folders too,
 # so that a deleted file counts).
@@ -31,7 +32,7 @@ INSTALL_STAMP := $(VENV)/.installed
 
 help:
 	@echo "make setup   gfortran (apt, if missing), .venv, pip install .[test]"
-	@echo "make demo    run input/case1..6.nml with the impact1d CLI and plot them"
+	@echo "make demo    run the scenes in input/ (the six cases, springs, stick-slip, rattle, break-away) and plot them"
 	@echo "make test    Fortran unit tests (meson test), then pytest"
 	@echo "make study   case 5's rest time over (r_left, r_right): a sweep and its heatmap"
 	@echo "make bench   accuracy and speed studies, Siconos as a peer (apt, if missing)"
@@ -77,10 +78,10 @@ $(BUILDDIR)/build.ninja: ;
 
 demo: setup
 	@mkdir -p output
-	@for n in $(CASES); do \
-	  echo "== case$$n"; \
-	  impact1d input/case$$n.nml; \
-	  impact1d-plot output/case$$n.dat; \
+	@for name in $(SCENES); do \
+	  echo "== $$name"; \
+	  impact1d input/$$name.nml; \
+	  impact1d-plot output/$$name.dat; \
 	done
 
 # An example study (README): 400 runs of case 5 on every core, then the heatmap.

@@ -119,6 +119,34 @@ contains
     end do
     mode%f_slide = -scene%friction * mode%sgn
 
+    load = f + mode%f_slide
+    tol = 1.0e3_wp * eps_wp * scale + tiny(1.0_wp)
+    tol_rate = 1.0e3_wp * eps_wp * sum(abs(df))
+    ! Both bodies stuck and pressed together through the link: three locked rows in two
+    ! dimensions, dependent, so the contact force lambda >= 0 is not fixed by them. The
+    ! mode holds while some lambda keeps both static frictions within their bounds,
+    ! |f_i + lambda n_i| <= mus_i m_i g: lambda lies in two intervals centred on -n_i f_i,
+    ! and eliminating it (Fourier-Motzkin) leaves four linear conditions on f. Without this
+    ! the pair would hold only up to one body's sliding bound plus the other's static one.
+    ! Only where the link must carry load: a rigid link or bodies merely touching log no rest.
+    if (all(mode%stuck) .and. count(active) == 1) then
+      k = findloc(active, .true., dim=1)
+      if (all(normal(:, k) /= 0.0_wp)) then
+        if (admissible([-1.0_wp, 0.0_wp], scene%static_friction(1)) .and. &
+            admissible([1.0_wp, 0.0_wp], scene%static_friction(1)) .and. &
+            admissible([0.0_wp, -1.0_wp], scene%static_friction(2)) .and. &
+            admissible([0.0_wp, 1.0_wp], scene%static_friction(2))) return
+        mode%gain = 0.0_wp
+        mode%n_hold = 0
+        call add_hold([-normal(1, k), 0.0_wp], scene%static_friction(1))
+        call add_hold([0.0_wp, -normal(2, k)], scene%static_friction(2))
+        call add_hold([normal(1, k), -normal(2, k)], sum(scene%static_friction))
+        call add_hold([-normal(1, k), normal(2, k)], sum(scene%static_friction))
+        found = all([(admissible(mode%hold_w(:, p), mode%hold_c(p)), p = 1, mode%n_hold)])
+        return
+      end if
+    end if
+
     ! Locked rows: held contacts (normal n_k) and stuck bodies (unit row e_i).
     m = 0
     row_body = 0
@@ -174,10 +202,6 @@ contains
         end if
       end do
     end if
-
-    load = f + mode%f_slide
-    tol = 1.0e3_wp * eps_wp * scale + tiny(1.0_wp)
-    tol_rate = 1.0e3_wp * eps_wp * sum(abs(df))
 
     mode%n_hold = 0
     do p = 1, m

@@ -139,7 +139,8 @@ contains
     call count_limit(i_max_rows); call count_limit(i_max_impulses); call count_limit(i_max_step_events)
     if (allocated(error)) return
     if (input%given(i_g) .and. input%value(i_g) < 0.0_wp .and. (value_or(i_mu1, 0.0_wp) > 0.0_wp &
-        .or. value_or(i_mu2, 0.0_wp) > 0.0_wp)) then
+        .or. value_or(i_mu2, 0.0_wp) > 0.0_wp .or. value_or(i_mus1, 0.0_wp) > 0.0_wp .or. &
+        value_or(i_mus2, 0.0_wp) > 0.0_wp)) then
       call raise(error, status_input, 'g = ' // fmt(input%value(i_g)) // &
         ' is negative with friction: the normal force m g must not pull the bodies off the surface')
       return

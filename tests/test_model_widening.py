@@ -263,3 +263,25 @@ def test_namelist_springs_group_and_cli_columns(tmp_path):
     assert back.columns == direct.columns
     for name in direct.columns:
         np.testing.assert_allclose(getattr(back, name), getattr(direct, name), rtol=1e-15, atol=1e-300)
+
+
+@pytest.mark.parametrize("dt", [0.1, 1e-3])
+def test_a_ramp_against_two_touching_blocks_breaks_away_at_the_sum_of_static_bounds(tmp_path, dt):
+    """A ramp of 4 N/s pushes block 1 into block 2 (they touch: the bodies meet): the pair
+    holds until the ramp reaches (mus1 m1 + mus2 m2) g = 13 N, at 3.25 s (not at one
+    body's sliding bound plus the other's static one, 11 N), then slides as one body:
+    3 a = 4 t - 7, to rounding (input/breakaway.nml)."""
+    table = ramp_table(tmp_path, 10.0, 40.0)
+    res = impact1d.simulate(impact1d.Scene(m1=1.0, m2=2.0, mu1=0.3, mus1=0.5, mu2=0.2, mus2=0.4,
+                                           g=G, x1=0.0, x2=0.0, f1_table=table, t_end=5.0,
+                                           dt=dt, dt_out=0.05))
+    slips = [t for kind, t in engine_events(res, ("slip1", "slip2"))]
+    assert len(slips) == 2 and slips == pytest.approx([3.25, 3.25], rel=1e-15)
+    t = res.t
+    moving = t > 3.25
+    v = (2.0 * (t**2 - 3.25**2) - 7.0 * (t - 3.25)) / 3.0
+    x = (2.0 / 3.0 * (t**3 - 3.25**3) - 2.0 * 3.25**2 * (t - 3.25) - 3.5 * (t - 3.25)**2) / 3.0
+    np.testing.assert_allclose(res.v1[moving], v[moving], rtol=1e-13)
+    np.testing.assert_allclose(res.x1[moving], x[moving], rtol=1e-12)
+    np.testing.assert_array_equal(res.x1, res.x2)
+    assert np.all(res.v1[~moving] == 0.0)

@@ -307,11 +307,15 @@ def _draw_kinetic_energy(ax, result, events):
     t = np.asarray(result.t, dtype=float)
     ke = np.asarray(result.ke, dtype=float)
     ax.plot(t, ke, color="black", linewidth=1.3, gid="ke", label="KE = m1 v1\u00b2/2 + m2 v2\u00b2/2")
+    top = float(np.max(ke)) if ke.size else 1.0
+    if getattr(result, "pe", None) is not None:
+        pe = np.asarray(result.pe, dtype=float)
+        ax.plot(t, pe, color="tab:purple", linewidth=1.1, gid="pe", label="PE of the springs")
+        top = max(top, float(np.max(pe)) if pe.size else 0.0)
     # From zero up: a constant energy (case 3) then reads as a flat line, not as
     # rounding noise blown up by autoscaling.
-    top = float(np.max(ke)) if ke.size else 1.0
     ax.set_ylim(0.0, 1.1 * top if top > 0 else 1.0)
-    ax.set_ylabel("kinetic energy (J)")
+    ax.set_ylabel("kinetic energy (J)" if getattr(result, "pe", None) is None else "energy (J)")
     _finish_time_axis(ax, t)
     _legend(ax)
 
@@ -362,13 +366,23 @@ def _draw_ledger(ax, result, events):
             linewidth=1.3, gid="friction_loss", label="friction loss D")
     ax.plot(t, np.asarray(result.impact_loss, dtype=float), color="tab:red", linewidth=1.3,
             gid="impact_loss", label="impact loss Q")
+    names = ["work", "friction_loss", "impact_loss"]
+    losses = "D \u2212 Q"
+    if getattr(result, "damping_loss", None) is not None:
+        ax.plot(t, np.asarray(result.damping_loss, dtype=float), color="tab:brown", linewidth=1.3,
+                gid="damping_loss", label="damping loss C")
+        names.append("damping_loss")
+        losses += " \u2212 C"
+    energy, what = ke, "KE"
+    if getattr(result, "pe", None) is not None:
+        energy, what = ke + np.asarray(result.pe, dtype=float), "(KE + PE)"
     if ke.size:
-        ax.plot(t, ke - ke[0], color="black", linewidth=1.0, linestyle="--", gid="ke_change",
-                label="KE \u2212 KE(0) = W \u2212 D \u2212 Q")
+        ax.plot(t, energy - energy[0], color="black", linewidth=1.0, linestyle="--", gid="ke_change",
+                label=f"{what} \u2212 {what}(0) = W \u2212 {losses}")
     # On the scale of the run's energy: a ledger that stays at rounding level
     # (no forces, no losses: case 3) reads as flat zero lines, not as noise.
     series = [np.asarray(getattr(result, n), dtype=float)
-              for n in ("work", "friction_loss", "impact_loss")] + [ke - ke[0] if ke.size else ke]
+              for n in names] + [energy - energy[0] if ke.size else ke]
     values = np.concatenate([s[np.isfinite(s)] for s in series] + [np.zeros(1)])
     scale = max(float(np.max(np.abs(values))), float(np.max(ke)) if ke.size else 0.0)
     lo, hi = float(values.min()), float(values.max())
@@ -383,8 +397,12 @@ def _draw_ledger(ax, result, events):
 def _draw_residual(ax, result, events):
     t = np.asarray(result.t, dtype=float)
     residual = np.asarray(result.residual, dtype=float)
-    ax.plot(t, residual, color="tab:gray", linewidth=1.0, gid="residual",
-            label="KE \u2212 KE(0) \u2212 W + D + Q")
+    label = "KE \u2212 KE(0) \u2212 W + D + Q"
+    if getattr(result, "pe", None) is not None:
+        label = "(KE + PE) \u2212 (KE + PE)(0) \u2212 W + D + Q"
+    if getattr(result, "damping_loss", None) is not None:
+        label += " + C"
+    ax.plot(t, residual, color="tab:gray", linewidth=1.0, gid="residual", label=label)
     amax = float(np.max(np.abs(residual))) if residual.size else 0.0
     # Symmetric limits around zero: the reader sees the residual's size, not its shape.
     ax.set_ylim(-1.15 * amax, 1.15 * amax) if amax > 0 else ax.set_ylim(-1.0, 1.0)
