@@ -1,16 +1,17 @@
 !> The limit for the engine's stepping loop (bench/performance.py): a plain classical RK4
 !> loop on the free-flight scenes' force law (no contacts, no friction),
 !> y = (x1, v1, x2, v2), y' = (v1, f1(t)/m1, v2, f2/m2), with f1(t) = F1 + F1_AMP sin(2 pi t /
-!> F1_PERIOD) when the last two arguments are given, F1 otherwise. No events, no ledger, no
+!> F1_PERIOD) when F1_AMP and F1_PERIOD are given, F1 otherwise, plus a spring to the ground
+!> on body 1, -K1 (x1 - X1_REST), when those are given too (F1_AMP = 0: no sine). No events, no ledger, no
 !> output but the final state. Everything comes from the command line so that nothing folds
 !> at compile time; the bench compiles it with the release build's flags (-O3) and times it
 !> the same way as the impact1d CLI (wall time of the process).
-!> usage: bare_rk4 N_STEPS DT M1 M2 F1 F2 X1 V1 X2 V2 [F1_AMP F1_PERIOD]
+!> usage: bare_rk4 N_STEPS DT M1 M2 F1 F2 X1 V1 X2 V2 [F1_AMP F1_PERIOD [K1 X1_REST]]
 program bare_rk4
   use, intrinsic :: iso_fortran_env, only: dp => real64, int64
   implicit none
   integer(int64) :: n, i
-  real(dp) :: dt, m(2), f(2), y(4), t, k1(4), k2(4), k3(4), k4(4), amp, omega
+  real(dp) :: dt, m(2), f(2), y(4), t, k1(4), k2(4), k3(4), k4(4), amp, omega, stiffness, x_rest
   character(len=64) :: arg
   integer :: j
 
@@ -37,6 +38,14 @@ program bare_rk4
     read(arg, *) omega
     omega = 2.0_dp * acos(-1.0_dp) / omega
   end if
+  stiffness = 0.0_dp
+  x_rest = 0.0_dp
+  if (command_argument_count() >= 14) then
+    call get_command_argument(13, arg)
+    read(arg, *) stiffness
+    call get_command_argument(14, arg)
+    read(arg, *) x_rest
+  end if
   t = 0.0_dp
   do i = 1, n
     k1 = rhs(t, y)
@@ -53,7 +62,10 @@ contains
   pure function rhs(time, state) result(dydt)
     real(dp), intent(in) :: time, state(4)
     real(dp) :: dydt(4)
-    if (amp == 0.0_dp) then
+    if (stiffness /= 0.0_dp) then
+      dydt = [state(2), (f(1) + amp * sin(omega * time) - stiffness * (state(1) - x_rest)) / m(1), &
+        state(4), f(2) / m(2)]
+    else if (amp == 0.0_dp) then
       dydt = [state(2), f(1) / m(1), state(4), f(2) / m(2)]
     else
       dydt = [state(2), (f(1) + amp * sin(omega * time)) / m(1), state(4), f(2) / m(2)]

@@ -35,23 +35,30 @@ RESULTS = BENCH / "results"          # raw numbers (JSON) of the last `make benc
 # frictionless constant-force scenes: reuse it, do not rewrite it.
 sys.path.insert(0, str(REPO / "tests"))
 import exact_reference  # noqa: E402
+import exact_springs  # noqa: E402  (the springs' and static friction's closed forms)
 
 SCENE_FILES = {
     "case3": REPO / "input" / "case3.nml",
     "case5": REPO / "input" / "case5.nml",
     "stickslip": BENCH / "scenes" / "stickslip.nml",
     "sine": BENCH / "scenes" / "sine.nml",
+    "oscillator": BENCH / "scenes" / "oscillator.nml",
+    "springslip": BENCH / "scenes" / "springslip.nml",
 }
 SCENE_LABELS = {
     "case3": "case 3 (elastic, all four contacts)",
     "case5": "case 5 (rattling into both walls, Zeno at t = 3)",
     "stickslip": "stick/slip (triangular force, friction)",
     "sine": "sine-forced (case 3 geometry, f1 = 20 sin(2 pi t/0.7 + 0.3))",
+    "oscillator": "impact oscillator (spring k = 4 at a wall, r = 0.8)",
+    "springslip": "stick-slip oscillator (spring k = 100, anchor 0.5 m/s, mus > mu)",
 }
 
 SCENE_SHORT = {"case3": "case 3 (elastic)", "case5": "case 5 (Zeno at t = 3)",
                "stickslip": "stick/slip (friction, triangle force)",
-               "sine": "sine-forced (case 3 geometry)"}
+               "sine": "sine-forced (case 3 geometry)",
+               "oscillator": "impact oscillator (spring)",
+               "springslip": "stick-slip oscillator (spring)"}
 
 IMPACT_KINDS = ("left", "right", "slot_min", "slot_max")
 
@@ -208,8 +215,30 @@ def _sine_reference(scene):
     return ref
 
 
+def _oscillator_reference(scene):
+    ref = exact_springs.impact_oscillator(scene.m1, scene.k1, scene.x1_rest, scene.x_left,
+                                          scene.r_left, scene.x1, scene.v1 or 0.0, scene.t_end)
+    (x, ), (v, ) = ref.state(scene.t_end)
+    return Reference([(float(e.t), e.kind) for e in ref.events if e.kind == "left"],
+                     [float(x), float(v), scene.x2, 0.0],
+                     "closed form (harmonic arcs, 50 digits: tests/exact_springs.py)")
+
+
+def _springslip_reference(scene):
+    table = np.loadtxt(Path(scene.f1_table), comments="#", ndmin=2)
+    pull = (table[1, 1] - table[0, 1]) / (table[1, 0] - table[0, 0])
+    ref = exact_springs.stick_slip(scene.m1, scene.k1, scene.x1_rest, pull, scene.mu1,
+                                   scene.mus1, scene.x1, scene.v1 or 0.0, scene.t_end,
+                                   g=scene.g if scene.g is not None else exact_springs.DEFAULT_G)
+    (x, ), (v, ) = ref.state(scene.t_end)
+    return Reference([(float(e.t), e.kind) for e in ref.events if e.kind in ("stick1", "slip1")],
+                     [float(x), float(v), scene.x2, 0.0],
+                     "closed form (harmonic slip arcs, 50 digits: tests/exact_springs.py)")
+
+
 _REFERENCES = {"case3": _case3_reference, "case5": _case5_reference,
-               "stickslip": _stickslip_reference, "sine": _sine_reference}
+               "stickslip": _stickslip_reference, "sine": _sine_reference,
+               "oscillator": _oscillator_reference, "springslip": _springslip_reference}
 
 
 def reference(name: str, scene=None) -> Reference:

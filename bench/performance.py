@@ -39,6 +39,7 @@ from scipy_reference import simulate_scipy
 
 FREEFLIGHT = common.BENCH / "scenes" / "freeflight.nml"
 SINEFLIGHT = common.BENCH / "scenes" / "sineflight.nml"
+SPRINGFLIGHT = common.BENCH / "scenes" / "springflight.nml"
 SLOTRATTLE = common.BENCH / "scenes" / "slotrattle.nml"
 BARE_SOURCE = common.BENCH / "bare_rk4.f90"
 # The meson release build compiles the core with these (buildtype=release: -O3, -DNDEBUG).
@@ -160,8 +161,10 @@ def stepping_loop(workdir: Path, scene_path: Path, n_steps: int):
     bare_cmd = [str(bare), str(n_steps), repr(dt), repr(scene.m1), repr(scene.m2),
                 repr(scene.f1), repr(scene.f2), repr(scene.x1), repr(scene.v1),
                 repr(scene.x2), repr(scene.v2)]
-    if scene.f1_amp is not None:
-        bare_cmd += [repr(scene.f1_amp), repr(scene.f1_period)]
+    if scene.f1_amp is not None or scene.k1 is not None:
+        bare_cmd += [repr(scene.f1_amp or 0.0), repr(scene.f1_period or 1.0)]
+    if scene.k1 is not None:
+        bare_cmd += [repr(scene.k1), repr(scene.x1_rest)]
     timed_process(bare_cmd), timed_process(cli)          # warm-up (page cache)
     rows = []
     for i in range(PAIRS_LOOP):
@@ -278,6 +281,7 @@ def run():
         results = {"case3": case3_against_scipy(),
                    "loop": stepping_loop(work, FREEFLIGHT, LOOP_STEPS),
                    "loop_sine": stepping_loop(work, SINEFLIGHT, SINE_STEPS),
+                   "loop_spring": stepping_loop(work, SPRINGFLIGHT, SINE_STEPS),
                    "scaling": scaling(), "memory": memory(work)}
     common.save_json("performance", results)
     _plot(results, common.DOCS / "performance.png")

@@ -6,7 +6,6 @@ module impact1d_stepping
   use impact1d_modes, only: mode_type
   use impact1d_events, only: hermite
   use impact1d_state, only: state_type, add_compensated
-  use impact1d_loads, only: applied_force
   implicit none
   private
   public :: rk4_type, book_constant_ledger, dense_output
@@ -23,6 +22,7 @@ module impact1d_stepping
     real(wp) :: end_force(2) = 0.0_wp, end_force_t = -huge(1.0_wp)
     !> With springs the force depends on the state too: the state it was evaluated in.
     real(wp) :: end_x(2) = 0.0_wp, end_x_lo(2) = 0.0_wp, end_v(2) = 0.0_wp, end_v_lo(2) = 0.0_wp
+    real(wp) :: end_external(2) = 0.0_wp   !< and its external (time-only) part
   contains
     procedure :: step => rk4_step
     procedure :: advance_constant
@@ -115,35 +115,38 @@ contains
     type(state_type), intent(in) :: a
     real(wp), intent(in) :: step
     type(state_type), intent(inout) :: b
-    real(wp), parameter :: node(4) = [0.0_wp, 0.5_wp, 0.5_wp, 1.0_wp]
-    real(wp) :: kx(2, 4), kv(2, 4), v0(2), vs(2), dx(2), f(2), acc_end(2), vm(2)
+    real(wp) :: kx(2, 4), kv(2, 4), v0(2), v1(2), vm(2), f(2), acc_end(2), half
+    ! The external forces at the step's start, middle and end (stages 2 and 3 share the
+    ! middle's): evaluated once each and used by the stages and by the work's quadrature.
     real(wp) :: f0(2), fm(2), f1(2)
-    integer :: stage
+    half = 0.5_wp * step
     v0 = a%v + a%v_lo
-    do stage = 1, 4
-      if (stage == 1) then
-        vs = v0
-        dx = a%x_lo
-        if (a%t == self%end_force_t .and. all(a%x == self%end_x) .and. all(a%x_lo == self%end_x_lo) &
-            .and. all(a%v == self%end_v) .and. all(a%v_lo == self%end_v_lo)) then
-          f = self%end_force
-        else
-          f = applied_force(scene, a%t, a%x, dx, vs)
-        end if
-      else
-        vs = v0 + (node(stage) * step) * kv(:, stage - 1)
-        dx = a%x_lo + (node(stage) * step) * kx(:, stage - 1)
-        f = applied_force(scene, a%t + node(stage) * step, a%x, dx, vs)
-      end if
-      kx(:, stage) = vs
-      kv(:, stage) = mode%acceleration(f)
-    end do
+    if (a%t == self%end_force_t .and. all(a%x == self%end_x) .and. all(a%x_lo == self%end_x_lo) &
+        .and. all(a%v == self%end_v) .and. all(a%v_lo == self%end_v_lo)) then
+      f0 = self%end_external
+      f = self%end_force
+    else
+      f0 = scene%forcing%force(a%t)
+      f = f0 + scene%springs%force(a%x, a%x_lo, v0)
+    end if
+    fm = scene%forcing%force(a%t + half)
+    f1 = scene%forcing%force(a%t + step)
+    kx(:, 1) = v0
+    kv(:, 1) = mode%acceleration(f)
+    kx(:, 2) = v0 + half * kv(:, 1)
+    kv(:, 2) = mode%acceleration(fm + scene%springs%force(a%x, a%x_lo + half * kx(:, 1), kx(:, 2)))
+    kx(:, 3) = v0 + half * kv(:, 2)
+    kv(:, 3) = mode%acceleration(fm + scene%springs%force(a%x, a%x_lo + half * kx(:, 2), kx(:, 3)))
+    kx(:, 4) = v0 + step * kv(:, 3)
+    kv(:, 4) = mode%acceleration(f1 + scene%springs%force(a%x, a%x_lo + step * kx(:, 3), kx(:, 4)))
     b = a
     call add_compensated(b%t, b%t_lo, step)
     call add_compensated(b%x, b%x_lo, (step / 6.0_wp) * (kx(:, 1) + 2.0_wp * (kx(:, 2) + kx(:, 3)) + kx(:, 4)))
     call add_compensated(b%v, b%v_lo, (step / 6.0_wp) * (kv(:, 1) + 2.0_wp * (kv(:, 2) + kv(:, 3)) + kv(:, 4)))
     ! The end force is the next step's start force.
-    f = applied_force(scene, b%t, b%x, b%x_lo, b%v + b%v_lo)
+    v1 = b%v + b%v_lo
+    f = f1 + scene%springs%force(b%x, b%x_lo, v1)
+    self%end_external = f1
     self%end_force = f
     self%end_force_t = b%t
     self%end_x = b%x
@@ -151,16 +154,14 @@ contains
     self%end_v = b%v
     self%end_v_lo = b%v_lo
     acc_end = mode%acceleration(f)
-    vm = 0.5_wp * (v0 + (b%v + b%v_lo)) + 0.125_wp * step * (kv(:, 1) - acc_end)
-    f0 = scene%forcing%force(a%t)
-    fm = scene%forcing%force(a%t + 0.5_wp * step)
-    f1 = scene%forcing%force(b%t)
+    vm = 0.5_wp * (v0 + v1) + 0.125_wp * step * (kv(:, 1) - acc_end)
     call add_compensated(b%work, b%work_lo, step / 6.0_wp * (dot_product(f0, v0) + &
-      4.0_wp * dot_product(fm, vm) + dot_product(f1, b%v)))
-    call add_compensated(b%friction_loss, b%friction_lo, step / 6.0_wp * &
-      dot_product(-mode%f_slide, v0 + 4.0_wp * vm + b%v))
-    call add_compensated(b%damping_loss, b%damping_lo, step / 6.0_wp * (scene%springs%damping_power(v0) + &
-      4.0_wp * scene%springs%damping_power(vm) + scene%springs%damping_power(b%v)))
+      4.0_wp * dot_product(fm, vm) + dot_product(f1, v1)))
+    if (any(mode%f_slide /= 0.0_wp)) call add_compensated(b%friction_loss, b%friction_lo, step / 6.0_wp * &
+      dot_product(-mode%f_slide, v0 + 4.0_wp * vm + v1))
+    if (scene%springs%has_damper) call add_compensated(b%damping_loss, b%damping_lo, step / 6.0_wp * &
+      (scene%springs%damping_power(v0) + 4.0_wp * scene%springs%damping_power(vm) + &
+      scene%springs%damping_power(v1)))
   end subroutine state_dependent_step
 
   !> The step's dense output: Hermite coefficients of both bodies' displacements.
