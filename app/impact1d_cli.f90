@@ -179,8 +179,13 @@ contains
     end do
     if (len(line) == 0) line = ' none'
     write(output_unit, '(a)') '  events   ' // line
-    write(output_unit, '(a, 5(a, es12.5))') '  final    ', ' t =', stats%last_row(1), '  x1 =', stats%last_row(2), &
-      '  v1 =', stats%last_row(3), '  x2 =', stats%last_row(4), '  v2 =', stats%last_row(5)
+    if (scene%n_bodies == 2) then
+      write(output_unit, '(a, 5(a, es12.5))') '  final    ', ' t =', stats%last_row(1), '  x1 =', stats%last_row(2), &
+        '  v1 =', stats%last_row(3), '  x2 =', stats%last_row(4), '  v2 =', stats%last_row(5)
+    else
+      write(output_unit, '(a, 3(a, es12.5))') '  final    ', ' t =', stats%last_row(1), '  x1 =', stats%last_row(2), &
+        '  v1 =', stats%last_row(3)
+    end if
     if (scene%springs%has_spring) then
       write(output_unit, '(2(a, es12.5), a)') '  energy    KE =', stats%last_row(6), '  PE =', &
         stats%last_row(i_pe), ' J'

@@ -2,7 +2,7 @@
 !> levels, and putting a closed contact exactly on its constraint.
 module impact1d_contacts
   use impact1d_kinds, only: wp
-  use impact1d_scene, only: scene_type, n_contacts, normal, i_slot_min, i_slot_max
+  use impact1d_scene, only: scene_type, n_contacts, i_slot_min, i_slot_max
   use impact1d_impacts, only: normal_velocity
   use impact1d_state, only: state_type, add_compensated
   use impact1d_yardsticks, only: gap_rounding, time_rounding, velocity_rounding
@@ -21,12 +21,12 @@ contains
     integer, intent(in) :: k
     type(state_type), intent(in) :: state
     real(wp) :: a, b, total, rounded
-    a = normal(1, k) * state%x(1)
-    b = normal(2, k) * state%x(2)
+    a = scene%normal(1, k) * state%x(1)
+    b = scene%normal(2, k) * state%x(2)
     total = a + b
     rounded = total - a
     gap = (total + scene%offset(k)) + (((a - (total - rounded)) + (b - rounded)) + &
-      dot_product(normal(:, k), state%x_lo))
+      dot_product(scene%normal(:, k), state%x_lo))
   end function gap
 
   !> Rounding level of gap k. A gap is exact to its own size (compensated positions, exact
@@ -39,8 +39,8 @@ contains
     integer, intent(in) :: k
     type(state_type), intent(in) :: state
     real(wp), intent(in) :: moved
-    gap_tolerance = gap_rounding * (moved + dot_product(abs(normal(:, k)), abs(state%x_lo))) + &
-      time_rounding * max(abs(state%t), scene%dt) * max(0.0_wp, -normal_velocity(k, state%v))
+    gap_tolerance = gap_rounding * (moved + dot_product(abs(scene%normal(:, k)), abs(state%x_lo))) + &
+      time_rounding * max(abs(state%t), scene%dt) * max(0.0_wp, -normal_velocity(scene, k, state%v))
   end function gap_tolerance
 
   !> gap_tolerance along a step from state a with dense output c, as a polynomial in theta:
@@ -56,15 +56,16 @@ contains
     real(wp), intent(in) :: c(3, 2), acc_rounding(2)
     real(wp) :: q(0:3)
     q(0) = gap_tolerance(scene, k, a, 0.0_wp)
-    q(1:3) = gap_rounding * (abs(normal(1, k)) * abs(c(:, 1)) + abs(normal(2, k)) * abs(c(:, 2)))
-    q(2) = q(2) + 0.5_wp * dot_product(abs(normal(:, k)), acc_rounding)
+    q(1:3) = gap_rounding * (abs(scene%normal(1, k)) * abs(c(:, 1)) + abs(scene%normal(2, k)) * abs(c(:, 2)))
+    q(2) = q(2) + 0.5_wp * dot_product(abs(scene%normal(:, k)), acc_rounding)
   end function gap_tolerance_along
 
   !> How far a step from a to b moved gap k (through either body).
-  pure real(wp) function displacement(k, a, b)
+  pure real(wp) function displacement(scene, k, a, b)
+    type(scene_type), intent(in) :: scene
     integer, intent(in) :: k
     type(state_type), intent(in) :: a, b
-    displacement = dot_product(abs(normal(:, k)), abs((b%x - a%x) + (b%x_lo - a%x_lo)))
+    displacement = dot_product(abs(scene%normal(:, k)), abs((b%x - a%x) + (b%x_lo - a%x_lo)))
   end function displacement
 
   !> Put a closed contact exactly on its constraint (gap = 0, no roundoff penetration).
@@ -74,13 +75,13 @@ contains
     logical, intent(in) :: closed(n_contacts)
     type(state_type), intent(inout) :: s
     real(wp) :: limit
+    integer :: i
     select case (k)
-    case (1)
-      s%x(1) = -scene%offset(1)
-      s%x_lo(1) = 0.0_wp
-    case (2)
-      s%x(2) = scene%offset(2)
-      s%x_lo(2) = 0.0_wp
+    case (1, 2)
+      ! A wall holds one body: normal . x + offset = 0 for the body it faces.
+      i = merge(1, 2, scene%normal(1, k) /= 0.0_wp)
+      s%x(i) = -scene%offset(k) / scene%normal(i, k)
+      s%x_lo(i) = 0.0_wp
     case (3, 4)
       ! Move the body that no wall holds.
       ! x2 = x1 + d exactly, the sum's rounding kept in the low part.
@@ -114,7 +115,7 @@ contains
     real(wp), intent(in) :: entry_scale(2)
     real(wp) :: acc(2)
     acc = mode%acceleration(state_force(scene, s))
-    u_tolerance = velocity_rounding * dot_product(abs(normal(:, k)), &
+    u_tolerance = velocity_rounding * dot_product(abs(scene%normal(:, k)), &
       max(abs(s%v) + abs(acc) * scene%dt, entry_scale))
   end function u_tolerance
 end module impact1d_contacts

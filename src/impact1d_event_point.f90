@@ -5,7 +5,7 @@
 module impact1d_event_point
   use impact1d_kinds, only: wp, eps_wp
   use impact1d_error, only: error_type, raise, status_simulation, fmt
-  use impact1d_scene, only: scene_type, n_contacts, normal, i_slot_min, i_slot_max
+  use impact1d_scene, only: scene_type, n_contacts, i_slot_min, i_slot_max
   use impact1d_modes, only: mode_type, solve_mode
   use impact1d_impacts, only: normal_velocity, impulse, most_approaching, restitution_of, &
     kinetic_energy, joint_inelastic, inelastic_projection
@@ -56,7 +56,7 @@ contains
       ! The user's numbers carry their decimal rounding (7.553 - 7.122 is not 0.431): at the
       ! start, a gap within it is contact, as the validator accepted it.
       if (initial .and. scene%has_contact(k)) closed(k) = closed(k) .or. gap(scene, k, s) <= &
-        gap_rounding * max(maxval(abs(normal(:, k) * s%x)), abs(scene%offset(k)))
+        gap_rounding * max(maxval(abs(scene%normal(:, k) * s%x)), abs(scene%offset(k)))
     end do
     ! A rigid link (d_min = d_max) is one constraint seen from both sides.
     if (scene%has_contact(i_slot_min) .and. scene%has_contact(i_slot_max)) then
@@ -95,7 +95,7 @@ contains
     end if
     n_impulses = 0
     do
-      k = most_approaching(closed, s%v, u_tolerances(scene, mode, s, entry_scale))
+      k = most_approaching(scene, closed, s%v, u_tolerances(scene, mode, s, entry_scale))
       if (k == 0) exit
       n_impulses = n_impulses + 1
       if (n_impulses > scene%max_impulses) then
@@ -106,7 +106,7 @@ contains
       v_before = s%v
       v_after = impulse(scene, k, restitution_of(scene, k, closed), s%v, rigid_pair(closed))
       call apply(scene, s, v_after)
-      if (all(normal(:, k) /= 0.0_wp)) entry_scale = maxval(entry_scale)
+      if (all(scene%normal(:, k) /= 0.0_wp)) entry_scale = maxval(entry_scale)
       call log_event(sink, stats, s%t, event_impact + k, v_before, v_after)
     end do
 
@@ -114,8 +114,8 @@ contains
     call zero_stopped(scene, s, acc, entry_scale)
     do k = 1, n_contacts
       if (.not. closed(k)) cycle
-      if (abs(normal_velocity(k, s%v)) <= u_tolerance(scene, mode, s, k, entry_scale) .and. &
-          normal_velocity(k, s%v) /= 0.0_wp) &
+      if (abs(normal_velocity(scene, k, s%v)) <= u_tolerance(scene, mode, s, k, entry_scale) .and. &
+          normal_velocity(scene, k, s%v) /= 0.0_wp) &
         call apply(scene, s, impulse(scene, k, 0.0_wp, s%v, rigid_pair(closed)))
     end do
 
@@ -131,8 +131,8 @@ contains
     ! A body still against the other one (a closed slot limit) that has stopped has stopped
     ! too: its velocity is the contact's rounding-level normal velocity.
     do k = 1, n_contacts
-      if (.not. closed(k) .or. any(normal(:, k) == 0.0_wp)) cycle
-      if (abs(normal_velocity(k, s%v)) > u_tolerance(scene, mode, s, k, entry_scale)) cycle
+      if (.not. closed(k) .or. any(scene%normal(:, k) == 0.0_wp)) cycle
+      if (abs(normal_velocity(scene, k, s%v)) > u_tolerance(scene, mode, s, k, entry_scale)) cycle
       do i = 1, 2
         if (s%v(i) == 0.0_wp) call zero_velocity(scene, s, 3 - i)
       end do
@@ -183,9 +183,9 @@ contains
       if (new_mode%active(k) .and. .not. event_log%in_contact(k)) then
         call event_log%begin_rest(scene, k, s%t, s%t, s%v, sink, stats)
       else if (event_log%in_contact(k) .and. .not. new_mode%active(k)) then
-        if (.not. candidate(k) .or. dot_product(normal(:, k), acc) > dot_product(abs(normal(:, k)), tol_a) .or. &
-            (dot_product(normal(:, k), acc) >= -dot_product(abs(normal(:, k)), tol_a) .and. &
-            dot_product(normal(:, k), matmul(new_mode%gain, df)) > 1.0e3_wp * eps_wp * sum(abs(df)) / &
+        if (.not. candidate(k) .or. dot_product(scene%normal(:, k), acc) > dot_product(abs(scene%normal(:, k)), tol_a) .or. &
+            (dot_product(scene%normal(:, k), acc) >= -dot_product(abs(scene%normal(:, k)), tol_a) .and. &
+            dot_product(scene%normal(:, k), matmul(new_mode%gain, df)) > 1.0e3_wp * eps_wp * sum(abs(df)) / &
             minval(scene%mass))) then
           if (event_log%pending_rest(k) < huge(1.0_wp)) then
             call log_event(sink, stats, s%t, event_rest + k, s%v, s%v)
@@ -240,7 +240,7 @@ contains
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
     real(wp) :: u, a_up, a_down, remaining
-    u = normal_velocity(k, s%v)
+    u = normal_velocity(scene, k, s%v)
     if (u <= u_tolerance(scene, mode, s, k, entry_scale)) return
     a_up = free_gap_acceleration(scene, mode, k, s, s%v, f, df, closed, entry_scale)
     if (a_up >= 0.0_wp) return
@@ -293,7 +293,7 @@ contains
     candidate(k) = .false.
     call solve_mode(scene, f, df, candidate, resting, moving_sign, free_mode, found, force_scale(scene, f, df))
     a_gap = 0.0_wp
-    if (found) a_gap = dot_product(normal(:, k), free_mode%acceleration(f))
+    if (found) a_gap = dot_product(scene%normal(:, k), free_mode%acceleration(f))
   end function free_gap_acceleration
 
   !> Bodies whose velocity is below the rounding of what a step changes it by, or of the
@@ -346,7 +346,7 @@ contains
     integer :: k
     do k = 1, n_contacts
       candidate(k) = closed(k)
-      if (candidate(k)) candidate(k) = abs(normal_velocity(k, s%v)) <= u_tolerance(scene, mode, s, k, entry_scale)
+      if (candidate(k)) candidate(k) = abs(normal_velocity(scene, k, s%v)) <= u_tolerance(scene, mode, s, k, entry_scale)
     end do
     resting = scene%static_friction > 0.0_wp .and. s%v == 0.0_wp
     moving_sign = 0.0_wp

@@ -2,7 +2,7 @@
 !> that momentum is kept by slot impacts and a wall only reverses its body's velocity.
 module impact1d_impacts
   use impact1d_kinds, only: wp
-  use impact1d_scene, only: scene_type, n_contacts, normal, i_left, i_right, i_slot_min, i_slot_max
+  use impact1d_scene, only: scene_type, n_contacts, i_left, i_right, i_slot_min, i_slot_max
   implicit none
   private
   public :: normal_velocity, impulse, most_approaching, restitution_of, kinetic_energy, &
@@ -11,10 +11,11 @@ module impact1d_impacts
 contains
 
   !> Rate of change of gap k.
-  pure real(wp) function normal_velocity(k, v)
+  pure real(wp) function normal_velocity(scene, k, v)
+    type(scene_type), intent(in) :: scene
     integer, intent(in) :: k
     real(wp), intent(in) :: v(2)
-    normal_velocity = dot_product(normal(:, k), v)
+    normal_velocity = dot_product(scene%normal(:, k), v)
   end function normal_velocity
 
   !> Velocities after an impulse on contact k that leaves the normal velocity at -r times
@@ -29,18 +30,19 @@ contains
     real(wp) :: v_after(2), p
     if (present(rigid)) then
       if (rigid .and. (k == i_left .or. k == i_right)) then
-        v_after = v - (1.0_wp + r) * normal_velocity(k, v) * sum(normal(:, k))
+        v_after = v - (1.0_wp + r) * normal_velocity(scene, k, v) * sum(scene%normal(:, k))
         return
       end if
     end if
-    p = -(1.0_wp + r) * normal_velocity(k, v) / dot_product(normal(:, k)**2, 1.0_wp / scene%mass)
-    v_after = v + normal(:, k) * p / scene%mass
+    p = -(1.0_wp + r) * normal_velocity(scene, k, v) / dot_product(scene%normal(:, k)**2, 1.0_wp / scene%mass)
+    v_after = v + scene%normal(:, k) * p / scene%mass
     ! A wall acts on its own body only: keep the other velocity bit for bit.
-    where (normal(:, k) == 0.0_wp) v_after = v
+    where (scene%normal(:, k) == 0.0_wp) v_after = v
   end function impulse
 
   !> The closed contact approaching fastest (0 if none approaches faster than its tol).
-  pure integer function most_approaching(closed, v, tol) result(k_best)
+  pure integer function most_approaching(scene, closed, v, tol) result(k_best)
+    type(scene_type), intent(in) :: scene
     logical, intent(in) :: closed(n_contacts)
     real(wp), intent(in) :: v(2), tol(n_contacts)
     integer :: k
@@ -49,9 +51,9 @@ contains
     u_best = 0.0_wp
     do k = 1, n_contacts
       if (.not. closed(k)) cycle
-      if (normal_velocity(k, v) < min(u_best, -tol(k))) then
+      if (normal_velocity(scene, k, v) < min(u_best, -tol(k))) then
         k_best = k
-        u_best = normal_velocity(k, v)
+        u_best = normal_velocity(scene, k, v)
       end if
     end do
   end function most_approaching
@@ -103,7 +105,7 @@ contains
 
     v_after = v
     pushed = .false.
-    if (most_approaching(closed, v, tol) == 0) return
+    if (most_approaching(scene, closed, v, tol) == 0) return
     best_distance = huge(1.0_wp)
     do k = 1, n_contacts
       if (.not. closed(k)) cycle
@@ -114,10 +116,10 @@ contains
           candidate = impulse(scene, k, 0.0_wp, v)
         else
           ! Opposite normals (a rigid link's two limits) span one line only: no vertex.
-          if (normal(1, j) * normal(2, k) - normal(2, j) * normal(1, k) == 0.0_wp) cycle
+          if (scene%normal(1, j) * scene%normal(2, k) - scene%normal(2, j) * scene%normal(1, k) == 0.0_wp) cycle
           candidate = 0.0_wp
         end if
-        if (most_approaching(closed, candidate, tol) /= 0) cycle
+        if (most_approaching(scene, closed, candidate, tol) /= 0) cycle
         distance = dot_product(scene%mass, (candidate - v)**2)
         if (distance >= best_distance) cycle
         best_distance = distance

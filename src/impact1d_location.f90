@@ -3,7 +3,7 @@
 !> integrator's own state, and the quiet times before which nothing needs locating.
 module impact1d_location
   use impact1d_kinds, only: wp, eps_wp
-  use impact1d_scene, only: scene_type, n_contacts, normal
+  use impact1d_scene, only: scene_type, n_contacts
   use impact1d_modes, only: mode_type, max_holds
   use impact1d_events, only: earliest_crossing
   use impact1d_impacts, only: normal_velocity
@@ -54,7 +54,7 @@ contains
       if (.not. have_dense) c = dense_output(a, b, step)
       have_dense = .true.
       p(0) = gap(scene, k, a)
-      p(1:3) = normal(1, k) * c(:, 1) + normal(2, k) * c(:, 2)
+      p(1:3) = scene%normal(1, k) * c(:, 1) + scene%normal(2, k) * c(:, 2)
       ! The common case first: the gap cannot reach zero within the step.
       if (p(0) - step * (abs(p(1)) + step * (abs(p(2)) + step * abs(p(3)))) > 0.0_wp) cycle
       ! Only a gap that may close needs the forces' rounding (a sine costs two evaluations).
@@ -187,8 +187,8 @@ contains
         tol = velocity_rounding * max(abs(a%v(which - 100)), abs(value))
       else
         value = gap(scene, which, b)
-        slope = normal_velocity(which, b%v)
-        tol = gap_tolerance(scene, which, b, displacement(which, a, b))
+        slope = normal_velocity(scene, which, b%v)
+        tol = gap_tolerance(scene, which, b, displacement(scene, which, a, b))
       end if
       if (abs(value) <= tol .or. slope == 0.0_wp) exit
       ! Newton stays inside the step that was located, or the clock could pass a stop.
@@ -210,7 +210,7 @@ contains
     constraints_hold = .true.
     do k = 1, n_contacts
       if (.not. scene%has_contact(k) .or. mode%active(k) .or. k == located_contact) cycle
-      if (gap(scene, k, b) < -gap_tolerance(scene, k, b, displacement(k, s, b))) constraints_hold = .false.
+      if (gap(scene, k, b) < -gap_tolerance(scene, k, b, displacement(scene, k, s, b))) constraints_hold = .false.
     end do
     do i = 1, 2
       if (scene%static_friction(i) == 0.0_wp .or. mode%sgn(i) == 0.0_wp) cycle
@@ -233,8 +233,8 @@ contains
     self%quiet_until = huge(1.0_wp)     ! what is not watched needs no location
     do k = 1, n_contacts
       if (.not. scene%has_contact(k) .or. mode%active(k)) cycle
-      self%quiet_until(k) = s%t + 0.99_wp * first_negative(gap(scene, k, s), normal_velocity(k, s%v), &
-        dot_product(normal(:, k), constant_acceleration))
+      self%quiet_until(k) = s%t + 0.99_wp * first_negative(gap(scene, k, s), normal_velocity(scene, k, s%v), &
+        dot_product(scene%normal(:, k), constant_acceleration))
     end do
     do i = 1, 2
       if (scene%static_friction(i) == 0.0_wp .or. mode%sgn(i) == 0.0_wp) cycle

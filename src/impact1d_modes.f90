@@ -4,7 +4,7 @@
 !> loop pays two multiply-adds per stage for them.
 module impact1d_modes
   use impact1d_kinds, only: wp, eps_wp
-  use impact1d_scene, only: scene_type, n_contacts, normal
+  use impact1d_scene, only: scene_type, n_contacts
   implicit none
   private
   public :: mode_type, solve_mode, max_holds
@@ -131,17 +131,17 @@ contains
     ! Only where the link must carry load: a rigid link or bodies merely touching log no rest.
     if (all(mode%stuck) .and. count(active) == 1) then
       k = findloc(active, .true., dim=1)
-      if (all(normal(:, k) /= 0.0_wp)) then
+      if (all(scene%normal(:, k) /= 0.0_wp)) then
         if (admissible([-1.0_wp, 0.0_wp], scene%static_friction(1)) .and. &
             admissible([1.0_wp, 0.0_wp], scene%static_friction(1)) .and. &
             admissible([0.0_wp, -1.0_wp], scene%static_friction(2)) .and. &
             admissible([0.0_wp, 1.0_wp], scene%static_friction(2))) return
         mode%gain = 0.0_wp
         mode%n_hold = 0
-        call add_hold([-normal(1, k), 0.0_wp], scene%static_friction(1))
-        call add_hold([0.0_wp, -normal(2, k)], scene%static_friction(2))
-        call add_hold([normal(1, k), -normal(2, k)], sum(scene%static_friction))
-        call add_hold([-normal(1, k), normal(2, k)], sum(scene%static_friction))
+        call add_hold([-scene%normal(1, k), 0.0_wp], scene%static_friction(1))
+        call add_hold([0.0_wp, -scene%normal(2, k)], scene%static_friction(2))
+        call add_hold([scene%normal(1, k), -scene%normal(2, k)], sum(scene%static_friction))
+        call add_hold([-scene%normal(1, k), scene%normal(2, k)], sum(scene%static_friction))
         found = all([(admissible(mode%hold_w(:, p), mode%hold_c(p)), p = 1, mode%n_hold)])
         return
       end if
@@ -155,7 +155,7 @@ contains
       if (.not. active(k)) cycle
       m = m + 1
       if (m > 2) return
-      rows(m, :) = normal(:, k)
+      rows(m, :) = scene%normal(:, k)
       row_contact(m) = k
     end do
     do i = 1, 2
@@ -220,8 +220,8 @@ contains
     ! way its friction assumes. Both are written in force units so one tolerance serves.
     do k = 1, n_contacts
       if (.not. candidate(k) .or. active(k)) cycle
-      meff = 1.0_wp / dot_product(normal(:, k)**2, minv)
-      w = meff * matmul(normal(:, k), mode%gain)
+      meff = 1.0_wp / dot_product(scene%normal(:, k)**2, minv)
+      w = meff * matmul(scene%normal(:, k), mode%gain)
       if (.not. admissible(w, 0.0_wp)) return
     end do
     do i = 1, 2

@@ -7,7 +7,7 @@ module impact1d_output
   use impact1d_kinds, only: wp
   use impact1d_error, only: error_type, raise, status_input, status_simulation, fmt
   use impact1d_scene, only: scene_input, real_names, n_real, i_title, i_method, i_g, i_dt_out, &
-    i_dt, default_gravity, i_k1, i_k2, i_k12, i_c1, i_c2, i_c12
+    i_dt, default_gravity, i_k1, i_k2, i_k12, i_c1, i_c2, i_c12, i_m2
   implicit none
   private
   public :: sink_type, memory_sink, summary_sink, file_sink, n_columns, column_names, n_event_kinds, event_names
@@ -112,6 +112,8 @@ module impact1d_output
     !> close alike), so a file is only trusted once its size on disk is what was written.
     integer(int64) :: bytes(2) = 0
     integer :: sample_bytes = 0, event_bytes = 0
+    !> Velocities of the bodies the scene has, in an event line.
+    integer :: n_bodies = 2
   contains
     procedure :: put_sample => file_put_sample
     procedure :: put_event => file_put_event
@@ -186,6 +188,7 @@ contains
     logical :: keep(n_columns)
     integer :: k
     keep = .true.
+    keep([4, 5]) = input%given(i_m2)           ! x2, v2: only with a second body
     keep(i_pe) = any(input%given([i_k1, i_k2, i_k12]))
     keep(i_damping_loss) = any(input%given([i_c1, i_c2, i_c12]))
     columns = pack([(k, k = 1, n_columns)], keep)
@@ -346,7 +349,8 @@ contains
     self%bytes = 0
     self%columns = present_columns(input)
     self%sample_bytes = line_bytes(row_format, 0.0_wp, size(self%columns))
-    self%event_bytes = line_bytes(event_format, 0.0_wp, 4, event_names(1))
+    self%n_bodies = merge(2, 1, input%given(i_m2))
+    self%event_bytes = line_bytes(event_format, 0.0_wp, 2 * self%n_bodies, event_names(1))
     call self%put_line(self%unit, '# impact1d output')
     call self%put_line(self%unit, '# title = ' // trim(input%text(i_title)))
     if (allocated(input%source)) call self%put_line(self%unit, '# scene = ' // input%source)
@@ -366,7 +370,11 @@ contains
     end do
     call self%put_line(self%unit, '#' // names_of(self%columns))
     call self%put_line(self%event_unit, '# impact1d events')
-    call self%put_line(self%event_unit, '# t kind v1_before v2_before v1_after v2_after')
+    if (self%n_bodies == 2) then
+      call self%put_line(self%event_unit, '# t kind v1_before v2_before v1_after v2_after')
+    else
+      call self%put_line(self%event_unit, '# t kind v1_before v1_after')
+    end if
   end subroutine file_open
 
   subroutine file_put_sample(self, row)
@@ -387,7 +395,11 @@ contains
     integer :: ios
     character(len=512) :: message
     if (allocated(self%write_failure)) return
-    write(self%event_unit, event_format, iostat=ios, iomsg=message) t, event_names(kind), v_before, v_after
+    if (self%n_bodies == 2) then
+      write(self%event_unit, event_format, iostat=ios, iomsg=message) t, event_names(kind), v_before, v_after
+    else
+      write(self%event_unit, event_format, iostat=ios, iomsg=message) t, event_names(kind), v_before(1), v_after(1)
+    end if
     if (ios /= 0) self%write_failure = self%event_path // ': ' // reason(message)
     self%bytes(2) = self%bytes(2) + self%event_bytes
   end subroutine file_put_event
@@ -471,7 +483,7 @@ contains
     real(wp) :: values(n_values)
     values = value
     if (present(name)) then
-      write(line, format) value, name, values(:4)
+      write(line, format) value, name, values
     else
       write(line, format) values
     end if

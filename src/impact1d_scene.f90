@@ -9,7 +9,7 @@ module impact1d_scene
   implicit none
   private
   public :: n_real, n_text, real_names, text_names, scene_input, scene_type, build_scene, validate
-  public :: n_contacts, normal, i_left, i_right, i_slot_min, i_slot_max
+  public :: n_contacts, two_body_normal, i_left, i_right, i_slot_min, i_slot_max
   public :: i_m1, i_m2, i_mu1, i_mu2, i_g, i_x_left, i_r_left, i_x_right, i_r_right, i_d_min, &
     i_r_min, i_d_max, i_r_max, i_x1, i_v1, i_x2, i_v2, i_f1, i_f2, i_f1_amp, i_f1_period, &
     i_f1_phase, i_f2_amp, i_f2_period, i_f2_phase, i_t_end, i_dt, i_dt_out, i_mus1, i_mus2, &
@@ -35,6 +35,9 @@ module impact1d_scene
     i_max_rows = 30, i_max_impulses = 31, i_max_step_events = 32, i_mus1 = 33, i_mus2 = 34, &
     i_k1 = 35, i_x1_rest = 36, i_c1 = 37, i_k2 = 38, i_x2_rest = 39, i_c2 = 40, i_k12 = 41, &
     i_d_rest = 42, i_c12 = 43
+  !> What only a second body can have: refused in a one-body scene (no m2).
+  integer, parameter :: body2_fields(18) = [i_x2, i_v2, i_mu2, i_mus2, i_f2, i_f2_amp, i_f2_period, &
+    i_f2_phase, i_k2, i_x2_rest, i_c2, i_k12, i_d_rest, i_c12, i_d_min, i_r_min, i_d_max, i_r_max]
   !> Each spring element's stiffness; its rest position and damping follow it.
   integer, parameter :: spring_index(n_elements) = [i_k1, i_k2, i_k12]
   integer, parameter :: i_title = 1, i_f1_table = 2, i_f2_table = 3, i_method = 4
@@ -43,8 +46,12 @@ module impact1d_scene
   integer, parameter :: n_contacts = 4, i_left = 1, i_right = 2, i_slot_min = 3, i_slot_max = 4
   character(len=*), parameter :: contact_names(n_contacts) = [character(len=8) :: &
     'left', 'right', 'slot_min', 'slot_max']
-  real(wp), parameter :: normal(2, n_contacts) = reshape( &
+  !> Their normals with two bodies: the left wall holds body 1, the right wall body 2. With
+  !> one body both walls hold body 1 (scene_type's normal).
+  real(wp), parameter :: two_body_normal(2, n_contacts) = reshape( &
     [1.0_wp, 0.0_wp, 0.0_wp, -1.0_wp, -1.0_wp, 1.0_wp, 1.0_wp, -1.0_wp], [2, n_contacts])
+  real(wp), parameter :: one_body_normal(2, n_contacts) = reshape( &
+    [1.0_wp, 0.0_wp, -1.0_wp, 0.0_wp, -1.0_wp, 1.0_wp, 1.0_wp, -1.0_wp], [2, n_contacts])
 
   real(wp), parameter :: default_gravity = 9.80665_wp
   !> The tutorial's zero-velocity threshold, used by the vissim method only.
@@ -74,6 +81,11 @@ module impact1d_scene
     character(len=:), allocatable :: title, method
     real(wp) :: mass(2), friction(2), static_friction(2)
     type(springs_type) :: springs
+    !> Bodies in the scene: 1 (m2 not given) or 2. A one-body scene keeps a body 2 at rest
+    !> at 0 that nothing acts on and no contact involves, so the solver's arrays stay 2-long.
+    integer :: n_bodies = 2
+    !> gap_k = normal(:, k) . x + offset_k
+    real(wp) :: normal(2, n_contacts) = two_body_normal
     logical :: has_contact(n_contacts) = .false.
     real(wp) :: offset(n_contacts) = 0.0_wp, restitution(n_contacts) = 1.0_wp
     real(wp) :: x0(2), v0(2)
@@ -93,7 +105,7 @@ contains
     logical, intent(in) :: require_run
     type(error_type), allocatable, intent(out) :: error
     integer :: k
-    real(wp) :: gap, scale
+    real(wp) :: gap, scale, nrm(2, n_contacts)
 
     do k = 1, n_real
       if (input%given(k) .and. .not. ieee_is_finite(input%value(k))) then
@@ -102,12 +114,31 @@ contains
         return
       end if
     end do
-    call require([i_m1, i_m2, i_x1, i_x2])
+    ! Without m2 the scene has one body, and nothing may name the second.
+    call require([i_m1, i_x1])
+    if (allocated(error)) return
+    if (input%given(i_m2)) then
+      call require([i_x2])
+    else
+      do k = 1, size(body2_fields)
+        if (input%given(body2_fields(k))) then
+          call raise(error, status_input, trim(real_names(body2_fields(k))) // ' is given but m2 is not: ' // &
+            'a scene without m2 has one body (give m2 for a second one)')
+          return
+        end if
+      end do
+      if (len_trim(input%text(i_f2_table)) > 0) then
+        call raise(error, status_input, 'f2_table is given but m2 is not: a scene without m2 has one body ' // &
+          '(give m2 for a second one)')
+        return
+      end if
+    end if
     if (allocated(error)) return
     if (require_run) call require([i_t_end, i_dt])
     if (allocated(error)) return
 
-    call positive(i_m1); call positive(i_m2)
+    call positive(i_m1)
+    if (input%given(i_m2)) call positive(i_m2)
     if (allocated(error)) return
     call nonnegative(i_mu1); call nonnegative(i_mu2); call nonnegative(i_zero_vel)
     call nonnegative(i_mus1); call nonnegative(i_mus2)
@@ -178,8 +209,9 @@ contains
     ! its 0.5 m gap): refused, as is a friction bound mu m g that overflows.
     do k = 1, n_contacts
       if (.not. has_limit(input, k)) cycle
-      gap = normal(1, k) * input%value(i_x1) + normal(2, k) * input%value(i_x2) + offset_of(k)
-      scale = maxval(abs(normal(:, k) * input%value([i_x1, i_x2])))
+      nrm = contact_normals(input)
+      gap = nrm(1, k) * input%value(i_x1) + nrm(2, k) * input%value(i_x2) + offset_of(k)
+      scale = maxval(abs(nrm(:, k) * input%value([i_x1, i_x2])))
       if (gap < -16.0_wp * eps_wp * max(scale, abs(offset_of(k)))) then
         call raise(error, status_input, 'the initial state x1 = ' // fmt(input%value(i_x1)) // &
           ', x2 = ' // fmt(input%value(i_x2)) // ' violates the ' // trim(contact_names(k)) // &
@@ -366,6 +398,12 @@ contains
     scene%method = 'event'
     if (len_trim(input%text(i_method)) > 0) scene%method = trim(input%text(i_method))
     scene%mass = input%value([i_m1, i_m2])
+    scene%normal = contact_normals(input)
+    if (.not. input%given(i_m2)) then
+      ! One body: body 2 is a unit mass at rest at 0 that nothing acts on.
+      scene%n_bodies = 1
+      scene%mass(2) = 1.0_wp
+    end if
     g = default_gravity
     if (input%given(i_g)) g = input%value(i_g)
     scene%friction = 0.0_wp
@@ -395,6 +433,7 @@ contains
     scene%springs%has_damper = any(input%given(spring_index + 2))
     scene%springs%present = scene%springs%has_spring .or. scene%springs%has_damper
     scene%x0 = input%value([i_x1, i_x2])
+    if (scene%n_bodies == 1) scene%x0(2) = 0.0_wp
     scene%v0 = 0.0_wp
     if (input%given(i_v1)) scene%v0(1) = input%value(i_v1)
     if (input%given(i_v2)) scene%v0(2) = input%value(i_v2)
@@ -441,8 +480,16 @@ contains
   pure logical function has_limit(input, k)
     type(scene_input), intent(in) :: input
     integer, intent(in) :: k
-    has_limit = input%given(limit_index(k)) .or. k == i_slot_min
+    has_limit = input%given(limit_index(k)) .or. (k == i_slot_min .and. input%given(i_m2))
   end function has_limit
+
+  !> The contacts' normals: with one body (no m2) both walls hold body 1.
+  pure function contact_normals(input) result(nrm)
+    type(scene_input), intent(in) :: input
+    real(wp) :: nrm(2, n_contacts)
+    nrm = two_body_normal
+    if (.not. input%given(i_m2)) nrm = one_body_normal
+  end function contact_normals
 
   !> Limit of constraint k: as given, or 0 for the bodies' meeting.
   pure real(wp) function limit_value(input, k)

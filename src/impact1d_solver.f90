@@ -317,7 +317,7 @@ contains
     do k = 1, n_contacts
       if (.not. scene%has_contact(k) .or. mode%active(k)) cycle
       if (gap(scene, k, s) <= gap_tolerance(scene, k, s, 0.0_wp) .and. &
-          normal_velocity(k, s%v) < -u_tolerance(scene, mode, s, k, [0.0_wp, 0.0_wp])) impact_due = .true.
+          normal_velocity(scene, k, s%v) < -u_tolerance(scene, mode, s, k, [0.0_wp, 0.0_wp])) impact_due = .true.
     end do
   end function impact_due
 end module impact1d_solver

@@ -9,7 +9,7 @@ module impact1d_vissim
   use, intrinsic :: iso_fortran_env, only: int64
   use impact1d_kinds, only: wp
   use impact1d_error, only: error_type, raise, status_simulation, fmt
-  use impact1d_scene, only: scene_type, n_contacts, normal, i_left, i_right, i_slot_min, i_slot_max, &
+  use impact1d_scene, only: scene_type, n_contacts, i_left, i_right, i_slot_min, i_slot_max, &
     sample_time
   use impact1d_impacts, only: impulse, kinetic_energy
   use impact1d_output, only: sink_type, run_stats, emit_sample, event_impact
@@ -71,10 +71,14 @@ contains
           if (.not. scene%has_contact(c)) cycle
           if (.not. (gap_before(c) >= 0.0_wp .and. gap(c, x) < 0.0_wp)) cycle
           v_hit = threshold(v)
-          if (c == i_left) x(1) = -scene%offset(i_left)
-          if (c == i_right) x(2) = scene%offset(i_right)
+          ! A wall clamps the body it faces: normal . x + offset = 0.
+          if (c == i_left .or. c == i_right) then
+            associate (i => merge(1, 2, scene%normal(1, c) /= 0.0_wp))
+              x(i) = -scene%offset(c) / scene%normal(i, c)
+            end associate
+          end if
           v_new = impulse(scene, c, scene%restitution(c), threshold(v_prev))
-          where (normal(:, c) == 0.0_wp) v_new = v
+          where (scene%normal(:, c) == 0.0_wp) v_new = v
           impact_loss = impact_loss + kinetic_energy(scene, threshold(v)) - kinetic_energy(scene, threshold(v_new))
           v = v_new
           v_prev = v
@@ -104,7 +108,7 @@ contains
     pure real(wp) function gap(k, positions)
       integer, intent(in) :: k
       real(wp), intent(in) :: positions(2)
-      gap = dot_product(normal(:, k), positions) + scene%offset(k)
+      gap = dot_product(scene%normal(:, k), positions) + scene%offset(k)
     end function gap
 
     !> The diagram's "no movement on zero velocity": |v| <= threshold reads as zero.

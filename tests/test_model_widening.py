@@ -285,3 +285,72 @@ def test_a_ramp_against_two_touching_blocks_breaks_away_at_the_sum_of_static_bou
     np.testing.assert_allclose(res.x1[moving], x[moving], rtol=1e-12)
     np.testing.assert_array_equal(res.x1, res.x2)
     assert np.all(res.v1[~moving] == 0.0)
+
+
+# --- one-body scenes -----------------------------------------------------------------------
+
+def test_one_body_between_two_walls_follows_the_closed_form():
+    """m1 only: both walls bound body 1; the outputs carry only what exists."""
+    res = impact1d.simulate(impact1d.Scene(m1=2.0, x1=1.0, v1=3.0, f1=-1.0, x_left=0.0, r_left=0.5,
+                                           x_right=2.0, r_right=0.9, t_end=4.0, dt=0.1, dt_out=0.1))
+    ref = xs.constant_force_bodies((2.0,), (-1.0,), (1.0,), (3.0,), 4.0, x_left=0.0, x_right=2.0,
+                                   r_left=0.5, r_right=0.9)
+    kinds = ("left", "right")
+    got, want = engine_events(res, kinds), reference_events(ref, kinds)
+    assert len(want) >= 3 and [k for k, _ in got] == [k for k, _ in want]
+    for (_, a), (_, b) in zip(got, want):
+        assert a == pytest.approx(b, rel=1e-13, abs=1e-13)
+    assert res.columns == ("t", "x1", "v1", "ke", "work", "friction_loss", "impact_loss", "residual")
+    assert res.x2 is None and res.v2 is None
+    assert res.events.dtype.names == ("t", "kind", "v1_before", "v1_after")
+    assert np.all((res.x1 >= 0.0) & (res.x1 <= 2.0))
+    assert res.energy_residual < 1e-12
+
+
+def test_one_body_impact_oscillator_on_its_own(tmp_path):
+    """The spring-mass on a wall without a parked second body: the same impacts."""
+    res = impact1d.simulate(impact1d.Scene(m1=1.0, x1=0.5, k1=4.0, x1_rest=0.0, x_left=0.0,
+                                           r_left=0.8, t_end=20.0, dt=1e-3, dt_out=0.01))
+    _, parked = oscillator_impacts(1e-3)
+    np.testing.assert_array_equal(res.events["t"], parked.events["t"])
+    np.testing.assert_array_equal(res.x1, parked.x1)
+
+
+@pytest.mark.parametrize("field", ["x2", "v2", "mu2", "f2", "k12", "d_min", "r_max", "k2"])
+def test_one_body_scene_refuses_what_needs_a_second_body(field):
+    extra = {"k12": dict(k12=1.0, d_rest=1.0), "k2": dict(k2=1.0, x2_rest=0.0)}.get(field, {field: 0.5})
+    with pytest.raises(InputError, match=f"{field} is given but m2 is not: a scene without m2 has one body"):
+        impact1d.simulate(impact1d.Scene(m1=1.0, x1=0.0, t_end=1.0, dt=0.1, **extra))
+
+
+def test_one_body_files_name_their_columns(tmp_path):
+    """CLI output of a one-body scene: no x2/v2 columns, events without v2, read back whole;
+    the plot and a sweep take it too."""
+    from tools import find_tool
+    import subprocess
+    scene = tmp_path / "block.nml"
+    scene.write_text("&bodies m1 = 1.0, mu1 = 0.2, mus1 = 0.4 /\n"
+                     "&walls x_left = 0.0, r_left = 0.5, x_right = 1.0 /\n"
+                     "&initial x1 = 0.5, v1 = 4.0 /\n&run t_end = 2.0, dt = 1e-3, dt_out = 0.01 /\n")
+    out = tmp_path / "block.dat"
+    run = subprocess.run([find_tool("impact1d"), str(scene), "-o", str(out)],
+                         capture_output=True, text=True, timeout=120)
+    assert run.returncode == 0, run.stderr
+    assert "x2 =" not in run.stdout
+    header = [line for line in out.read_text().splitlines() if line.startswith("#")]
+    assert header[-1] == "# t x1 v1 ke work friction_loss impact_loss residual"
+    events_header = (tmp_path / "block.events.dat").read_text().splitlines()[1]
+    assert events_header == "# t kind v1_before v1_after"
+    back = impact1d.read_output(out)
+    direct = impact1d.simulate(impact1d.load_scene(scene))
+    assert back.columns == direct.columns and back.x2 is None
+    np.testing.assert_allclose(back.x1, direct.x1, rtol=1e-15)
+    assert list(back.events["kind"]) == list(direct.events["kind"])
+    np.testing.assert_allclose(back.events["v1_after"], direct.events["v1_after"], rtol=1e-15)
+    import matplotlib
+    matplotlib.use("Agg")
+    impact1d.plot.save(direct, tmp_path / "block.png")
+    assert (tmp_path / "block.png").stat().st_size > 0
+    table = impact1d.sweep(impact1d.load_scene(scene), {"v1": [1.0, 4.0]}, workers=1)
+    assert table["x2_end"].isna().all() and table["error"].eq("").all()
+    np.testing.assert_allclose(table["x1_end"].iloc[1], direct.x1[-1], rtol=0, atol=0)

@@ -7,7 +7,8 @@ import os
 import numpy as np
 
 from ._scene import REAL_FIELDS, TEXT_FIELDS, Scene, InputError
-from ._simulate import COLUMNS, OPTIONAL_COLUMNS, EVENT_DTYPE, Result, result_from_columns
+from ._simulate import (COLUMNS, OPTIONAL_COLUMNS, EVENT_DTYPE, ONE_BODY_EVENT_DTYPE, Result,
+                        result_from_columns)
 
 __all__ = ["read_output", "events_path"]
 
@@ -36,19 +37,20 @@ def _read_header(path):
     return fields, last
 
 
-def _read_events(path) -> np.ndarray:
+def _read_events(path, one_body=False) -> np.ndarray:
     rows = []
+    dtype = ONE_BODY_EVENT_DTYPE if one_body else EVENT_DTYPE
     with open(path, encoding="utf-8") as handle:
         for number, line in enumerate(handle, 1):
             text = line.split("#", 1)[0].split()
             if not text:
                 continue
-            if len(text) != 6:
-                raise InputError(f"{path}:{number}: expected 6 entries "
-                                 "(t kind v1_before v2_before v1_after v2_after)")
+            if len(text) != len(dtype.names):
+                raise InputError(f"{path}:{number}: expected {len(dtype.names)} entries "
+                                 f"({' '.join(dtype.names)})")
             t, kind, *velocities = text
             rows.append((float(t), kind, *map(float, velocities)))
-    return np.array(rows, dtype=EVENT_DTYPE)
+    return np.array(rows, dtype=dtype)
 
 
 def read_output(path) -> Result:
@@ -83,8 +85,9 @@ def read_output(path) -> Result:
     scene = Scene(**kwargs, source=header.get("scene"))
 
     events_file = events_path(path)
-    events = (_read_events(events_file) if os.path.isfile(events_file)
-              else np.empty(0, dtype=EVENT_DTYPE))
+    one_body = "x2" not in names
+    events = (_read_events(events_file, one_body) if os.path.isfile(events_file)
+              else np.empty(0, dtype=ONE_BODY_EVENT_DTYPE if one_body else EVENT_DTYPE))
     residual = samples[:, names.index("residual")]
     energy_residual = float(np.max(np.abs(residual))) if residual.size else 0.0
     return result_from_columns(samples, events, names, energy_residual=energy_residual,

@@ -11,18 +11,21 @@ import numpy as np
 
 from ._scene import REAL_FIELDS, Scene, InputError, decode, raise_for_status, to_core, _words, _api
 
-__all__ = ["Result", "simulate", "COLUMNS", "EVENT_DTYPE"]
+__all__ = ["Result", "simulate", "COLUMNS", "EVENT_DTYPE", "ONE_BODY_EVENT_DTYPE"]
 
 # Every sample column the api (and the CLI output) can have, checked against the core
 # below. A run has those its scene has: pe only with springs, damping_loss only with
 # dampers (Result.columns); the others always.
 COLUMNS = ("t", "x1", "v1", "x2", "v2", "ke", "pe", "work", "friction_loss",
            "impact_loss", "damping_loss", "residual")
-OPTIONAL_COLUMNS = ("pe", "damping_loss")
+OPTIONAL_COLUMNS = ("x2", "v2", "pe", "damping_loss")
 
 # Longest event kind is "release_slot_min" (16 characters).
 EVENT_DTYPE = np.dtype([("t", "f8"), ("kind", "U20"), ("v1_before", "f8"),
                         ("v2_before", "f8"), ("v1_after", "f8"), ("v2_after", "f8")])
+# A one-body scene's events (no m2: the scene has no body 2).
+ONE_BODY_EVENT_DTYPE = np.dtype([("t", "f8"), ("kind", "U20"), ("v1_before", "f8"),
+                                 ("v1_after", "f8")])
 
 if _words(_api.column_names()) != COLUMNS:
     raise ImportError("impact1d._core sample columns do not match impact1d.COLUMNS: "
@@ -100,13 +103,14 @@ class Result:
     """One run: the samples as float64 arrays (one entry per output time), the event
     log, the run's accuracy monitor and the scene actually run. pe (the springs' potential
     energy) and damping_loss (what the dampers dissipated) are None for a scene without
-    springs or dampers: `columns` names the columns the run has."""
+    springs or dampers, and x2 and v2 for a one-body scene (no m2; its events then have no
+    v2 fields either): `columns` names the columns the run has."""
 
     t: np.ndarray = field(default_factory=_empty)
     x1: np.ndarray = field(default_factory=_empty)
     v1: np.ndarray = field(default_factory=_empty)
-    x2: np.ndarray = field(default_factory=_empty)
-    v2: np.ndarray = field(default_factory=_empty)
+    x2: Optional[np.ndarray] = field(default_factory=_empty)
+    v2: Optional[np.ndarray] = field(default_factory=_empty)
     ke: np.ndarray = field(default_factory=_empty)
     pe: Optional[np.ndarray] = None
     work: np.ndarray = field(default_factory=_empty)
@@ -143,6 +147,7 @@ def result_from_columns(samples: np.ndarray, events: np.ndarray, names=COLUMNS, 
     # Column-major (as f2py returns it, a copy otherwise): each column is a contiguous row
     # of the transpose, shared rather than copied.
     columns = dict(zip(names, np.asfortranarray(samples).T))
+    columns.update({name: None for name in OPTIONAL_COLUMNS if name not in columns})
     return Result(**columns, events=events, **extra)
 
 
@@ -180,8 +185,15 @@ def simulate(scene: Scene, *, progress: bool = False, **overrides) -> Result:
     present = np.flatnonzero(has_column)
     column_names = tuple(COLUMNS[k] for k in present)
     samples = samples[:n_samples] if len(present) == len(COLUMNS) else samples[:n_samples, present]
-    events = np.empty(n_events, dtype=EVENT_DTYPE)
-    if n_events > 0:
+    one_body = "x2" not in column_names
+    events = np.empty(n_events, dtype=ONE_BODY_EVENT_DTYPE if one_body else EVENT_DTYPE)
+    if n_events > 0 and one_body:
+        names = _kind_names()
+        kind = np.asarray(event_kind[:n_events])
+        events["t"] = event_t[:n_events]
+        events["kind"] = names[np.where((kind >= 1) & (kind < len(names)), kind, 0)]
+        events["v1_before"], events["v1_after"] = event_v[0, :n_events], event_v[2, :n_events]
+    elif n_events > 0:
         names = _kind_names()
         kind = np.asarray(event_kind[:n_events])
         events["t"] = event_t[:n_events]

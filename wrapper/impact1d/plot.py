@@ -202,7 +202,8 @@ def _legend(ax, **kw):
 def _draw_positions(ax, result, events):
     t = np.asarray(result.t, dtype=float)
     x1 = np.asarray(result.x1, dtype=float)
-    x2 = np.asarray(result.x2, dtype=float)
+    # A one-body scene has no x2: drawn as an empty series.
+    x2 = np.asarray(result.x2 if result.x2 is not None else x1[:0], dtype=float)
     x_left = _float_or_none(_scene_value(result, "x_left"))
     x_right = _float_or_none(_scene_value(result, "x_right"))
     d_min = _float_or_none(_scene_value(result, "d_min"))
@@ -210,8 +211,8 @@ def _draw_positions(ax, result, events):
 
     # Limits from the bodies and the walls only: a wide slot (case 5 has
     # d_max = 50 m) must not squash the motion.
-    lo = [np.min(x1), np.min(x2)] if t.size else [0.0]
-    hi = [np.max(x1), np.max(x2)] if t.size else [1.0]
+    lo = [np.min(x1)] + ([np.min(x2)] if x2.size else []) if t.size else [0.0]
+    hi = [np.max(x1)] + ([np.max(x2)] if x2.size else []) if t.size else [1.0]
     for w in (x_left, x_right):
         if w is not None:
             lo.append(w)
@@ -255,7 +256,8 @@ def _draw_positions(ax, result, events):
                    label=f"{name} wall x = {w:g} m")
 
     ax.plot(t, x1, color=_BODY_COLOR[1], linewidth=1.4, gid="x1", label="x1 (body 1)")
-    ax.plot(t, x2, color=_BODY_COLOR[2], linewidth=1.4, gid="x2", label="x2 (body 2)")
+    if x2.size:
+        ax.plot(t, x2, color=_BODY_COLOR[2], linewidth=1.4, gid="x2", label="x2 (body 2)")
 
     # Smaller markers when impacts crowd (long runs), so the paths stay visible.
     n_impacts = sum(1 for _, k in events if k in CONTACTS)
@@ -265,7 +267,8 @@ def _draw_positions(ax, result, events):
         if times.size == 0:
             continue
         xs, ys = [], []
-        for body in _CONTACT_BODIES[contact]:
+        # One body: both walls hold body 1.
+        for body in (_CONTACT_BODIES[contact] if x2.size else (1,)):
             pos = x1 if body == 1 else x2
             xs.append(times)
             ys.append(np.interp(times, t, pos))
@@ -285,8 +288,9 @@ def _draw_velocities(ax, result, events):
     ax.axhline(0.0, color="0.5", linewidth=0.8)
     ax.plot(t, np.asarray(result.v1, dtype=float), color=_BODY_COLOR[1], linewidth=1.2,
             gid="v1", label="v1 (body 1)")
-    ax.plot(t, np.asarray(result.v2, dtype=float), color=_BODY_COLOR[2], linewidth=1.2,
-            gid="v2", label="v2 (body 2)")
+    if result.v2 is not None:
+        ax.plot(t, np.asarray(result.v2, dtype=float), color=_BODY_COLOR[2], linewidth=1.2,
+                gid="v2", label="v2 (body 2)")
     # Friction mode switches: the body's velocity is zero there.
     styles = {"stick": ("s", "stuck (friction holds)"), "slip": ("D", "slips (breaks away)")}
     for what, (marker, text) in styles.items():
@@ -306,7 +310,8 @@ def _draw_velocities(ax, result, events):
 def _draw_kinetic_energy(ax, result, events):
     t = np.asarray(result.t, dtype=float)
     ke = np.asarray(result.ke, dtype=float)
-    ax.plot(t, ke, color="black", linewidth=1.3, gid="ke", label="KE = m1 v1\u00b2/2 + m2 v2\u00b2/2")
+    ax.plot(t, ke, color="black", linewidth=1.3, gid="ke",
+            label="KE = m1 v1\u00b2/2" + (" + m2 v2\u00b2/2" if result.v2 is not None else ""))
     top = float(np.max(ke)) if ke.size else 1.0
     if getattr(result, "pe", None) is not None:
         pe = np.asarray(result.pe, dtype=float)

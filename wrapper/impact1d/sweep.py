@@ -47,21 +47,24 @@ def summarize(result) -> dict:
     events = result.events
     kinds = events["kind"]
     counts = {kind: int(np.count_nonzero(kinds == kind)) for kind in _IMPACT_KINDS}
-    moving = (result.v1 != 0.0) | (result.v2 != 0.0)
+    two_bodies = result.v2 is not None
+    moving = (result.v1 != 0.0) | ((result.v2 != 0.0) if two_bodies else False)
     if moving[-1]:
         t_rest = math.nan
     else:
         # The core's order: events at a sample's time come before that sample, and events
         # at one instant in the order logged.
         t_sample_moved = result.t[np.flatnonzero(moving)[-1]] if moving.any() else -math.inf
-        leaves_moving = (events["v1_after"] != 0.0) | (events["v2_after"] != 0.0)
+        leaves_moving = (events["v1_after"] != 0.0) | (
+            (events["v2_after"] != 0.0) if two_bodies else False)
         after = np.arange(len(events)) > (np.flatnonzero(leaves_moving)[-1] if leaves_moving.any() else -1)
         t_event_moved = events["t"][~after].max() if (~after).any() and leaves_moving.any() else -math.inf
         still = events["t"][after & (events["t"] > t_sample_moved)]
         at_rest = result.t[(result.t > t_sample_moved) & (result.t >= t_event_moved)]
         t_rest = float(min(still.min() if len(still) else math.inf, at_rest.min()))
-    row = {"x1_end": result.x1[-1], "v1_end": result.v1[-1], "x2_end": result.x2[-1],
-           "v2_end": result.v2[-1], "ke_end": result.ke[-1],
+    row = {"x1_end": result.x1[-1], "v1_end": result.v1[-1],
+           "x2_end": result.x2[-1] if two_bodies else math.nan,
+           "v2_end": result.v2[-1] if two_bodies else math.nan, "ke_end": result.ke[-1],
            "n_impacts": sum(counts.values()), **{f"n_{k}": counts[k] for k in _IMPACT_KINDS},
            "t_rest": t_rest, "impact_loss": result.impact_loss[-1],
            "friction_loss": result.friction_loss[-1],
