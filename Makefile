@@ -18,7 +18,7 @@ export MPLBACKEND ?= Agg
 # compile serves the wheel and the Fortran unit tests, and re-runs are no-ops.
 BUILDDIR := $(CURDIR)/build/py
 # The tutorial's six cases, then the mechanisms beyond it (springs, dampers, static friction).
-SCENES   := case1 case2 case3 case4 case5 case6 impact_oscillator stick_slip gear_rattle breakaway
+SCENES   := case1 case2 case3 case4 case5 case6 impact_oscillator stick_slip gear_rattle breakaway mounted_stop
 
 # What the installed package is made of: a change re-installs it (folders too,
 # so that a deleted file counts).

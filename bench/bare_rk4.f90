@@ -17,34 +17,21 @@ program bare_rk4
 
   call get_command_argument(1, arg)
   read(arg, *) n
-  call get_command_argument(2, arg)
-  read(arg, *) dt
-  do j = 1, 2
-    call get_command_argument(2 + j, arg)
-    read(arg, *) m(j)
-    call get_command_argument(4 + j, arg)
-    read(arg, *) f(j)
-  end do
-  do j = 1, 4
-    call get_command_argument(6 + j, arg)
-    read(arg, *) y(j)
-  end do
+  dt = argument(2)
+  m = [argument(3), argument(4)]
+  f = [argument(5), argument(6)]
+  y = [(argument(6 + j), j = 1, 4)]
   amp = 0.0_dp
   omega = 0.0_dp
   if (command_argument_count() >= 12) then
-    call get_command_argument(11, arg)
-    read(arg, *) amp
-    call get_command_argument(12, arg)
-    read(arg, *) omega
-    omega = 2.0_dp * acos(-1.0_dp) / omega
+    amp = argument(11)
+    omega = 2.0_dp * acos(-1.0_dp) / argument(12)
   end if
   stiffness = 0.0_dp
   x_rest = 0.0_dp
   if (command_argument_count() >= 14) then
-    call get_command_argument(13, arg)
-    read(arg, *) stiffness
-    call get_command_argument(14, arg)
-    read(arg, *) x_rest
+    stiffness = argument(13)
+    x_rest = argument(14)
   end if
   t = 0.0_dp
   do i = 1, n
@@ -58,6 +45,14 @@ program bare_rk4
   print '(5es25.16)', t, y
 
 contains
+
+  !> Command-line argument i as a number.
+  real(dp) function argument(i)
+    integer, intent(in) :: i
+    character(len=64) :: text
+    call get_command_argument(i, text)
+    read(text, *) argument
+  end function argument
 
   pure function rhs(time, state) result(dydt)
     real(dp), intent(in) :: time, state(4)
