@@ -115,10 +115,10 @@ contains
       end if
     end do
     ! Without m2 the scene has one body, and nothing may name the second.
-    call require([i_m1, i_x1])
+    call require(input, [i_m1, i_x1], error)
     if (allocated(error)) return
     if (input%given(i_m2)) then
-      call require([i_x2])
+      call require(input, [i_x2], error)
     else
       do k = 1, size(body2_fields)
         if (input%given(body2_fields(k))) then
@@ -134,22 +134,24 @@ contains
       end if
     end if
     if (allocated(error)) return
-    if (require_run) call require([i_t_end, i_dt])
+    if (require_run) call require(input, [i_t_end, i_dt], error)
     if (allocated(error)) return
 
-    call positive(i_m1)
-    if (input%given(i_m2)) call positive(i_m2)
+    call positive(input, i_m1, error)
+    if (input%given(i_m2)) call positive(input, i_m2, error)
     if (allocated(error)) return
-    call nonnegative(i_mu1); call nonnegative(i_mu2); call nonnegative(i_zero_vel)
-    call nonnegative(i_mus1); call nonnegative(i_mus2)
+    call nonnegative(input, i_mu1, error)
+    call nonnegative(input, i_mu2, error)
+    call nonnegative(input, i_zero_vel, error)
+    call nonnegative(input, i_mus1, error); call nonnegative(input, i_mus2, error)
     do k = 1, n_elements
-      call nonnegative(spring_index(k)); call nonnegative(spring_index(k) + 2)
+      call nonnegative(input, spring_index(k), error); call nonnegative(input, spring_index(k) + 2, error)
     end do
     if (allocated(error)) return
     do k = 0, 1
-      if (input%given(i_mus1 + k) .and. input%value(i_mus1 + k) < value_or(i_mu1 + k, 0.0_wp)) then
+      if (input%given(i_mus1 + k) .and. input%value(i_mus1 + k) < value_or(input, i_mu1 + k, 0.0_wp)) then
         call raise(error, status_input, trim(real_names(i_mus1 + k)) // ' = ' // fmt(input%value(i_mus1 + k)) // &
-          ' is below ' // trim(real_names(i_mu1 + k)) // ' = ' // fmt(value_or(i_mu1 + k, 0.0_wp)) // &
+          ' is below ' // trim(real_names(i_mu1 + k)) // ' = ' // fmt(value_or(input, i_mu1 + k, 0.0_wp)) // &
           ': static friction is at least the sliding friction')
         return
       end if
@@ -167,17 +169,19 @@ contains
         return
       end if
     end do
-    call count_limit(i_max_rows); call count_limit(i_max_impulses); call count_limit(i_max_step_events)
+    call count_limit(input, i_max_rows, error)
+    call count_limit(input, i_max_impulses, error)
+    call count_limit(input, i_max_step_events, error)
     if (allocated(error)) return
-    if (input%given(i_g) .and. input%value(i_g) < 0.0_wp .and. (value_or(i_mu1, 0.0_wp) > 0.0_wp &
-        .or. value_or(i_mu2, 0.0_wp) > 0.0_wp .or. value_or(i_mus1, 0.0_wp) > 0.0_wp .or. &
-        value_or(i_mus2, 0.0_wp) > 0.0_wp)) then
+    if (input%given(i_g) .and. input%value(i_g) < 0.0_wp .and. (value_or(input, i_mu1, 0.0_wp) > 0.0_wp &
+        .or. value_or(input, i_mu2, 0.0_wp) > 0.0_wp .or. value_or(input, i_mus1, 0.0_wp) > 0.0_wp .or. &
+        value_or(input, i_mus2, 0.0_wp) > 0.0_wp)) then
       call raise(error, status_input, 'g = ' // fmt(input%value(i_g)) // &
         ' is negative with friction: the normal force m g must not pull the bodies off the surface')
       return
     end if
-    call restitution(i_r_left, i_x_left); call restitution(i_r_right, i_x_right)
-    call restitution(i_r_min, i_d_min); call restitution(i_r_max, i_d_max)
+    call restitution(input, i_r_left, i_x_left, error); call restitution(input, i_r_right, i_x_right, error)
+    call restitution(input, i_r_min, i_d_min, error); call restitution(input, i_r_max, i_d_max, error)
     if (allocated(error)) return
     if (input%given(i_x_left) .and. input%given(i_x_right)) then
       if (input%value(i_x_left) >= input%value(i_x_right)) then
@@ -198,8 +202,8 @@ contains
         return
       end if
     end if
-    call sine_terms(i_f1_amp, i_f1_period, i_f1_phase)
-    call sine_terms(i_f2_amp, i_f2_period, i_f2_phase)
+    call sine_terms(input, i_f1_amp, i_f1_period, i_f1_phase, error)
+    call sine_terms(input, i_f2_amp, i_f2_period, i_f2_phase, error)
     if (allocated(error)) return
 
     ! The initial state must satisfy every constraint; a gap within the rounding of the
@@ -210,35 +214,41 @@ contains
     do k = 1, n_contacts
       if (.not. has_limit(input, k)) cycle
       nrm = contact_normals(input)
-      gap = nrm(1, k) * input%value(i_x1) + nrm(2, k) * input%value(i_x2) + offset_of(k)
+      gap = nrm(1, k) * input%value(i_x1) + nrm(2, k) * input%value(i_x2) + offset_of(input, k)
       scale = maxval(abs(nrm(:, k) * input%value([i_x1, i_x2])))
-      if (gap < -16.0_wp * eps_wp * max(scale, abs(offset_of(k)))) then
-        call raise(error, status_input, 'the initial state x1 = ' // fmt(input%value(i_x1)) // &
-          ', x2 = ' // fmt(input%value(i_x2)) // ' violates the ' // trim(contact_names(k)) // &
-          ' constraint (' // trim(real_names(limit_index(k))) // ' = ' // &
-          fmt(limit_value(input, k)) // merge(' by default: the bodies meet', '                            ', &
-          .not. input%given(limit_index(k))) // ')')
+      if (gap < -16.0_wp * eps_wp * max(scale, abs(offset_of(input, k)))) then
+        if (input%given(limit_index(k))) then
+          call raise(error, status_input, 'the initial state ' // initial_positions(input) // ' violates the ' // &
+            trim(contact_names(k)) // ' constraint (' // trim(real_names(limit_index(k))) // ' = ' // &
+            fmt(limit_value(input, k)) // ')')
+        else
+          call raise(error, status_input, 'the initial state ' // initial_positions(input) // ' violates the ' // &
+            trim(contact_names(k)) // ' constraint (d_min = 0 by default: the bodies meet at x2 = x1)')
+        end if
         return
       end if
       ! Within the rounding of the user's decimals (the contact test below) it is contact.
-      if (gap > 16.0_wp * eps_wp * max(scale, abs(offset_of(k)))) &
-        call resolvable('the initial ' // trim(contact_names(k)) // ' gap', gap, max(scale, abs(offset_of(k))))
+      if (gap > 16.0_wp * eps_wp * max(scale, abs(offset_of(input, k)))) &
+        call resolvable('the initial ' // trim(contact_names(k)) // ' gap', gap, &
+          max(scale, abs(offset_of(input, k))), error)
       if (allocated(error)) return
     end do
     scale = maxval(abs(input%value([i_x1, i_x2])))
     if (input%given(i_x_left)) scale = max(scale, abs(input%value(i_x_left)))
     if (input%given(i_x_right)) scale = max(scale, abs(input%value(i_x_right)))
     if (input%given(i_x_left) .and. input%given(i_x_right)) &
-      call resolvable('the walls'' distance x_right - x_left', input%value(i_x_right) - input%value(i_x_left), scale)
-    if (input%given(i_d_min)) call resolvable('d_min', input%value(i_d_min), scale)
-    if (input%given(i_d_max)) call resolvable('d_max', input%value(i_d_max), scale)
+      call resolvable('the walls'' distance x_right - x_left', &
+        input%value(i_x_right) - input%value(i_x_left), scale, error)
+    if (input%given(i_d_min)) call resolvable('d_min', input%value(i_d_min), scale, error)
+    if (input%given(i_d_max)) call resolvable('d_max', input%value(i_d_max), scale, error)
     if (input%given(i_d_min) .and. input%given(i_d_max)) &
-      call resolvable('the slot''s width d_max - d_min', input%value(i_d_max) - input%value(i_d_min), scale)
+      call resolvable('the slot''s width d_max - d_min', &
+        input%value(i_d_max) - input%value(i_d_min), scale, error)
     if (allocated(error)) return
     do k = 0, 3
       associate (i => merge(i_mu1, i_mus1, k < 2) + mod(k, 2))
         if (.not. input%given(i)) cycle
-        if (input%value(i) * input%value(i_m1 + mod(k, 2)) * abs(value_or(i_g, default_gravity)) > huge(1.0_wp)) then
+        if (input%value(i) * input%value(i_m1 + mod(k, 2)) * abs(value_or(input, i_g, default_gravity)) > huge(1.0_wp)) then
           call raise(error, status_input, trim(real_names(i)) // ' = ' // fmt(input%value(i)) // &
             ': the friction bound mu m g overflows')
           return
@@ -276,11 +286,11 @@ contains
       end if
     end if
     if (input%given(i_t_end) .and. (input%given(i_dt) .or. input%given(i_dt_out))) then
-      if (input%value(i_t_end) / value_or(i_dt_out, input%value(i_dt)) > &
-          value_or(i_max_rows, real(max_samples, wp)) - 1.0_wp) then
+      if (input%value(i_t_end) / value_or(input, i_dt_out, input%value(i_dt)) > &
+          value_or(input, i_max_rows, real(max_samples, wp)) - 1.0_wp) then
         call raise(error, status_input, 't_end / dt_out = ' // &
-          fmt(input%value(i_t_end) / value_or(i_dt_out, input%value(i_dt))) // &
-          ' output rows is over the limit of ' // fmt(value_or(i_max_rows, real(max_samples, wp))) // &
+          fmt(input%value(i_t_end) / value_or(input, i_dt_out, input%value(i_dt))) // &
+          ' output rows is over the limit of ' // fmt(value_or(input, i_max_rows, real(max_samples, wp))) // &
           ': set a larger dt_out (or &run max_rows)')
         return
       end if
@@ -292,95 +302,123 @@ contains
         return
       end if
     end if
-
-  contains
-
-    subroutine require(indices)
-      integer, intent(in) :: indices(:)
-      integer :: j
-      do j = 1, size(indices)
-        if (.not. input%given(indices(j))) then
-          call raise(error, status_input, trim(real_names(indices(j))) // ' is required but not given')
-          return
-        end if
-      end do
-    end subroutine require
-
-    subroutine positive(i)
-      integer, intent(in) :: i
-      if (allocated(error)) return
-      if (input%value(i) <= 0.0_wp) call raise(error, status_input, trim(real_names(i)) // ' = ' // &
-        fmt(input%value(i)) // ' must be positive')
-    end subroutine positive
-
-    !> A work limit: a whole number from 1 to the largest default integer.
-    subroutine count_limit(i)
-      integer, intent(in) :: i
-      if (allocated(error) .or. .not. input%given(i)) return
-      if (input%value(i) < 1.0_wp .or. input%value(i) > real(huge(1), wp) .or. &
-          input%value(i) /= aint(input%value(i))) call raise(error, status_input, trim(real_names(i)) // &
-        ' = ' // fmt(input%value(i)) // ' must be a whole number from 1 to ' // fmt(huge(1)))
-    end subroutine count_limit
-
-    subroutine nonnegative(i)
-      integer, intent(in) :: i
-      if (allocated(error) .or. .not. input%given(i)) return
-      if (input%value(i) < 0.0_wp) call raise(error, status_input, trim(real_names(i)) // ' = ' // &
-        fmt(input%value(i)) // ' must not be negative')
-    end subroutine nonnegative
-
-    subroutine restitution(i, owner)
-      integer, intent(in) :: i, owner
-      if (allocated(error) .or. .not. input%given(i)) return
-      if (input%value(i) < 0.0_wp .or. input%value(i) > 1.0_wp) then
-        call raise(error, status_input, trim(real_names(i)) // ' = ' // fmt(input%value(i)) // &
-          ' is outside [0, 1]')
-      else if (.not. input%given(owner) .and. i /= i_r_min) then
-        ! (r_min alone is the restitution of the bodies meeting: d_min = 0 by default.)
-        call raise(error, status_input, trim(real_names(i)) // ' is given but ' // &
-          trim(real_names(owner)) // ' is not: a restitution needs its constraint')
-      end if
-    end subroutine restitution
-
-    subroutine sine_terms(i_amp, i_period, i_phase)
-      integer, intent(in) :: i_amp, i_period, i_phase
-      if (allocated(error)) return
-      if (input%given(i_amp) .neqv. input%given(i_period)) then
-        call raise(error, status_input, trim(real_names(i_amp)) // ' and ' // trim(real_names(i_period)) // &
-          ' go together: a sine force needs both')
-      else if (input%given(i_phase) .and. .not. input%given(i_amp)) then
-        call raise(error, status_input, trim(real_names(i_phase)) // ' is given but ' // &
-          trim(real_names(i_amp)) // ' is not')
-      else if (input%given(i_period)) then
-        if (input%value(i_period) <= 0.0_wp) call raise(error, status_input, trim(real_names(i_period)) // &
-          ' = ' // fmt(input%value(i_period)) // ' must be positive')
-      end if
-    end subroutine sine_terms
-
-    !> A length the scene relies on: zero (contact, a rigid link), or at least
-    !> min_resolved_ulps units of rounding of the coordinates it is measured against.
-    subroutine resolvable(what, length, scale)
-      character(len=*), intent(in) :: what
-      real(wp), intent(in) :: length, scale
-      if (allocated(error)) return
-      if (length <= 0.0_wp .or. length >= min_resolved_ulps * eps_wp * scale) return
-      call raise(error, status_input, what // ' = ' // fmt(length) // ' is below the resolution of ' // &
-        'the scene''s coordinates (|x| up to ' // fmt(scale) // ' m resolves ' // &
-        fmt(min_resolved_ulps * eps_wp * scale) // ' m): move the scene nearer the origin')
-    end subroutine resolvable
-
-    real(wp) function value_or(i, default)
-      integer, intent(in) :: i
-      real(wp), intent(in) :: default
-      value_or = default
-      if (input%given(i)) value_or = input%value(i)
-    end function value_or
-
-    real(wp) function offset_of(k)
-      integer, intent(in) :: k
-      offset_of = offset_sign(k) * limit_value(input, k)
-    end function offset_of
   end subroutine validate
+
+  !> Each of indices is given (the first that is not is the error).
+  subroutine require(input, indices, error)
+    type(scene_input), intent(in) :: input
+    type(error_type), allocatable, intent(inout) :: error
+    integer, intent(in) :: indices(:)
+    integer :: j
+    do j = 1, size(indices)
+      if (.not. input%given(indices(j))) then
+        call raise(error, status_input, trim(real_names(indices(j))) // ' is required but not given')
+        return
+      end if
+    end do
+  end subroutine require
+
+  !> Value i is above zero (unless an earlier check failed).
+  subroutine positive(input, i, error)
+    type(scene_input), intent(in) :: input
+    type(error_type), allocatable, intent(inout) :: error
+    integer, intent(in) :: i
+    if (allocated(error)) return
+    if (input%value(i) <= 0.0_wp) call raise(error, status_input, trim(real_names(i)) // ' = ' // &
+      fmt(input%value(i)) // ' must be positive')
+  end subroutine positive
+
+  !> A work limit: a whole number from 1 to the largest default integer.
+  subroutine count_limit(input, i, error)
+    type(scene_input), intent(in) :: input
+    type(error_type), allocatable, intent(inout) :: error
+    integer, intent(in) :: i
+    if (allocated(error) .or. .not. input%given(i)) return
+    if (input%value(i) < 1.0_wp .or. input%value(i) > real(huge(1), wp) .or. &
+        input%value(i) /= aint(input%value(i))) call raise(error, status_input, trim(real_names(i)) // &
+      ' = ' // fmt(input%value(i)) // ' must be a whole number from 1 to ' // fmt(huge(1)))
+  end subroutine count_limit
+
+  !> Value i, when given, is not below zero.
+  subroutine nonnegative(input, i, error)
+    type(scene_input), intent(in) :: input
+    type(error_type), allocatable, intent(inout) :: error
+    integer, intent(in) :: i
+    if (allocated(error) .or. .not. input%given(i)) return
+    if (input%value(i) < 0.0_wp) call raise(error, status_input, trim(real_names(i)) // ' = ' // &
+      fmt(input%value(i)) // ' must not be negative')
+  end subroutine nonnegative
+
+  !> Restitution i, when given, is in [0, 1] and has its constraint (owner).
+  subroutine restitution(input, i, owner, error)
+    type(scene_input), intent(in) :: input
+    type(error_type), allocatable, intent(inout) :: error
+    integer, intent(in) :: i, owner
+    if (allocated(error) .or. .not. input%given(i)) return
+    if (input%value(i) < 0.0_wp .or. input%value(i) > 1.0_wp) then
+      call raise(error, status_input, trim(real_names(i)) // ' = ' // fmt(input%value(i)) // &
+        ' is outside [0, 1]')
+    else if (.not. input%given(owner) .and. i /= i_r_min) then
+      ! (r_min alone is the restitution of the bodies meeting: d_min = 0 by default.)
+      call raise(error, status_input, trim(real_names(i)) // ' is given but ' // &
+        trim(real_names(owner)) // ' is not: a restitution needs its constraint')
+    end if
+  end subroutine restitution
+
+  !> A sine force's amplitude and period go together; its phase needs them.
+  subroutine sine_terms(input, i_amp, i_period, i_phase, error)
+    type(scene_input), intent(in) :: input
+    type(error_type), allocatable, intent(inout) :: error
+    integer, intent(in) :: i_amp, i_period, i_phase
+    if (allocated(error)) return
+    if (input%given(i_amp) .neqv. input%given(i_period)) then
+      call raise(error, status_input, trim(real_names(i_amp)) // ' and ' // trim(real_names(i_period)) // &
+        ' go together: a sine force needs both')
+    else if (input%given(i_phase) .and. .not. input%given(i_amp)) then
+      call raise(error, status_input, trim(real_names(i_phase)) // ' is given but ' // &
+        trim(real_names(i_amp)) // ' is not')
+    else if (input%given(i_period)) then
+      if (input%value(i_period) <= 0.0_wp) call raise(error, status_input, trim(real_names(i_period)) // &
+        ' = ' // fmt(input%value(i_period)) // ' must be positive')
+    end if
+  end subroutine sine_terms
+
+  !> A length the scene relies on: zero (contact, a rigid link), or at least
+  !> min_resolved_ulps units of rounding of the coordinates it is measured against.
+  subroutine resolvable(what, length, scale, error)
+    type(error_type), allocatable, intent(inout) :: error
+    character(len=*), intent(in) :: what
+    real(wp), intent(in) :: length, scale
+    if (allocated(error)) return
+    if (length <= 0.0_wp .or. length >= min_resolved_ulps * eps_wp * scale) return
+    call raise(error, status_input, what // ' = ' // fmt(length) // ' is below the resolution of ' // &
+      'the scene''s coordinates (|x| up to ' // fmt(scale) // ' m resolves ' // &
+      fmt(min_resolved_ulps * eps_wp * scale) // ' m): move the scene nearer the origin')
+  end subroutine resolvable
+
+  !> 'x1 = .., x2 = ..' (x1 alone in a one-body scene), for messages.
+  pure function initial_positions(input) result(text)
+    type(scene_input), intent(in) :: input
+    character(len=:), allocatable :: text
+    text = 'x1 = ' // fmt(input%value(i_x1))
+    if (input%given(i_m2)) text = text // ', x2 = ' // fmt(input%value(i_x2))
+  end function initial_positions
+
+  !> Value i, or default when it is not given.
+  pure real(wp) function value_or(input, i, default)
+    type(scene_input), intent(in) :: input
+    integer, intent(in) :: i
+    real(wp), intent(in) :: default
+    value_or = default
+    if (input%given(i)) value_or = input%value(i)
+  end function value_or
+
+  !> Constraint k's offset as the input gives it (gap = normal . x + offset).
+  pure real(wp) function offset_of(input, k)
+    type(scene_input), intent(in) :: input
+    integer, intent(in) :: k
+    offset_of = offset_sign(k) * limit_value(input, k)
+  end function offset_of
 
   !> Validate and build the model. tables(i) holds f_i's table when the input names one.
   subroutine build_scene(input, tables, scene, error)

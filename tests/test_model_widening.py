@@ -354,3 +354,15 @@ def test_one_body_files_name_their_columns(tmp_path):
     table = impact1d.sweep(impact1d.load_scene(scene), {"v1": [1.0, 4.0]}, workers=1)
     assert table["x2_end"].isna().all() and table["error"].eq("").all()
     np.testing.assert_allclose(table["x1_end"].iloc[1], direct.x1[-1], rtol=0, atol=0)
+
+
+def test_vissim_method_runs_one_body_scenes():
+    """The tutorial's scheme on a one-body scene: both walls clamp body 1, the impacts are
+    the event method's to O(dt)."""
+    scene = impact1d.Scene(m1=2.0, x1=1.0, v1=3.0, f1=-1.0, x_left=0.0, r_left=0.5, x_right=2.0,
+                           r_right=0.9, t_end=4.0, dt=1e-3)
+    exact, approx = impact1d.simulate(scene), impact1d.simulate(scene, method="vissim")
+    assert approx.columns == exact.columns and approx.x2 is None
+    assert np.all((approx.x1 >= 0.0) & (approx.x1 <= 2.0))
+    assert list(approx.events["kind"]) == list(exact.events["kind"])
+    np.testing.assert_allclose(approx.events["t"], exact.events["t"], rtol=0, atol=5e-3)
