@@ -81,7 +81,8 @@ contains
   !> the events the event arrays up to n_events; when either needs more room than the caller
   !> gave (max_samples, max_events), status is 3 and n_samples, n_events are the sizes needed:
   !> call again with them. has_column(k) is 1 for the columns the scene has (column_names
-  !> lists all of them; pe and damping_loss only exist with springs and dampers).
+  !> lists all of them; x2 and v2 only exist with a second body, pe and damping_loss with
+  !> springs and dampers): they fill samples' first columns, in column_names' order.
   subroutine simulate(n, values, given, title, f1_table, f2_table, method, progress, max_samples, &
       n_cols, max_events, samples, has_column, event_t, event_kind, event_v, n_samples, n_events, steps, &
       energy_residual, status, message)
@@ -105,6 +106,7 @@ contains
     type(run_stats) :: stats
     type(memory_sink) :: sink
     type(error_type), allocatable :: error
+    integer, allocatable :: columns(:)
 
     n_samples = 0
     n_events = 0
@@ -120,8 +122,9 @@ contains
     input = flat_input(values, given, title, f1_table, f2_table, method)
     call prepare_scene(input, scene, error)
     if (failed(error, status, message)) return
-    has_column(present_columns(input)) = 1
-    call sink%reserve(scene%n_samples)
+    columns = present_columns(input)
+    has_column(columns) = 1
+    call sink%reserve(scene%n_samples, columns)
     sink%show_progress = progress /= 0
     call run(scene, sink, stats, error)
     call sink%end_progress()
@@ -135,7 +138,8 @@ contains
       message = 'internal: the result arrays are too small'
       return
     end if
-    samples(:n_samples, :) = sink%samples(:n_samples, :)
+    ! The present columns first, in order (has_column says which they are).
+    samples(:n_samples, :size(columns)) = sink%samples(:n_samples, :)
     event_t(:n_events) = sink%event_time(:n_events)
     event_kind(:n_events) = sink%event_kind(:n_events)
     event_v(:, :n_events) = sink%event_v(:, :n_events)

@@ -73,7 +73,8 @@ module impact1d_output
 
   !> Keeps everything in arrays (the Python side copies them out).
   type, extends(sink_type) :: memory_sink
-    real(wp), allocatable :: samples(:, :)
+    real(wp), allocatable :: samples(:, :)      !< one column per present column, in order
+    integer, allocatable :: columns(:)
     integer :: n_samples = 0
     real(wp), allocatable :: event_time(:), event_v(:, :)
     integer, allocatable :: event_kind(:)
@@ -152,22 +153,36 @@ contains
   !> both methods report through here, so their columns cannot drift apart. A row that is not
   !> finite (v = 1e300 squares to an infinite KE, and the residual becomes NaN) is an error,
   !> never a result: a NaN would also slip through the max of the residuals.
-  !> springs: [pe, pe0, damping_loss] for a scene with springs or dampers (the residual then
-  !> counts the potential energy and the dampers' loss).
-  subroutine emit_sample(sink, stats, t, x, v, mass, ke0, work, friction_loss, impact_loss, error, springs)
+  !> springs: [pe, pe0, damping_loss], used when with_springs (a scene with springs or
+  !> dampers: the residual then counts the potential energy and the dampers' loss).
+  subroutine emit_sample(sink, stats, t, x, v, mass, ke0, work, friction_loss, impact_loss, &
+      with_springs, springs, error)
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
     real(wp), intent(in) :: t, x(2), v(2), mass(2), ke0, work, friction_loss, impact_loss
+    logical, intent(in) :: with_springs
+    real(wp), intent(in) :: springs(3)
     type(error_type), allocatable, intent(out) :: error
-    real(wp), intent(in), optional :: springs(3)
     real(wp) :: row(n_columns), ke
     ke = 0.5_wp * dot_product(mass, v**2)
-    if (present(springs)) then
-      row = [t, x(1), v(1), x(2), v(2), ke, springs(1), work, friction_loss, impact_loss, springs(3), &
-        ((ke + springs(1)) - (ke0 + springs(2))) - work + friction_loss + impact_loss + springs(3)]
+    ! Element by element: an array constructor here cost a temporary per sample.
+    row(1) = t
+    row(2) = x(1)
+    row(3) = v(1)
+    row(4) = x(2)
+    row(5) = v(2)
+    row(6) = ke
+    row(i_work) = work
+    row(i_friction_loss) = friction_loss
+    row(i_impact_loss) = impact_loss
+    if (with_springs) then
+      row(i_pe) = springs(1)
+      row(i_damping_loss) = springs(3)
+      row(n_columns) = ((ke + springs(1)) - (ke0 + springs(2))) - work + friction_loss + impact_loss + springs(3)
     else
-      row = [t, x(1), v(1), x(2), v(2), ke, 0.0_wp, work, friction_loss, impact_loss, 0.0_wp, &
-        ke - ke0 - work + friction_loss + impact_loss]
+      row(i_pe) = 0.0_wp
+      row(i_damping_loss) = 0.0_wp
+      row(n_columns) = ke - ke0 - work + friction_loss + impact_loss
     end if
     if (.not. all(abs(row) <= huge(1.0_wp))) then
       call raise(error, status_simulation, 'at t = ' // fmt(t) // ': the kinetic energy or the ' // &
@@ -237,11 +252,14 @@ contains
     self%progress_shown = .false.
   end subroutine end_progress
 
-  subroutine memory_reserve(self, n_samples)
+  !> Room for n_samples rows of the given columns (present_columns: only those are kept,
+  !> so a scene's memory is what it has).
+  subroutine memory_reserve(self, n_samples, columns)
     class(memory_sink), intent(inout) :: self
-    integer, intent(in) :: n_samples
+    integer, intent(in) :: n_samples, columns(:)
+    self%columns = columns
     if (allocated(self%samples)) deallocate(self%samples)
-    allocate(self%samples(n_samples, n_columns))
+    allocate(self%samples(n_samples, size(columns)))
     self%n_samples = 0
     if (allocated(self%event_time)) deallocate(self%event_time, self%event_v, self%event_kind)
     allocate(self%event_time(64), self%event_v(4, 64), self%event_kind(64))
@@ -287,7 +305,7 @@ contains
     class(memory_sink), intent(inout) :: self
     real(wp), intent(in) :: row(n_columns)
     self%n_samples = self%n_samples + 1
-    self%samples(self%n_samples, :) = row
+    self%samples(self%n_samples, :) = row(self%columns)
   end subroutine memory_put_sample
 
   subroutine memory_put_event(self, t, kind, v_before, v_after)

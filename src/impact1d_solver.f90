@@ -136,13 +136,11 @@ contains
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
     type(error_type), allocatable, intent(out) :: error
-    if (scene%springs%present) then
-      call emit_sample(sink, stats, s%t, s%x, s%v, scene%mass, ke0, s%work, s%friction_loss, s%impact_loss, &
-        error, [scene%springs%potential(s%x, s%x_lo), pe0, s%damping_loss])
-    else
-      call emit_sample(sink, stats, s%t, s%x, s%v, scene%mass, ke0, s%work, s%friction_loss, s%impact_loss, &
-        error)
-    end if
+    real(wp) :: pe
+    pe = 0.0_wp
+    if (scene%springs%present) pe = scene%springs%potential(s%x, s%x_lo)
+    call emit_sample(sink, stats, s%t, s%x, s%v, scene%mass, ke0, s%work, s%friction_loss, s%impact_loss, &
+      scene%springs%present, [pe, pe0, s%damping_loss], error)
     j_sample = j_sample + 1
   end subroutine emit
 

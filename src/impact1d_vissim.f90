@@ -96,12 +96,8 @@ contains
   contains
 
     subroutine emit()
-      if (scene%springs%present) then
-        call emit_sample(sink, stats, t, x, threshold(v), scene%mass, ke0, work, friction_loss, impact_loss, &
-          error, [scene%springs%potential(x, [0.0_wp, 0.0_wp]), pe0, damping_loss])
-      else
-        call emit_sample(sink, stats, t, x, threshold(v), scene%mass, ke0, work, friction_loss, impact_loss, error)
-      end if
+      call emit_sample(sink, stats, t, x, threshold(v), scene%mass, ke0, work, friction_loss, impact_loss, &
+        scene%springs%present, [scene%springs%potential(x, [0.0_wp, 0.0_wp]), pe0, damping_loss], error)
       j_sample = j_sample + 1
     end subroutine emit
 

@@ -13,7 +13,7 @@ program test_event_log
   type(scene_type) :: scene
 
   scene%dt = 1.0e-3_wp
-  call sink%reserve(4)
+  call sink%reserve(4, [1, 2, 3])   ! (samples are not used here)
   event_log%pending_rest(i_left) = 3.0_wp
   call event_log%flush_pending_rest(2.5_wp, [0.0_wp, 1.0_wp], sink, stats)
   call check(sink%n_events == 0, 'no rest before t = 3')

@@ -71,6 +71,18 @@ def _summary_names() -> tuple:
     return _words(_api.summary_column_names())
 
 
+_ABSENT = {name: None for name in OPTIONAL_COLUMNS}
+
+
+@lru_cache(maxsize=None)
+def _column_layout(has_column: bytes):
+    """The core's has_column flags (as bytes: a few layouts recur) -> (the present columns'
+    names in order, whether the scene has one body)."""
+    flags = np.frombuffer(has_column, dtype=np.int32)
+    names = tuple(name for name, flag in zip(COLUMNS, flags) if flag)
+    return names, "x2" not in names
+
+
 def _sample_capacity(scene) -> int:
     """Rows a run will emit: t = 0, dt_out, ..., t_end (the core's exact count may be one
     less; a scene the core refuses needs none)."""
@@ -182,23 +194,19 @@ def simulate(scene: Scene, *, progress: bool = False, **overrides) -> Result:
     n_samples, n_events = int(n_samples), int(n_events)
     # Event-heavy scenes tend to come in series (sweeps): start the next one with room.
     _event_capacity = max(_EVENT_CAPACITY, min(n_events + n_events // 8, _EVENT_CAPACITY_MAX))
-    present = np.flatnonzero(has_column)
-    column_names = tuple(COLUMNS[k] for k in present)
-    samples = samples[:n_samples] if len(present) == len(COLUMNS) else samples[:n_samples, present]
-    one_body = "x2" not in column_names
+    names, one_body = _column_layout(has_column.tobytes())
+    # The present columns come first; each is a contiguous view of the core's column-major
+    # array (no copy). Absent ones are None.
+    columns = dict(_ABSENT)
+    columns.update((name, samples[:n_samples, j]) for j, name in enumerate(names))
     events = np.empty(n_events, dtype=ONE_BODY_EVENT_DTYPE if one_body else EVENT_DTYPE)
-    if n_events > 0 and one_body:
-        names = _kind_names()
+    if n_events > 0:
         kind = np.asarray(event_kind[:n_events])
+        kinds = _kind_names()
         events["t"] = event_t[:n_events]
-        events["kind"] = names[np.where((kind >= 1) & (kind < len(names)), kind, 0)]
+        events["kind"] = kinds[np.where((kind >= 1) & (kind < len(kinds)), kind, 0)]
         events["v1_before"], events["v1_after"] = event_v[0, :n_events], event_v[2, :n_events]
-    elif n_events > 0:
-        names = _kind_names()
-        kind = np.asarray(event_kind[:n_events])
-        events["t"] = event_t[:n_events]
-        events["kind"] = names[np.where((kind >= 1) & (kind < len(names)), kind, 0)]
-        events["v1_before"], events["v2_before"] = event_v[0, :n_events], event_v[1, :n_events]
-        events["v1_after"], events["v2_after"] = event_v[2, :n_events], event_v[3, :n_events]
-    return result_from_columns(samples, events, column_names, energy_residual=float(energy_residual),
-                               steps=int(steps), scene=scene)
+        if not one_body:
+            events["v2_before"], events["v2_after"] = event_v[1, :n_events], event_v[3, :n_events]
+    return Result(**columns, events=events, energy_residual=float(energy_residual),
+                  steps=int(steps), scene=scene)
