@@ -34,7 +34,7 @@ help:
 	@echo "make setup   gfortran (apt, if missing), .venv, pip install .[test]"
 	@echo "make demo    run the scenes in input/ (the six cases, springs, stick-slip, rattle, break-away) and plot them"
 	@echo "make test    Fortran unit tests (meson test), then pytest"
-	@echo "make study   case 5's rest time over (r_left, r_right): a sweep and its heatmap"
+	@echo "make study   case 5's rest time over (r_left, r_right), the impact oscillator's bifurcation diagram"
 	@echo "make bench   accuracy and speed studies, Siconos as a peer (apt, if missing)"
 	@echo "             -> docs/accuracy.md, docs/performance.md"
 	@echo "make clean   remove .venv, build/ and output files"
@@ -90,6 +90,7 @@ study: setup
 	    --vary t_end=10 -o output/case5_rest.csv
 	impact1d-plot output/case5_rest.csv --x r_left --y r_right --value t_rest \
 	    -o docs/study_case5_rest.png
+	$(BIN)/python studies/impact_oscillator_bifurcation.py docs/study_impact_oscillator.png
 
 test: setup
 	meson test -C $(BUILDDIR) --print-errorlogs

@@ -31,16 +31,18 @@ contains
 
   !> Earliest event in (0, step]: a gap closing, a sliding body stopping, a mode condition
   !> failing. which = k for contact k, 100 + i for body i, -1 for a mode condition.
-  subroutine locate(self, scene, mode, constant_forcing, a, b, step, theta, which)
+  subroutine locate(self, scene, mode, constant_forcing, polynomial_forcing, a, b, step, theta, which)
     class(watch_type), intent(in) :: self
     type(scene_type), intent(in) :: scene
     type(mode_type), intent(in) :: mode
     logical, intent(in) :: constant_forcing
+    !> The dense output is exact (the motion is a cubic): else its own error counts too.
+    logical, intent(in) :: polynomial_forcing
     type(state_type), intent(in) :: a, b
     real(wp), intent(in) :: step
     real(wp), intent(out) :: theta
     integer, intent(out) :: which
-    real(wp) :: c(3, 2), p(0:3), candidate, scale, acc_rounding(2)
+    real(wp) :: c(3, 2), p(0:3), q(0:3), candidate, scale, acc_rounding(2), acc0(2)
     integer :: k, i
     logical :: have_dense, have_acc_rounding
 
@@ -58,10 +60,21 @@ contains
       ! The common case first: the gap cannot reach zero within the step.
       if (p(0) - step * (abs(p(1)) + step * (abs(p(2)) + step * abs(p(3)))) > 0.0_wp) cycle
       ! Only a gap that may close needs the forces' rounding (a sine costs two evaluations).
-      if (.not. have_acc_rounding) acc_rounding = 1.0e3_wp * eps_wp * &
-        force_scale(scene, state_force(scene, a), state_rate(scene, a)) / scene%mass
+      if (.not. have_acc_rounding) then
+        acc_rounding = 1.0e3_wp * eps_wp * force_scale(scene, state_force(scene, a), state_rate(scene, a)) / scene%mass
+        if (.not. polynomial_forcing) acc0 = mode%acceleration(state_force(scene, a))
+      end if
       have_acc_rounding = .true.
-      candidate = earliest_crossing(p, step, gap_tolerance_along(scene, k, a, c, acc_rounding))
+      q = gap_tolerance_along(scene, k, a, c, acc_rounding)
+      ! A motion that is not a cubic (a sine, springs, dampers) is only approximated by the
+      ! step's Hermite cubic: its curvature at the start differs from the true one, the gap
+      ! acceleration, by up to the interpolation error. A gap released at this instant with
+      ! a tiny acceleration away would dip below zero on the cubic alone (a spring-mass
+      ! leaving a wall as the sine force turns: located again and again at theta = 0).
+      ! The dips the cubic cannot resolve do not count; a real crossing still does, and
+      ! the step's end is checked on the integrator's own state (constraints_hold).
+      if (.not. polynomial_forcing) q(2) = q(2) + abs(p(2) - 0.5_wp * dot_product(scene%normal(:, k), acc0))
+      candidate = earliest_crossing(p, step, q)
       if (candidate < theta) then
         theta = candidate
         which = k

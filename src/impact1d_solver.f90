@@ -175,7 +175,7 @@ contains
       end if
       call rk%step(scene, mode, s, h, trial)
       if (.not. watch%watching) exit      ! nothing in this mode can end it: no location needed
-      call watch%locate(scene, mode, rk%constant_forcing, s, trial, h, h_event, watched)
+      call watch%locate(scene, mode, rk%constant_forcing, rk%polynomial_forcing, s, trial, h, h_event, watched)
       located = h_event <= h
       if (located) then
         h = h_event

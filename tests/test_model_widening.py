@@ -366,3 +366,18 @@ def test_vissim_method_runs_one_body_scenes():
     assert np.all((approx.x1 >= 0.0) & (approx.x1 <= 2.0))
     assert list(approx.events["kind"]) == list(exact.events["kind"])
     np.testing.assert_allclose(approx.events["t"], exact.events["t"], rtol=0, atol=5e-3)
+
+
+def test_spring_mass_released_from_a_wall_by_a_turning_sine_force_leaves_it():
+    """Resting on a wall, pressed by a sine force against its spring: when the force turns,
+    the contact is released with a rounding-level acceleration away. The step's Hermite
+    cubic (the motion is not a cubic with a spring and a damper) dipped 3e-21 m below the
+    wall, which was located again and again at the same instant (found by the
+    bifurcation study: 'more than 100000 events within one step')."""
+    scene = impact1d.Scene(m1=1.0, x1=0.0, x_left=-0.05, r_left=0.8, k1=40.0, x1_rest=0.0, c1=0.4,
+                           f1_amp=4.2142857142857135, f1_period=2.4, t_end=5.0, dt=1e-3, dt_out=0.01)
+    res = impact1d.simulate(scene)
+    releases = res.events[res.events["kind"] == "release_left"]
+    assert len(releases) >= 1 and releases["t"][0] == pytest.approx(4.6111215688, abs=1e-9)
+    assert res.x1[-1] > -0.05 and np.all(res.x1 >= -0.05)
+    assert res.energy_residual < 1e-8
