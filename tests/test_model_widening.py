@@ -381,3 +381,55 @@ def test_spring_mass_released_from_a_wall_by_a_turning_sine_force_leaves_it():
     assert len(releases) >= 1 and releases["t"][0] == pytest.approx(4.6111215688, abs=1e-9)
     assert res.x1[-1] > -0.05 and np.all(res.x1 >= -0.05)
     assert res.energy_residual < 1e-8
+
+
+def _random_spring_scene(rng):
+    """A random scene with springs, dampers, static friction, walls, a link, sine forcing."""
+    kw = dict(m1=float(rng.uniform(0.3, 3)), x1=0.0, v1=float(rng.uniform(-3, 3)), t_end=3.0, dt=1e-3,
+              dt_out=0.01)
+    if rng.random() < 0.6:
+        kw["mu1"] = float(rng.uniform(0, 0.5))
+        kw["mus1"] = kw["mu1"] + float(rng.uniform(0, 0.4))
+    if rng.random() < 0.7:
+        kw.update(k1=float(rng.uniform(0, 200)), x1_rest=float(rng.uniform(-1, 1)))
+    if rng.random() < 0.5:
+        kw["c1"] = float(rng.uniform(0, 5))
+    if rng.random() < 0.6:
+        kw.update(x_left=-float(rng.uniform(0, 1)), r_left=float(rng.choice([0, 0.5, 1])))
+    if rng.random() < 0.6:
+        kw.update(x_right=float(rng.uniform(1.5, 3)), r_right=float(rng.choice([0, 0.5, 1])))
+    if rng.random() < 0.5:
+        kw.update(f1_amp=float(rng.uniform(0, 30)), f1_period=float(rng.uniform(0.2, 3)))
+    if rng.random() < 0.7:
+        kw.update(m2=float(rng.uniform(0.3, 3)), x2=float(rng.uniform(0.0, 1.0)), v2=float(rng.uniform(-3, 3)),
+                  r_min=float(rng.choice([0, 0.5, 1])))
+        if rng.random() < 0.5:
+            kw["mu2"] = float(rng.uniform(0, 0.5))
+            kw["mus2"] = kw["mu2"] + float(rng.uniform(0, 0.4))
+        if rng.random() < 0.5:
+            kw.update(k12=float(rng.uniform(0, 300)), d_rest=float(rng.uniform(0, 1)),
+                      c12=float(rng.uniform(0, 3)))
+        if rng.random() < 0.5:
+            kw.update(d_max=kw["x2"] + float(rng.uniform(0, 0.5)), r_max=float(rng.choice([0, 0.5, 1])))
+    return impact1d.Scene(**kw)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_random_spring_scenes_keep_their_constraints_and_ledger(seed):
+    """Seeded random mechanisms (springs, dampers, static friction, walls, link, sine): at
+    dt = 1e-3 every run ends, no body crosses a wall or the other body, and the ledger
+    closes to the integrator's order (<= 1e-6 of the run's energy scale)."""
+    rng = np.random.default_rng([10, seed])
+    for n in range(25):
+        scene = _random_spring_scene(rng)
+        res = impact1d.simulate(scene)
+        x_left = -np.inf if scene.x_left is None else scene.x_left
+        x_right = np.inf if scene.x_right is None else scene.x_right
+        assert res.x1.min() >= x_left - 1e-12, (n, scene)
+        if res.x2 is not None:
+            assert res.x2.max() <= x_right + 1e-12 and np.all(res.x2 - res.x1 >= -1e-12), (n, scene)
+        else:
+            assert res.x1.max() <= x_right + 1e-12, (n, scene)
+        energy = res.ke + (res.pe if res.pe is not None else 0.0)
+        scale = max(1.0, float(energy.max()), abs(float(res.work[-1])))
+        assert res.energy_residual <= 1e-6 * scale, (n, res.energy_residual, scene)
