@@ -118,6 +118,23 @@ def test_cli_writes_the_table_and_the_plot_draws_it(case5, tmp_path):
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
+def test_cli_writes_parquet_with_the_same_rows(case5, tmp_path):
+    """-o NAME.parquet: the same table as CSV, column types kept (counts stay integers)."""
+    csv, parquet = tmp_path / "table.csv", tmp_path / "table.parquet"
+    for out in (csv, parquet):
+        done = subprocess.run([find_tool("impact1d-sweep"), str(INPUT / "case5.nml"),
+                               "--vary", "r_left=0:1:3", "--vary", "r_right=0.25,0.75", "-o", str(out)],
+                              capture_output=True, text=True, timeout=RUN_TIMEOUT)
+        assert done.returncode == 0, done.stderr
+    from_parquet = pd.read_parquet(parquet)
+    from_csv = pd.read_csv(csv, keep_default_na=False, na_values=[""])
+    assert list(from_parquet.columns) == list(from_csv.columns) == ["r_left", "r_right", *SUMMARY_COLUMNS, "error"]
+    assert str(from_parquet["n_impacts"].dtype) == "Int64"
+    for name in ("t_rest", "x1_end", "energy_residual"):
+        np.testing.assert_array_equal(from_parquet[name].to_numpy(float), from_csv[name].to_numpy(float))
+    assert parquet.read_bytes()[:4] == b"PAR1"
+
+
 def test_cli_bad_vary_is_one_line(tmp_path):
     done = subprocess.run([find_tool("impact1d-sweep"), str(INPUT / "case5.nml"),
                            "--vary", "r_left=0:1"], capture_output=True, text=True,
