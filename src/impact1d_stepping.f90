@@ -50,6 +50,9 @@ contains
     type(state_type), intent(in) :: a
     type(state_type), intent(inout) :: b
     real(wp) :: dx(2)
+    ! No force, no sliding friction (case 3 between impacts): nothing to book, and adding
+    ! zeros would change no bit.
+    if (all(scene%forcing%constant == 0.0_wp) .and. all(mode%f_slide == 0.0_wp)) return
     dx = (b%x - a%x) + (b%x_lo - a%x_lo)
     call add_compensated(b%work, b%work_lo, dot_product(scene%forcing%constant, dx))
     call add_compensated(b%friction_loss, b%friction_lo, -dot_product(mode%f_slide, dx))
