@@ -197,7 +197,8 @@ contains
       summary(:, j) = [stats%last_row([2, 3, 4, 5, 6]), &
         real(sum(stats%events(event_impact + 1:event_impact + n_contacts)), wp), &
         real(stats%events(event_impact + 1:event_impact + n_contacts), wp), &
-        sink%rest_time(stats%last_row), stats%last_row([i_impact_loss, i_friction_loss]), stats%max_residual, real(stats%steps, wp)]
+        sink%rest_time(stats%last_row), stats%last_row([i_impact_loss, i_friction_loss]), &
+        stats%max_residual, real(stats%steps, wp)]
       ! A one-body scene has no x2_end, v2_end.
       if (scene%n_bodies == 1) summary(3:4, j) = ieee_value(1.0_c_double, ieee_quiet_nan)
     end do

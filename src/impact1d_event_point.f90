@@ -15,7 +15,7 @@ module impact1d_event_point
   use impact1d_contacts, only: gap, gap_tolerance, snap, rigid_pair, u_tolerance
   use impact1d_stepping, only: rk4_type
   use impact1d_location, only: watch_type
-  use impact1d_loads, only: state_force, state_rate
+  use impact1d_loads, only: state_force, applied_rate
   use impact1d_event_log, only: event_log_type, log_event
   implicit none
   private
@@ -49,7 +49,7 @@ contains
     type(mode_type) :: new_mode
 
     f = state_force(scene, s)
-    df = state_rate(scene, s)
+    df = applied_rate(scene, s%t, s%v)
     do k = 1, n_contacts
       closed(k) = scene%has_contact(k)
       if (closed(k)) closed(k) = k == which .or. gap(scene, k, s) <= gap_tolerance(scene, k, s, 0.0_wp)
@@ -141,7 +141,7 @@ contains
     ! Dampers pull with the velocities the impacts left.
     if (scene%springs%has_damper) then
       f = state_force(scene, s)
-      df = state_rate(scene, s)
+      df = applied_rate(scene, s%t, s%v)
     end if
     call candidates(scene, mode, s, entry_scale, closed, candidate, resting, moving_sign)
     call solve_mode(scene, f, df, candidate, resting, moving_sign, new_mode, found, force_scale(scene, f, df))

@@ -7,7 +7,7 @@ module impact1d_loads
   use impact1d_state, only: state_type
   implicit none
   private
-  public :: applied_force, applied_rate, state_force, state_rate
+  public :: applied_force, applied_rate, state_force
 
 contains
 
@@ -37,12 +37,4 @@ contains
     real(wp) :: f(2)
     f = applied_force(scene, s%t, s%x, s%x_lo, s%v)
   end function state_force
-
-  !> Their rate in state s.
-  pure function state_rate(scene, s) result(df)
-    type(scene_type), intent(in) :: scene
-    type(state_type), intent(in) :: s
-    real(wp) :: df(2)
-    df = applied_rate(scene, s%t, s%v)
-  end function state_rate
 end module impact1d_loads

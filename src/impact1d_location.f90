@@ -11,7 +11,7 @@ module impact1d_location
   use impact1d_yardsticks, only: velocity_rounding, force_scale
   use impact1d_contacts, only: gap, gap_tolerance, gap_tolerance_along, displacement
   use impact1d_stepping, only: rk4_type, dense_output
-  use impact1d_loads, only: applied_force, state_force, state_rate
+  use impact1d_loads, only: applied_force, state_force, applied_rate
   implicit none
   private
   public :: watch_type, hold_crossing, refine, constraints_hold, first_negative
@@ -61,7 +61,8 @@ contains
       if (p(0) - step * (abs(p(1)) + step * (abs(p(2)) + step * abs(p(3)))) > 0.0_wp) cycle
       ! Only a gap that may close needs the forces' rounding (a sine costs two evaluations).
       if (.not. have_acc_rounding) then
-        acc_rounding = 1.0e3_wp * eps_wp * force_scale(scene, state_force(scene, a), state_rate(scene, a)) / scene%mass
+        acc_rounding = 1.0e3_wp * eps_wp * &
+          force_scale(scene, state_force(scene, a), applied_rate(scene, a%t, a%v)) / scene%mass
         if (.not. polynomial_forcing) acc0 = mode%acceleration(state_force(scene, a))
       end if
       have_acc_rounding = .true.
@@ -172,7 +173,8 @@ contains
   real(wp) function hold_tolerance(scene, a)
     type(scene_type), intent(in) :: scene
     type(state_type), intent(in) :: a
-    hold_tolerance = 1.0e3_wp * eps_wp * force_scale(scene, state_force(scene, a), state_rate(scene, a)) &
+    hold_tolerance = 1.0e3_wp * eps_wp * &
+      force_scale(scene, state_force(scene, a), applied_rate(scene, a%t, a%v)) &
       + tiny(1.0_wp)
   end function hold_tolerance
 

@@ -248,7 +248,8 @@ contains
     do k = 0, 3
       associate (i => merge(i_mu1, i_mus1, k < 2) + mod(k, 2))
         if (.not. input%given(i)) cycle
-        if (input%value(i) * input%value(i_m1 + mod(k, 2)) * abs(value_or(input, i_g, default_gravity)) > huge(1.0_wp)) then
+        if (input%value(i) * input%value(i_m1 + mod(k, 2)) * abs(value_or(input, i_g, default_gravity)) > &
+            huge(1.0_wp)) then
           call raise(error, status_input, trim(real_names(i)) // ' = ' // fmt(input%value(i)) // &
             ': the friction bound mu m g overflows')
           return
