@@ -433,3 +433,20 @@ def test_random_spring_scenes_keep_their_constraints_and_ledger(seed):
         energy = res.ke + (res.pe if res.pe is not None else 0.0)
         scale = max(1.0, float(energy.max()), abs(float(res.work[-1])))
         assert res.energy_residual <= 1e-6 * scale, (n, res.energy_residual, scene)
+
+
+def test_spring_pressing_a_mass_into_a_wall_rattles_to_rest_at_the_closed_form_time():
+    """The spring's rest position 0.2 m behind the wall: each impact (r = 0.5) shortens the
+    next arc, the impacts accumulate (closed form: tests/exact_springs.py sums the series)
+    and the mass rests on the wall from then on."""
+    m, k, x_rest, r = 1.0, 4.0, -0.2, 0.5
+    ref = xs.impact_oscillator(m, k, x_rest, 0.0, r, 0.3, 0.0, 5.0)
+    t_rest = float(ref.times("rest_left")[0])
+    res = impact1d.simulate(one_body(m1=m, x1=0.3, k1=k, x1_rest=x_rest, x_left=0.0, r_left=r,
+                                     t_end=5.0, dt=1e-3, dt_out=0.01))
+    rests = res.events[res.events["kind"] == "rest_left"]
+    assert len(rests) == 1 and abs(rests["t"][0] - t_rest) < 1e-8
+    first = [float(t) for t in ref.times("left")[:4]]
+    np.testing.assert_allclose(res.events[res.events["kind"] == "left"]["t"][:4], first, rtol=0, atol=1e-9)
+    after = res.t > t_rest
+    assert np.all(res.x1[after] == 0.0) and np.all(res.v1[after] == 0.0)
