@@ -183,7 +183,8 @@ contains
       if (new_mode%active(k) .and. .not. event_log%in_contact(k)) then
         call event_log%begin_rest(scene, k, s%t, s%t, s%v, sink, stats)
       else if (event_log%in_contact(k) .and. .not. new_mode%active(k)) then
-        if (.not. candidate(k) .or. dot_product(scene%normal(:, k), acc) > dot_product(abs(scene%normal(:, k)), tol_a) .or. &
+        if (.not. candidate(k) .or. &
+            dot_product(scene%normal(:, k), acc) > dot_product(abs(scene%normal(:, k)), tol_a) .or. &
             (dot_product(scene%normal(:, k), acc) >= -dot_product(abs(scene%normal(:, k)), tol_a) .and. &
             dot_product(scene%normal(:, k), matmul(new_mode%gain, df)) > 1.0e3_wp * eps_wp * sum(abs(df)) / &
             minval(scene%mass))) then
