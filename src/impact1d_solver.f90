@@ -252,32 +252,36 @@ contains
     ! Whole steps of dt ending at least a step short of the stop and the quiet time
     ! (capped where the count would not fit an integer: such a run never ends anyway).
     n_bulk = int(min(min((t_stop - s%t) - s%t_lo, t_quiet - s%t) / scene%dt, 1.0e18_wp), int64) - 1
-    h = scene%dt
-    dv = h * rk%constant_acceleration
-    half_dv = 0.5_wp * dv
-    t = s%t
-    t_lo = s%t_lo
-    x = s%x
-    x_lo = s%x_lo
-    v = s%v
-    v_lo = s%v_lo
-    do while (n_bulk > 0)
-      ! In runs of up to the next progress report.
-      n = min(n_bulk, 4096_int64 - iand(stats%steps, 4095_int64))
-      call constant_steps(n, h, dv, half_dv, t, t_lo, x, x_lo, v, v_lo)
-      n_bulk = n_bulk - n
-      stats%steps = stats%steps + n
-      if (iand(stats%steps, 4095_int64) == 0) call sink%progress(t, scene%t_end)
-    end do
-    call renormalise(t, t_lo)
-    call renormalise(x, x_lo)
-    call renormalise(v, v_lo)
-    s%t = t
-    s%t_lo = t_lo
-    s%x = x
-    s%x_lo = x_lo
-    s%v = v
-    s%v_lo = v_lo
+    ! (No bulk: a stop within two steps, as with a sample every step. The state is left as
+    ! it is: renormalising an already normalised sum changes no bit.)
+    if (n_bulk > 0) then
+      h = scene%dt
+      dv = h * rk%constant_acceleration
+      half_dv = 0.5_wp * dv
+      t = s%t
+      t_lo = s%t_lo
+      x = s%x
+      x_lo = s%x_lo
+      v = s%v
+      v_lo = s%v_lo
+      do while (n_bulk > 0)
+        ! In runs of up to the next progress report.
+        n = min(n_bulk, 4096_int64 - iand(stats%steps, 4095_int64))
+        call constant_steps(n, h, dv, half_dv, t, t_lo, x, x_lo, v, v_lo)
+        n_bulk = n_bulk - n
+        stats%steps = stats%steps + n
+        if (iand(stats%steps, 4095_int64) == 0) call sink%progress(t, scene%t_end)
+      end do
+      call renormalise(t, t_lo)
+      call renormalise(x, x_lo)
+      call renormalise(v, v_lo)
+      s%t = t
+      s%t_lo = t_lo
+      s%x = x
+      s%x_lo = x_lo
+      s%v = v
+      s%v_lo = v_lo
+    end if
     ! The last steps: to the stop by the step rule, while they stay quiet.
     do
       h = step_toward(scene, s, t_stop)
