@@ -302,7 +302,7 @@ def test_one_body_between_two_walls_follows_the_closed_form():
         assert a == pytest.approx(b, rel=1e-13, abs=1e-13)
     assert res.columns == ("t", "x1", "v1", "ke", "work", "friction_loss", "impact_loss", "residual")
     assert res.x2 is None and res.v2 is None
-    assert res.events.dtype.names == ("t", "kind", "v1_before", "v1_after")
+    assert res.events.dtype == impact1d.ONE_BODY_EVENT_DTYPE
     assert np.all((res.x1 >= 0.0) & (res.x1 <= 2.0))
     assert res.energy_residual < 1e-12
 
