@@ -142,7 +142,7 @@ def test_stick_slip_oscillator_follows_the_closed_form_limit_cycle(tmp_path):
     slips = [t for kind, t in got if kind == "slip1"]
     period = float(cycle["period"])
     assert slips[-1] - slips[-2] == pytest.approx(period, abs=1e-8)
-    assert res.energy_residual < 1e-5          # the ramp's work: order 4, not rounding
+    assert res.energy_residual < 1e-6          # the ramp's work: order 4 (4e-7 J measured), not rounding
 
 
 @pytest.mark.parametrize("c12", [0.0, 0.5, 4.0, 8.0])   # undamped, under, critical, over

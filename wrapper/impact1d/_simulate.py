@@ -156,10 +156,12 @@ def result_from_columns(samples: np.ndarray, events: np.ndarray, names=COLUMNS, 
     (in COLUMNS order; the optional ones may be missing)."""
     names = tuple(names)
     samples = np.asarray(samples, dtype=np.float64).reshape(-1, len(names))
-    # Column-major (as f2py returns it, a copy otherwise): each column is a contiguous row
-    # of the transpose, shared rather than copied.
-    columns = dict(zip(names, np.asfortranarray(samples).T))
-    columns.update({name: None for name in OPTIONAL_COLUMNS if name not in columns})
+    # Each column a contiguous view: as the core's column-major arrays already are (no
+    # copy), a copy of a row-major table (np.loadtxt) otherwise. Absent columns are None.
+    if samples.shape[0] > 1 and samples.strides[0] != samples.itemsize:
+        samples = np.asfortranarray(samples)
+    columns = dict(_ABSENT)
+    columns.update((name, samples[:, j]) for j, name in enumerate(names))
     return Result(**columns, events=events, **extra)
 
 
@@ -195,10 +197,6 @@ def simulate(scene: Scene, *, progress: bool = False, **overrides) -> Result:
     # Event-heavy scenes tend to come in series (sweeps): start the next one with room.
     _event_capacity = max(_EVENT_CAPACITY, min(n_events + n_events // 8, _EVENT_CAPACITY_MAX))
     names, one_body = _column_layout(has_column.tobytes())
-    # The present columns come first; each is a contiguous view of the core's column-major
-    # array (no copy). Absent ones are None.
-    columns = dict(_ABSENT)
-    columns.update((name, samples[:n_samples, j]) for j, name in enumerate(names))
     events = np.empty(n_events, dtype=ONE_BODY_EVENT_DTYPE if one_body else EVENT_DTYPE)
     if n_events > 0:
         kind = np.asarray(event_kind[:n_events])
@@ -208,5 +206,6 @@ def simulate(scene: Scene, *, progress: bool = False, **overrides) -> Result:
         events["v1_before"], events["v1_after"] = event_v[0, :n_events], event_v[2, :n_events]
         if not one_body:
             events["v2_before"], events["v2_after"] = event_v[1, :n_events], event_v[3, :n_events]
-    return Result(**columns, events=events, energy_residual=float(energy_residual),
-                  steps=int(steps), scene=scene)
+    # The present columns come first in the core's array.
+    return result_from_columns(samples[:n_samples, :len(names)], events, names,
+                               energy_residual=float(energy_residual), steps=int(steps), scene=scene)
