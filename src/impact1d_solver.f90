@@ -14,9 +14,10 @@ module impact1d_solver
   use impact1d_impacts, only: normal_velocity, kinetic_energy
   use impact1d_output, only: sink_type, run_stats, emit_sample
   use impact1d_vissim, only: run_vissim
-  use impact1d_state, only: state_type, renormalise, finite_state, constant_steps
+  use impact1d_state, only: state_type, renormalise, finite_state, constant_step, &
+    constant_steps
   use impact1d_contacts, only: gap, gap_tolerance, u_tolerance
-  use impact1d_stepping, only: rk4_type, book_constant_ledger
+  use impact1d_stepping, only: rk4_type, book_constant_ledger, books_ledger
   use impact1d_location, only: watch_type, refine, constraints_hold
   use impact1d_event_log, only: event_log_type
   use impact1d_event_point, only: event_point
@@ -25,6 +26,13 @@ module impact1d_solver
   public :: run, run_stats
 
   integer, parameter :: max_halvings = 60        !< retries of a step whose end violated a constraint
+
+  !> Where the run stops next: the next sample (its index and time), the next table corner
+  !> and the earliest pending accumulation time; a step goes no further than the first.
+  type :: stops_type
+    integer :: j_sample = 0
+    real(wp) :: sample_t = 0.0_wp, t_break = 0.0_wp, t_rest = huge(1.0_wp)
+  end type stops_type
 
 contains
 
@@ -41,9 +49,10 @@ contains
     type(rk4_type) :: rk
     type(watch_type) :: watch
     type(event_log_type) :: event_log
-    real(wp) :: ke0, pe0, t_stop, t_break, t_rest, sample_t, window_start
+    type(stops_type) :: stops
+    real(wp) :: ke0, pe0, t_stop, window_start
     logical :: located, at_stop, glided, event_due
-    integer :: j_sample, watched, window_events
+    integer :: watched, window_events
 
     if (scene%method == 'vissim') then
       call run_vissim(scene, sink, stats, error)
@@ -64,24 +73,23 @@ contains
 
     call event_point(scene, .true., 0, s, mode, event_log, watch, rk, sink, stats, error)
     if (allocated(error)) return
-    j_sample = 0
-    call emit(scene, s, ke0, pe0, j_sample, sink, stats, error)
+    call emit(scene, s, ke0, pe0, stops%j_sample, sink, stats, error)
     if (allocated(error)) return
 
-    t_break = scene%forcing%next_breakpoint(s%t)
-    do while (j_sample < scene%n_samples)
+    stops%t_break = scene%forcing%next_breakpoint(s%t)
+    do while (stops%j_sample < scene%n_samples)
       ! Step: to the next sample, table corner or accumulation time, whichever is first.
-      sample_t = sample_time(scene, j_sample)
-      if (t_break <= s%t) t_break = scene%forcing%next_breakpoint(s%t)
-      t_rest = minval(event_log%pending_rest)
-      t_stop = min(sample_t, t_break, t_rest)
+      stops%sample_t = sample_time(scene, stops%j_sample)
+      if (stops%t_break <= s%t) stops%t_break = scene%forcing%next_breakpoint(s%t)
+      stops%t_rest = minval(event_log%pending_rest)
 
       located = .false.
       glided = .false.
       if (rk%constant_forcing) then
-        call glide(scene, mode, rk, watch, t_stop, s, sink, stats, glided, error)
+        call glide(scene, mode, rk, watch, ke0, pe0, stops, s, sink, stats, glided, error)
         if (allocated(error)) return
       end if
+      t_stop = min(stops%sample_t, stops%t_break, stops%t_rest)
       at_stop = glided
       if (.not. at_stop) then
         ! Locate and re-step: one step toward the stop, cut at the earliest event in it.
@@ -92,7 +100,7 @@ contains
       ! Events, table corners (the force's slope changes) and accumulation times need an
       ! event point; a sample time does not.
       event_due = located
-      if (.not. event_due .and. at_stop) event_due = t_stop == t_break .or. t_stop == t_rest
+      if (.not. event_due .and. at_stop) event_due = t_stop == stops%t_break .or. t_stop == stops%t_rest
       ! A stop reached by quiet steps has no gap near closing.
       if (.not. event_due .and. at_stop .and. .not. glided) event_due = impact_due(scene, mode, s)
       if (event_due) then
@@ -118,8 +126,8 @@ contains
         if (allocated(error)) return
       end if
       ! Emit.
-      if (at_stop .and. s%t == sample_t) then
-        call emit(scene, s, ke0, pe0, j_sample, sink, stats, error)
+      if (at_stop .and. s%t == stops%sample_t) then
+        call emit(scene, s, ke0, pe0, stops%j_sample, sink, stats, error)
         if (allocated(error)) return
       end if
     end do
@@ -216,11 +224,26 @@ contains
     type(scene_type), intent(in) :: scene
     type(state_type), intent(in) :: s
     real(wp), intent(in) :: t_stop
-    real(wp) :: remaining
-    remaining = (t_stop - s%t) - s%t_lo
-    h = min(scene%dt, remaining)
-    if (remaining - h <= 1.0e-9_wp * scene%dt) h = remaining
+    h = step_length(scene%dt, (t_stop - s%t) - s%t_lo)
   end function step_toward
+
+  !> step_toward's rule on the time remaining to the stop.
+  pure real(wp) function step_length(dt, remaining) result(h)
+    real(wp), intent(in) :: dt, remaining
+    h = min(dt, remaining)
+    if (remaining - h <= 1.0e-9_wp * dt) h = remaining
+  end function step_length
+
+  !> A stop that is a sample and nothing else (no table corner, no accumulation time, not
+  !> the run's last sample, which run takes): glide takes its sample and goes on.
+  pure logical function quiet_sample(scene, stops, t_stop)
+    type(scene_type), intent(in) :: scene
+    type(stops_type), intent(in) :: stops
+    real(wp), intent(in) :: t_stop
+    quiet_sample = .true.
+    if (t_stop /= stops%sample_t .or. t_stop == stops%t_break .or. t_stop == stops%t_rest .or. &
+      stops%j_sample >= scene%n_samples - 1) quiet_sample = .false.
+  end function quiet_sample
 
   !> Under constant forces the steps that end before every watched gap's and sliding body's
   !> quiet time (watch%find_quiet_times) can meet no event: they need no location, and the
@@ -229,83 +252,170 @@ contains
   !> are compensated as in add_compensated but renormalised once at the end (the low parts
   !> carry the rounding meanwhile, and a position's increment reads its velocity's low
   !> part). The last steps before the stop follow step_toward, so the steps are those of the
-  !> located path.
-  subroutine glide(scene, mode, rk, watch, t_stop, s, sink, stats, at_stop, error)
+  !> located path. A sample stop that is neither a table corner nor an accumulation time
+  !> needs nothing but its sample: it is emitted here and the glide goes on to the next
+  !> stop (with a sample every step, going back through run's loop for each cost a third of
+  !> a run); the arithmetic is the same either way.
+  subroutine glide(scene, mode, rk, watch, ke0, pe0, stops, s, sink, stats, at_stop, error)
     type(scene_type), intent(in) :: scene
     type(mode_type), intent(in) :: mode
     type(rk4_type), intent(in) :: rk
     type(watch_type), intent(in) :: watch
-    real(wp), intent(in) :: t_stop
+    real(wp), intent(in) :: ke0, pe0
+    type(stops_type), intent(inout) :: stops
     type(state_type), intent(inout) :: s
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
-    logical, intent(out) :: at_stop      !< the steps reached t_stop
+    logical, intent(out) :: at_stop      !< the steps reached the stop (stops say which)
     type(error_type), allocatable, intent(inout) :: error
-    type(state_type) :: start
-    real(wp) :: t_quiet, h, t, t_lo, x(2), x_lo(2), v(2), v_lo(2), dv(2), half_dv(2)
+    real(wp) :: t_quiet, t_stop, h, t, t_lo, x(2), x_lo(2), v(2), v_lo(2), dv(2), half_dv(2)
+    real(wp) :: x_start(2), x_lo_start(2)
     integer(int64) :: n_bulk, n
 
-    at_stop = .false.
     t_quiet = minval(watch%quiet_until)
-    if (s%t + step_toward(scene, s, t_stop) >= t_quiet) return
-    start = s
-    ! Whole steps of dt ending at least a step short of the stop and the quiet time
-    ! (capped where the count would not fit an integer: such a run never ends anyway).
-    n_bulk = int(min(min((t_stop - s%t) - s%t_lo, t_quiet - s%t) / scene%dt, 1.0e18_wp), int64) - 1
-    ! (No bulk: a stop within two steps, as with a sample every step. The state is left as
-    ! it is: renormalising an already normalised sum changes no bit.)
-    if (n_bulk > 0) then
-      h = scene%dt
-      dv = h * rk%constant_acceleration
-      half_dv = 0.5_wp * dv
-      t = s%t
-      t_lo = s%t_lo
-      x = s%x
-      x_lo = s%x_lo
-      v = s%v
-      v_lo = s%v_lo
-      do while (n_bulk > 0)
-        ! In runs of up to the next progress report.
-        n = min(n_bulk, 4096_int64 - iand(stats%steps, 4095_int64))
-        call constant_steps(n, h, dv, half_dv, t, t_lo, x, x_lo, v, v_lo)
-        n_bulk = n_bulk - n
-        stats%steps = stats%steps + n
-        if (iand(stats%steps, 4095_int64) == 0) call sink%progress(t, scene%t_end)
-      end do
-      call renormalise(t, t_lo)
-      call renormalise(x, x_lo)
-      call renormalise(v, v_lo)
-      s%t = t
-      s%t_lo = t_lo
-      s%x = x
-      s%x_lo = x_lo
-      s%v = v
-      s%v_lo = v_lo
-    end if
-    ! The last steps: to the stop by the step rule, while they stay quiet.
+    ! Samples a step apart take a loop of their own.
+    call step_to_samples(scene, mode, rk, t_quiet, ke0, pe0, stops, s, sink, stats, error)
+    if (allocated(error)) return
     do
-      h = step_toward(scene, s, t_stop)
-      if (h <= 0.0_wp .or. s%t + h >= t_quiet) exit
-      at_stop = h == (t_stop - s%t) - s%t_lo
-      call rk%advance_constant(s, h)
+      at_stop = .false.
+      t_stop = min(stops%sample_t, stops%t_break, stops%t_rest)
+      if (s%t + step_toward(scene, s, t_stop) >= t_quiet) return
+      x_start = s%x
+      x_lo_start = s%x_lo
+      ! Whole steps of dt ending at least a step short of the stop and the quiet time
+      ! (capped where the count would not fit an integer: such a run never ends anyway).
+      ! No bulk for a stop within two steps, as with a sample every step (the state is left
+      ! as it is: renormalising an already normalised sum changes no bit); below 1.5 steps
+      ! the count is 0 without the division.
+      n_bulk = 0
+      if ((t_stop - s%t) - s%t_lo >= 1.5_wp * scene%dt) n_bulk = &
+        int(min(min((t_stop - s%t) - s%t_lo, t_quiet - s%t) / scene%dt, 1.0e18_wp), int64) - 1
+      if (n_bulk > 0) then
+        h = scene%dt
+        dv = h * rk%constant_acceleration
+        half_dv = 0.5_wp * dv
+        t = s%t
+        t_lo = s%t_lo
+        x = s%x
+        x_lo = s%x_lo
+        v = s%v
+        v_lo = s%v_lo
+        do while (n_bulk > 0)
+          ! In runs of up to the next progress report.
+          n = min(n_bulk, 4096_int64 - iand(stats%steps, 4095_int64))
+          call constant_steps(n, h, dv, half_dv, t, t_lo, x, x_lo, v, v_lo)
+          n_bulk = n_bulk - n
+          stats%steps = stats%steps + n
+          if (iand(stats%steps, 4095_int64) == 0) call sink%progress(t, scene%t_end)
+        end do
+        call renormalise(t, t_lo)
+        call renormalise(x, x_lo)
+        call renormalise(v, v_lo)
+        s%t = t
+        s%t_lo = t_lo
+        s%x = x
+        s%x_lo = x_lo
+        s%v = v
+        s%v_lo = v_lo
+      end if
+      ! The last steps: to the stop by the step rule, while they stay quiet.
+      do
+        h = step_toward(scene, s, t_stop)
+        if (h <= 0.0_wp .or. s%t + h >= t_quiet) exit
+        at_stop = h == (t_stop - s%t) - s%t_lo
+        call rk%advance_constant(s, h)
+        stats%steps = stats%steps + 1
+        if (iand(stats%steps, 4095_int64) == 0) call sink%progress(s%t, scene%t_end)
+        if (at_stop) then
+          s%t = t_stop
+          s%t_lo = 0.0_wp
+          exit
+        end if
+      end do
+      call book_constant_ledger(scene, mode, x_start, x_lo_start, s%x, s%x_lo, s)
+      call check_finite(s, error)
+      if (allocated(error)) return
+      if (.not. (at_stop .and. quiet_sample(scene, stops, t_stop))) return
+      call emit(scene, s, ke0, pe0, stops%j_sample, sink, stats, error)
+      if (allocated(error)) return
+      stops%sample_t = sample_time(scene, stops%j_sample)
+    end do
+  end subroutine glide
+
+  !> Quiet samples one step apart (dt_out = dt, as in the tutorial's scenes), each stop a
+  !> single step from the last: glide's per-stop set-up cost more than the step itself, so
+  !> they take this loop, with t, x and v in local variables and the state written back at
+  !> the end. The step (constant_step), the ledger and the sample are glide's: the same
+  !> bits. Scenes here have no springs (constant forces), so the sample has no potential
+  !> energy. Returns at the first stop that is not such a sample.
+  subroutine step_to_samples(scene, mode, rk, t_quiet, ke0, pe0, stops, s, sink, stats, error)
+    type(scene_type), intent(in) :: scene
+    type(mode_type), intent(in) :: mode
+    type(rk4_type), intent(in) :: rk
+    real(wp), intent(in) :: t_quiet, ke0, pe0
+    type(stops_type), intent(inout) :: stops
+    type(state_type), intent(inout) :: s
+    class(sink_type), intent(inout) :: sink
+    type(run_stats), intent(inout) :: stats
+    type(error_type), allocatable, intent(inout) :: error
+    real(wp) :: t_stop, remaining, h, a(2), t, t_lo, x(2), x_lo(2), v(2), v_lo(2)
+    logical :: books
+
+    a = rk%constant_acceleration
+    books = books_ledger(scene, mode)
+    t = s%t
+    t_lo = s%t_lo
+    x = s%x
+    x_lo = s%x_lo
+    v = s%v
+    v_lo = s%v_lo
+    do
+      t_stop = min(stops%sample_t, stops%t_break, stops%t_rest)
+      if (.not. quiet_sample(scene, stops, t_stop)) exit
+      remaining = (t_stop - t) - t_lo
+      h = step_length(scene%dt, remaining)
+      if (h /= remaining .or. h <= 0.0_wp .or. t + h >= t_quiet) exit
+      call constant_step(h, a, t, t_lo, x, x_lo, v, v_lo)
+      t = t_stop
+      t_lo = 0.0_wp
       stats%steps = stats%steps + 1
-      if (iand(stats%steps, 4095_int64) == 0) call sink%progress(s%t, scene%t_end)
-      if (at_stop) then
-        s%t = t_stop
-        s%t_lo = 0.0_wp
+      if (iand(stats%steps, 4095_int64) == 0) call sink%progress(t, scene%t_end)
+      if (books) then
+        ! (s%x: where the last step began.)
+        call book_constant_ledger(scene, mode, s%x, s%x_lo, x, x_lo, s)
+        s%x = x
+        s%x_lo = x_lo
+      end if
+      call emit_sample(sink, stats, t, x, v, scene%mass, ke0, s%work, s%friction_loss, s%impact_loss, &
+        .false., [0.0_wp, pe0, 0.0_wp], error)
+      if (allocated(error)) then
+        ! The sample's row is checked whole (checking the state first cost a fifth of this
+        ! loop); a state that is not finite is named as glide names it.
+        if (.not. finite_state(x, v, s%work)) call raise_not_finite(t, error)
         exit
       end if
+      stops%j_sample = stops%j_sample + 1
+      stops%sample_t = sample_time(scene, stops%j_sample)
     end do
-    call book_constant_ledger(scene, mode, start, s)
-    call check_finite(s, error)
-  end subroutine glide
+    s%t = t
+    s%t_lo = t_lo
+    s%x = x
+    s%x_lo = x_lo
+    s%v = v
+    s%v_lo = v_lo
+  end subroutine step_to_samples
 
   subroutine check_finite(s, error)
     type(state_type), intent(in) :: s
     type(error_type), allocatable, intent(inout) :: error
-    if (.not. finite_state(s)) call raise(error, status_simulation, 'at t = ' // fmt(s%t) // &
-      ': the state is no longer finite')
+    if (.not. finite_state(s%x, s%v, s%work)) call raise_not_finite(s%t, error)
   end subroutine check_finite
+
+  subroutine raise_not_finite(t, error)
+    real(wp), intent(in) :: t
+    type(error_type), allocatable, intent(inout) :: error
+    call raise(error, status_simulation, 'at t = ' // fmt(t) // ': the state is no longer finite')
+  end subroutine raise_not_finite
 
   !> A gap that closed exactly at a stop (its root at the step's very end) with the bodies
   !> still approaching: the impact belongs to this instant, so the sample shows its result.

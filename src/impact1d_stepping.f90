@@ -5,10 +5,10 @@ module impact1d_stepping
   use impact1d_scene, only: scene_type
   use impact1d_modes, only: mode_type
   use impact1d_events, only: hermite
-  use impact1d_state, only: state_type, add_compensated
+  use impact1d_state, only: state_type, add_compensated, constant_step
   implicit none
   private
-  public :: rk4_type, book_constant_ledger, dense_output
+  public :: rk4_type, book_constant_ledger, books_ledger, dense_output
 
   !> What the integrator keeps between steps.
   type :: rk4_type
@@ -36,27 +36,32 @@ contains
     class(rk4_type), intent(in) :: self
     type(state_type), intent(inout) :: state
     real(wp), intent(in) :: step
-    call add_compensated(state%t, state%t_lo, step)
-    call add_compensated(state%x, state%x_lo, step * ((state%v + state%v_lo) + &
-      (0.5_wp * step) * self%constant_acceleration))
-    call add_compensated(state%v, state%v_lo, step * self%constant_acceleration)
+    call constant_step(step, self%constant_acceleration, state%t, state%t_lo, state%x, state%x_lo, &
+      state%v, state%v_lo)
   end subroutine advance_constant
 
   !> Under constant forces the work and the friction loss over any stretch of one mode are
-  !> the forces times the displacement, exactly (no quadrature).
-  pure subroutine book_constant_ledger(scene, mode, a, b)
+  !> the forces times the displacement, exactly (no quadrature): from x_a to x_b, into s.
+  pure subroutine book_constant_ledger(scene, mode, x_a, x_lo_a, x_b, x_lo_b, s)
     type(scene_type), intent(in) :: scene
     type(mode_type), intent(in) :: mode
-    type(state_type), intent(in) :: a
-    type(state_type), intent(inout) :: b
+    real(wp), intent(in) :: x_a(2), x_lo_a(2), x_b(2), x_lo_b(2)
+    type(state_type), intent(inout) :: s
     real(wp) :: dx(2)
-    ! No force, no sliding friction (case 3 between impacts): nothing to book, and adding
-    ! zeros would change no bit.
-    if (all(scene%forcing%constant == 0.0_wp) .and. all(mode%f_slide == 0.0_wp)) return
-    dx = (b%x - a%x) + (b%x_lo - a%x_lo)
-    call add_compensated(b%work, b%work_lo, dot_product(scene%forcing%constant, dx))
-    call add_compensated(b%friction_loss, b%friction_lo, -dot_product(mode%f_slide, dx))
+    if (.not. books_ledger(scene, mode)) return
+    dx = (x_b - x_a) + (x_lo_b - x_lo_a)
+    call add_compensated(s%work, s%work_lo, dot_product(scene%forcing%constant, dx))
+    call add_compensated(s%friction_loss, s%friction_lo, -dot_product(mode%f_slide, dx))
   end subroutine book_constant_ledger
+
+  !> Whether a stretch of this mode under constant forces has work or friction to book: not
+  !> without a force and a sliding body (case 3 between impacts: adding zeros would change
+  !> no bit).
+  pure logical function books_ledger(scene, mode)
+    type(scene_type), intent(in) :: scene
+    type(mode_type), intent(in) :: mode
+    books_ledger = any(scene%forcing%constant /= 0.0_wp) .or. any(mode%f_slide /= 0.0_wp)
+  end function books_ledger
 
   !> One classical RK4 step of the mode's equations from a to b; the energy ledger by
   !> Simpson's rule on the step's Hermite velocity, exact where RK4 is (polynomial forcing).
@@ -77,7 +82,7 @@ contains
     if (self%constant_forcing) then
       ! The mode's acceleration was worked out once, at the event point.
       call self%advance_constant(b, step)
-      call book_constant_ledger(scene, mode, a, b)
+      call book_constant_ledger(scene, mode, a%x, a%x_lo, b%x, b%x_lo, b)
       return
     end if
     ! A step's end force is the next step's start force: evaluated once (a sine costs).
