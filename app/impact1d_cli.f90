@@ -142,7 +142,7 @@ program impact1d_cli
 
   if (.not. out_given) out_path = 'output/' // stem(scene_path) // '.dat'
   call refuse_to_overwrite_inputs(out_path)
-  call refuse_to_overwrite_inputs(events_path(out_path))
+  call refuse_to_overwrite_inputs(trim(events_path(out_path)))
   call make_parent_folders(out_path)
   ! Held from creating the temporary files until they are registered: a signal in between
   ! would otherwise leave them behind.
@@ -152,7 +152,7 @@ program impact1d_cli
     call release_signals()
     call fail(error%status, error%message)
   end if
-  call guard_temporaries(out_path // '.part' // c_null_char, events_path(out_path) // '.part' // c_null_char)
+  call guard_temporaries(out_path // '.part' // c_null_char, trim(events_path(out_path)) // '.part' // c_null_char)
   call allow_signals()
   ! Progress only where a person watches: stderr a terminal (file descriptor 2).
   sink%show_progress = c_isatty(2_c_int) == 1
@@ -170,12 +170,13 @@ contains
     character(len=:), allocatable :: line
     write(output_unit, '(a)') 'impact1d: ' // trim(input%text(i_title))
     write(output_unit, '(a)') '  scene     ' // scene_path // ' (method ' // scene%method // ', dt = ' // &
-      fmt(scene%dt) // ' s, t_end = ' // fmt(scene%t_end) // ' s)'
-    write(output_unit, '(a)') '  output    ' // out_path // ' (' // fmt(scene%n_samples) // ' rows every ' // &
-      fmt(scene%dt_out) // ' s) and ' // events_path(out_path) // ' (' // fmt(sum(stats%events)) // ' events)'
+      trim(fmt(scene%dt)) // ' s, t_end = ' // trim(fmt(scene%t_end)) // ' s)'
+    write(output_unit, '(a)') '  output    ' // out_path // ' (' // trim(fmt(scene%n_samples)) // ' rows every ' // &
+      trim(fmt(scene%dt_out)) // ' s) and ' // trim(events_path(out_path)) // ' (' // &
+      trim(fmt(sum(stats%events))) // ' events)'
     line = ''
     do k = 1, n_event_kinds
-      if (stats%events(k) > 0) line = line // ' ' // trim(event_names(k)) // ' ' // fmt(stats%events(k))
+      if (stats%events(k) > 0) line = line // ' ' // trim(event_names(k)) // ' ' // trim(fmt(stats%events(k)))
     end do
     if (len(line) == 0) line = ' none'
     write(output_unit, '(a)') '  events   ' // line
@@ -197,7 +198,7 @@ contains
     if (scene%springs%has_damper) write(output_unit, '(a, es12.5)', advance='no') '  damping loss =', &
       stats%last_row(i_damping_loss)
     write(output_unit, '(a, es9.2, a)') '  |residual| <=', stats%max_residual, ' J'
-    write(output_unit, '(a)') '  steps     ' // fmt(stats%steps) // ' RK4 steps'
+    write(output_unit, '(a)') '  steps     ' // trim(fmt(stats%steps)) // ' RK4 steps'
   end subroutine summary
 
   !> Command-line argument i, whatever its length.

@@ -224,16 +224,18 @@ contains
     input%text(i_method) = method
   end function flat_input
 
-  !> Words separated by single spaces (how names cross to Python).
-  pure function joined(words) result(text)
+  !> Words separated by single spaces (how names cross to Python), as long as the flat
+  !> API's names (no function returns a deferred-length string: see impact1d_error's fmt).
+  pure function joined(words) result(out)
     character(len=*), intent(in) :: words(:)
+    character(len=1024) :: out
     character(len=:), allocatable :: text
     integer :: k
     text = ''
     do k = 1, size(words)
       text = text // ' ' // trim(words(k))
     end do
-    text = adjustl(text)
+    out = adjustl(text)
   end function joined
 
   logical function field_count_ok(n, status, message)

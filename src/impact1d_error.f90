@@ -5,7 +5,7 @@ module impact1d_error
   use impact1d_kinds, only: wp
   implicit none
   private
-  public :: error_type, raise, status_ok, status_input, status_simulation, fmt
+  public :: error_type, raise, status_ok, status_input, status_simulation, fmt, fmt_width
 
   integer, parameter :: status_ok = 0          !< no error
   integer, parameter :: status_input = 1       !< the scene or its files are wrong: Python's InputError
@@ -17,7 +17,12 @@ module impact1d_error
     character(len=:), allocatable :: message
   end type error_type
 
-  !> Shortest text of a number for messages (g0 keeps every digit the user wrote).
+  !> Shortest text of a number for messages (g0 keeps every digit the user wrote), blank
+  !> padded to fmt_width: callers write trim(fmt(x)). No function here returns a string of
+  !> deferred length: gfortran 12 keeps such a result's length in a static variable of the
+  !> caller, which threads building messages at once overwrite (measured: 6 messages in
+  !> 20000 came out corrupted with two threads).
+  integer, parameter :: fmt_width = 32
   interface fmt
     module procedure fmt_real, fmt_int, fmt_int64
   end interface fmt
@@ -39,14 +44,14 @@ contains
     if (allocated(error)) deallocate(error)
     allocate(error)
     error%status = status
-    error%message = printable(message)
+    call escape_controls(message, error%message)
   end subroutine raise
 
   !> Control bytes (from a file quoted in a message) as \xNN: a message is one line that
   !> cannot move the terminal's cursor or ring its bell. UTF-8 text passes unchanged.
-  pure function printable(text) result(shown)
+  pure subroutine escape_controls(text, shown)
     character(len=*), intent(in) :: text
-    character(len=:), allocatable :: shown
+    character(len=:), allocatable, intent(out) :: shown
     character(len=*), parameter :: hex = '0123456789abcdef'
     integer :: j, code
     shown = text
@@ -60,20 +65,21 @@ contains
         shown = shown // text(j:j)
       end if
     end do
-  end function printable
+  end subroutine escape_controls
 
   !> Shortest decimal that reads back as x (1 to 17 digits), in plain notation for
   !> moderate magnitudes: 0.001, 2.5, 1e-12, 6.02e+23.
-  pure function fmt_real(x) result(text)
+  pure function fmt_real(x) result(out)
     real(wp), intent(in) :: x
+    character(len=fmt_width) :: out
     character(len=:), allocatable :: text
     character(len=40) :: buffer
     character(len=12) :: form
     real(wp) :: back
-    integer :: digits, ios, e
+    integer :: digits, ios, e, exponent_value
     if (x /= x .or. abs(x) > huge(x)) then
-      write(buffer, '(g0)') x
-      text = trim(adjustl(buffer))
+      write(out, '(g0)') x
+      out = adjustl(out)
       return
     end if
     do digits = 1, 17
@@ -95,47 +101,33 @@ contains
       if (text(1:1) == '.') text = '0' // text
       if (text(1:2) == '-.') text = '-0' // text(2:)
     else
+      ! 1.0E-012 -> 1e-12: the mantissa without trailing zeros (nor a bare point), the
+      ! exponent as a plain integer.
       text = trim(adjustl(buffer))
       e = index(text, 'E')
-      ! 1.0E-012 -> 1e-12
-      text = strip_mantissa(text(:e - 1)) // 'e' // exponent_text(text(e + 1:))
+      read(text(e + 1:), *, iostat=ios) exponent_value
+      text = text(:e - 1)
+      if (index(text, '.') > 0) then
+        do while (text(len(text):len(text)) == '0')
+          text = text(:len(text) - 1)
+        end do
+        if (text(len(text):len(text)) == '.') text = text(:len(text) - 1)
+      end if
+      write(buffer, '(i0)') exponent_value
+      text = text // 'e' // trim(buffer)
     end if
+    out = text
   end function fmt_real
 
-  pure function strip_mantissa(m) result(out)
-    character(len=*), intent(in) :: m
-    character(len=:), allocatable :: out
-    out = m
-    if (index(out, '.') == 0) return
-    do while (out(len(out):len(out)) == '0')
-      out = out(:len(out) - 1)
-    end do
-    if (out(len(out):len(out)) == '.') out = out(:len(out) - 1)
-  end function strip_mantissa
-
-  pure function exponent_text(e) result(out)
-    character(len=*), intent(in) :: e
-    character(len=:), allocatable :: out
-    integer :: value, ios
-    character(len=8) :: buffer
-    read(e, *, iostat=ios) value
-    write(buffer, '(i0)') value
-    out = trim(buffer)
-  end function exponent_text
-
-  pure function fmt_int64(i) result(text)
+  pure function fmt_int64(i) result(out)
     integer(int64), intent(in) :: i
-    character(len=:), allocatable :: text
-    character(len=24) :: buffer
-    write(buffer, '(i0)') i
-    text = trim(buffer)
+    character(len=fmt_width) :: out
+    write(out, '(i0)') i
   end function fmt_int64
 
-  pure function fmt_int(i) result(text)
+  pure function fmt_int(i) result(out)
     integer, intent(in) :: i
-    character(len=:), allocatable :: text
-    character(len=24) :: buffer
-    write(buffer, '(i0)') i
-    text = trim(buffer)
+    character(len=fmt_width) :: out
+    write(out, '(i0)') i
   end function fmt_int
 end module impact1d_error

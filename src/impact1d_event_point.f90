@@ -99,8 +99,8 @@ contains
       if (k == 0) exit
       n_impulses = n_impulses + 1
       if (n_impulses > scene%max_impulses) then
-        call raise(error, status_simulation, 'at t = ' // fmt(s%t) // ': the impacts did not settle after ' &
-          // fmt(scene%max_impulses) // ' impulses (&run max_impulses)')
+        call raise(error, status_simulation, 'at t = ' // trim(fmt(s%t)) // ': the impacts did not settle after ' &
+          // trim(fmt(scene%max_impulses)) // ' impulses (&run max_impulses)')
         return
       end if
       v_before = s%v
@@ -146,7 +146,7 @@ contains
     call candidates(scene, mode, s, entry_scale, closed, candidate, resting, moving_sign)
     call solve_mode(scene, f, df, candidate, resting, moving_sign, new_mode, found, force_scale(scene, f, df))
     if (.not. found) then
-      call raise(error, status_simulation, 'at t = ' // fmt(s%t) // &
+      call raise(error, status_simulation, 'at t = ' // trim(fmt(s%t)) // &
         ': no consistent contact and friction state (complementarity problem has no solution)')
       return
     end if

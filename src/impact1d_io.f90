@@ -69,7 +69,7 @@ contains
       if (len_trim(input%text(i_f1_table + i - 1)) == 0) cycle
       call read_table(trim(input%text(i_f1_table + i - 1)), tables(i), error)
       if (allocated(error)) then
-        error%message = 'f' // fmt(i) // '_table: ' // error%message
+        error%message = 'f' // trim(fmt(i)) // '_table: ' // error%message
         return
       end if
     end do
@@ -98,7 +98,7 @@ contains
     character(len=512) :: message
     real(wp) :: values(n_real), values_other(n_real)
     character(len=1024) :: texts(4), texts_other(4)
-    character(len=:), allocatable :: lines(:)
+    character(len=:), allocatable :: lines(:), reason
 
     call scan_groups(path, present, error)
     if (allocated(error)) return
@@ -170,8 +170,8 @@ contains
         case ('run'); read(lines, nml=run, iostat=ios, iomsg=message)
         end select
         if (ios /= 0) then
-          call raise(error, status_input, path // ': in &' // trim(known_groups(j)) // ': ' // &
-            plain_reason(trim(message), j))
+          call plain_reason(trim(message), j, reason)
+          call raise(error, status_input, path // ': in &' // trim(known_groups(j)) // ': ' // reason)
           return
         end if
       end do
@@ -210,10 +210,10 @@ contains
   end subroutine read_all_lines
 
   !> The namelist reader's message in plain words: a misspelt variable gets the group's names.
-  function plain_reason(message, group) result(text)
+  subroutine plain_reason(message, group, text)
     character(len=*), intent(in) :: message
     integer, intent(in) :: group
-    character(len=:), allocatable :: text
+    character(len=:), allocatable, intent(out) :: text
     character(len=*), parameter :: unmatched = 'Cannot match namelist object name '
     integer :: at
     text = message
@@ -221,7 +221,7 @@ contains
     if (at == 0) return
     text = 'unknown variable ''' // trim(message(at + len(unmatched):)) // ''' (&' // &
       trim(known_groups(group)) // ' has: ' // trim(group_variables(group)) // ')'
-  end function plain_reason
+  end subroutine plain_reason
 
   !> Which groups the file has, and the syntax the namelist reader would pass over in silence:
   !> a misspelt group (&wall), a group given twice, text outside any group, a group without
@@ -271,7 +271,7 @@ contains
             open_group = 0
           else if (open_group > 0) then
             call fail('the group &' // trim(known_groups(open_group)) // ' (line ' // &
-              fmt(group_line(open_group)) // ') has no closing ''/'' before &' // name)
+              trim(fmt(group_line(open_group))) // ') has no closing ''/'' before &' // name)
             return
           else
             group = 0
@@ -283,8 +283,8 @@ contains
               return
             end if
             if (present(group)) then
-              call fail('the group &' // name // ' is given twice (lines ' // fmt(group_line(group)) // &
-                ' and ' // fmt(line_number) // ')')
+              call fail('the group &' // name // ' is given twice (lines ' // trim(fmt(group_line(group))) // &
+                ' and ' // trim(fmt(line_number)) // ')')
               return
             end if
             present(group) = .true.
@@ -320,7 +320,7 @@ contains
     end do
     close(unit)
     if (open_group > 0) then
-      call raise(error, status_input, path // ':' // fmt(group_line(open_group)) // ': the group &' // &
+      call raise(error, status_input, path // ':' // trim(fmt(group_line(open_group))) // ': the group &' // &
         trim(known_groups(open_group)) // ' has no closing ''/'' (every group ends with /)')
     else if (.not. any_content) then
       call raise(error, status_input, path // ': the file is empty')
@@ -331,7 +331,7 @@ contains
     subroutine fail(what)
       character(len=*), intent(in) :: what
       close(unit)
-      call raise(error, status_input, path // ':' // fmt(line_number) // ': ' // what)
+      call raise(error, status_input, path // ':' // trim(fmt(line_number)) // ': ' // what)
     end subroutine fail
   end subroutine scan_groups
 
@@ -367,7 +367,7 @@ contains
         if (ios == 0) read(line, *, iostat=extra) value, surplus
         if (ios /= 0 .or. extra == 0) then
           close(unit)
-          call raise(error, status_input, path // ':' // fmt(line_number) // ': ''' // trim(adjustl(line)) // &
+          call raise(error, status_input, path // ':' // trim(fmt(line_number)) // ': ''' // trim(adjustl(line)) // &
             ''' is not one number (expected ' // trim(real_names(dat_order(n_read))) // ')')
           return
         end if
@@ -377,7 +377,7 @@ contains
         input%text(i_f1_table) = beside(path, trim(adjustl(line)))
       else
         close(unit)
-        call raise(error, status_input, path // ':' // fmt(line_number) // &
+        call raise(error, status_input, path // ':' // trim(fmt(line_number)) // &
           ': more entries than the 17 numbers and an f1 table file')
         return
       end if
@@ -387,7 +387,7 @@ contains
       if (n_read == 0) then
         call raise(error, status_input, path // ': the file is empty')
       else
-        call raise(error, status_input, path // ': ' // fmt(n_read) // ' numbers, 17 expected; ' // &
+        call raise(error, status_input, path // ': ' // trim(fmt(n_read)) // ' numbers, 17 expected; ' // &
           trim(real_names(dat_order(n_read + 1))) // ' and after are missing')
       end if
       return
@@ -431,7 +431,7 @@ contains
       end if
       if (n > 0) then
         if (row(1) <= t(n)) then
-          call fail(': time ' // fmt(row(1)) // ' does not increase (after ' // fmt(t(n)) // ')')
+          call fail(': time ' // trim(fmt(row(1))) // ' does not increase (after ' // trim(fmt(t(n))) // ')')
           return
         end if
       end if
@@ -454,7 +454,7 @@ contains
     subroutine fail(what)
       character(len=*), intent(in) :: what
       close(unit)
-      call raise(error, status_input, path // ':' // fmt(line_number) // what)
+      call raise(error, status_input, path // ':' // trim(fmt(line_number)) // what)
     end subroutine fail
   end subroutine read_table
 
@@ -515,22 +515,21 @@ contains
   end subroutine next_data_line
 
   !> A path written in a scene file is relative to that file's folder.
-  function beside(scene_path, path) result(resolved)
+  pure function beside(scene_path, path) result(resolved)
     character(len=*), intent(in) :: scene_path, path
-    character(len=:), allocatable :: resolved
+    character(len=len(scene_path) + len(path)) :: resolved    ! blank padded
     integer :: slash
-    resolved = trim(path)
-    if (len(resolved) == 0) return
-    if (resolved(1:1) == '/') return
+    resolved = path
+    if (len_trim(path) == 0 .or. path(1:1) == '/') return
     slash = index(scene_path, '/', back=.true.)
-    if (slash > 0) resolved = scene_path(:slash) // resolved
+    if (slash > 0) resolved = scene_path(:slash) // path
   end function beside
 
-  function given_text(text) result(given)
+  pure function given_text(text) result(given)
     character(len=*), intent(in) :: text
-    character(len=:), allocatable :: given
+    character(len=len(text)) :: given    ! blank padded
     given = ''
-    if (text /= absent_text) given = trim(text)
+    if (text /= absent_text) given = text
   end function given_text
 
   !> text in lower case (ASCII letters only): group and method names are case-insensitive.

@@ -188,8 +188,8 @@ contains
         row(n_columns) = ke - ke0 - work + friction_loss + impact_loss
       end if
       if (.not. all(abs(row) <= huge(1.0_wp))) then
-        call raise(error, status_simulation, 'at t = ' // fmt(t) // ': the kinetic energy or the ' // &
-          'energy ledger is no longer finite (KE = ' // fmt(ke) // ', KE0 = ' // fmt(ke0) // ' J)')
+        call raise(error, status_simulation, 'at t = ' // trim(fmt(t)) // ': the kinetic energy or the ' // &
+          'energy ledger is no longer finite (KE = ' // trim(fmt(ke)) // ', KE0 = ' // trim(fmt(ke0)) // ' J)')
         return
       end if
       stats%max_residual = max(stats%max_residual, abs(row(n_columns)))
@@ -213,15 +213,15 @@ contains
   end function present_columns
 
   !> The names of the given columns, each after a space.
-  function names_of(columns) result(text)
+  subroutine names_of(columns, text)
     integer, intent(in) :: columns(:)
-    character(len=:), allocatable :: text
+    character(len=:), allocatable, intent(out) :: text
     integer :: k
     text = ''
     do k = 1, size(columns)
       text = text // ' ' // trim(column_words(columns(k)))
     end do
-  end function names_of
+  end subroutine names_of
 
   !> Called by the stepping loop every few thousand steps: cheap unless a line is due.
   subroutine progress(self, t, t_end)
@@ -241,7 +241,7 @@ contains
     write(percent, '(i3, a)') int(100.0_wp * t / t_end), '%'
     write(now, '(f16.2)') t
     write(error_unit, '(a)', advance='no') achar(13) // 'impact1d: ' // trim(adjustl(percent)) // &
-      ' (t = ' // trim(adjustl(now)) // ' of ' // fmt(t_end) // ' s)   '
+      ' (t = ' // trim(adjustl(now)) // ' of ' // trim(fmt(t_end)) // ' s)   '
     flush(error_unit)
     self%progress_shown = .true.
   end subroutine progress
@@ -344,10 +344,11 @@ contains
     type(error_type), allocatable, intent(out) :: error
     integer :: ios, k
     character(len=512) :: message
+    character(len=:), allocatable :: header
     logical :: folder
 
     self%path = path
-    self%event_path = events_path(path)
+    self%event_path = trim(events_path(path))
     folder = is_folder(path)
     if (path(len(path):) == '/' .or. folder) then
       call raise(error, status_input, 'cannot write output ' // path // ': it is a folder (give a file name)')
@@ -356,14 +357,14 @@ contains
     open(newunit=self%unit, file=self%path // '.part', status='replace', action='write', &
       iostat=ios, iomsg=message)
     if (ios /= 0) then
-      call raise(error, status_input, 'cannot write output ' // path // ': ' // reason(message))
+      call raise(error, status_input, 'cannot write output ' // path // ': ' // trim(reason(message)))
       return
     end if
     open(newunit=self%event_unit, file=self%event_path // '.part', status='replace', action='write', &
       iostat=ios, iomsg=message)
     if (ios /= 0) then
       close(self%unit, status='delete')
-      call raise(error, status_input, 'cannot write output ' // self%event_path // ': ' // reason(message))
+      call raise(error, status_input, 'cannot write output ' // self%event_path // ': ' // trim(reason(message)))
       return
     end if
     self%is_open = .true.
@@ -382,14 +383,15 @@ contains
     end if
     do k = 1, n_real
       if (input%given(k)) then
-        call self%put_line(self%unit, '# ' // trim(real_names(k)) // ' = ' // fmt(input%value(k)))
+        call self%put_line(self%unit, '# ' // trim(real_names(k)) // ' = ' // trim(fmt(input%value(k))))
       else if (k == i_g) then
-        call self%put_line(self%unit, '# g = ' // fmt(default_gravity))
+        call self%put_line(self%unit, '# g = ' // trim(fmt(default_gravity)))
       else if (k == i_dt_out) then
-        call self%put_line(self%unit, '# dt_out = ' // fmt(input%value(i_dt)))
+        call self%put_line(self%unit, '# dt_out = ' // trim(fmt(input%value(i_dt))))
       end if
     end do
-    call self%put_line(self%unit, '#' // names_of(self%columns))
+    call names_of(self%columns, header)
+    call self%put_line(self%unit, '#' // header)
     call self%put_line(self%event_unit, '# impact1d events')
     if (self%n_bodies == 2) then
       call self%put_line(self%event_unit, '# t kind v1_before v2_before v1_after v2_after')
@@ -405,7 +407,7 @@ contains
     character(len=512) :: message
     if (allocated(self%write_failure)) return
     write(self%unit, row_format, iostat=ios, iomsg=message) row(self%columns)
-    if (ios /= 0) self%write_failure = self%path // ': ' // reason(message)
+    if (ios /= 0) self%write_failure = self%path // ': ' // trim(reason(message))
     self%bytes(1) = self%bytes(1) + self%sample_bytes
   end subroutine file_put_sample
 
@@ -421,7 +423,7 @@ contains
     else
       write(self%event_unit, event_format, iostat=ios, iomsg=message) t, event_names(kind), v_before(1), v_after(1)
     end if
-    if (ios /= 0) self%write_failure = self%event_path // ': ' // reason(message)
+    if (ios /= 0) self%write_failure = self%event_path // ': ' // trim(reason(message))
     self%bytes(2) = self%bytes(2) + self%event_bytes
   end subroutine file_put_event
 
@@ -434,8 +436,8 @@ contains
     character(len=512) :: message
     if (allocated(self%write_failure)) return
     write(unit, '(a)', iostat=ios, iomsg=message) text
-    if (ios /= 0 .and. unit == self%unit) self%write_failure = self%path // ': ' // reason(message)
-    if (ios /= 0 .and. unit /= self%unit) self%write_failure = self%event_path // ': ' // reason(message)
+    if (ios /= 0 .and. unit == self%unit) self%write_failure = self%path // ': ' // trim(reason(message))
+    if (ios /= 0 .and. unit /= self%unit) self%write_failure = self%event_path // ': ' // trim(reason(message))
     if (unit == self%unit) self%bytes(1) = self%bytes(1) + len(text) + 1
     if (unit /= self%unit) self%bytes(2) = self%bytes(2) + len(text) + 1
   end subroutine put_line
@@ -479,19 +481,19 @@ contains
     character(len=512) :: message
     if (.not. allocated(self%write_failure)) then
       flush(unit, iostat=ios, iomsg=message)
-      if (ios /= 0) self%write_failure = path // ': ' // reason(message)
+      if (ios /= 0) self%write_failure = path // ': ' // trim(reason(message))
     end if
     if (allocated(self%write_failure)) then
       close(unit, iostat=ios)
       return
     end if
     close(unit, iostat=ios, iomsg=message)
-    if (ios /= 0) self%write_failure = path // ': ' // reason(message)
+    if (ios /= 0) self%write_failure = path // ': ' // trim(reason(message))
     if (allocated(self%write_failure)) return
     written = self%bytes(merge(1, 2, unit == self%unit))
     inquire(file=path // '.part', size=on_disk)
-    if (on_disk /= written) self%write_failure = path // ': only ' // fmt(on_disk) // ' of ' // &
-      fmt(written) // ' bytes reached the disk (is it full?)'
+    if (on_disk /= written) self%write_failure = path // ': only ' // trim(fmt(on_disk)) // ' of ' // &
+      trim(fmt(written)) // ' bytes reached the disk (is it full?)'
   end subroutine finish_file
 
   !> Length in bytes (with its newline) of a line written with a fixed-width format.
@@ -568,7 +570,7 @@ contains
   !> (res.dat, res.txt and res all give res.events.dat).
   pure function events_path(path) result(events)
     character(len=*), intent(in) :: path
-    character(len=:), allocatable :: events
+    character(len=len(path) + 11) :: events     ! blank padded: callers trim
     integer :: slash, dot, name_start
     slash = index(path, '/', back=.true.)
     dot = index(path(slash + 1:), '.', back=.true.)
@@ -585,11 +587,11 @@ contains
   !> the temporary name, which means nothing to the user.
   pure function reason(message) result(text)
     character(len=*), intent(in) :: message
-    character(len=:), allocatable :: text
+    character(len=len(message)) :: text     ! blank padded: callers trim
     integer :: quote_end
     quote_end = index(message, ''': ', back=.true.)
-    text = trim(message)
-    if (quote_end > 0) text = trim(message(quote_end + 3:))
+    text = message
+    if (quote_end > 0) text = message(quote_end + 3:)
   end function reason
 
   !> True when path names an existing folder (opening path/. succeeds only then).

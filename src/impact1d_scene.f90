@@ -3,7 +3,7 @@
 module impact1d_scene
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use impact1d_kinds, only: wp, eps_wp
-  use impact1d_error, only: error_type, raise, status_input, fmt
+  use impact1d_error, only: error_type, raise, status_input, fmt, fmt_width
   use impact1d_forcing, only: forcing_type, table_type
   use impact1d_springs, only: springs_type, n_elements
   implicit none
@@ -109,7 +109,7 @@ contains
 
     do k = 1, n_real
       if (input%given(k) .and. .not. ieee_is_finite(input%value(k))) then
-        call raise(error, status_input, trim(real_names(k)) // ' = ' // fmt(input%value(k)) // &
+        call raise(error, status_input, trim(real_names(k)) // ' = ' // trim(fmt(input%value(k))) // &
           ' is not a finite number')
         return
       end if
@@ -150,8 +150,9 @@ contains
     if (allocated(error)) return
     do k = 0, 1
       if (input%given(i_mus1 + k) .and. input%value(i_mus1 + k) < value_or(input, i_mu1 + k, 0.0_wp)) then
-        call raise(error, status_input, trim(real_names(i_mus1 + k)) // ' = ' // fmt(input%value(i_mus1 + k)) // &
-          ' is below ' // trim(real_names(i_mu1 + k)) // ' = ' // fmt(value_or(input, i_mu1 + k, 0.0_wp)) // &
+        call raise(error, status_input, trim(real_names(i_mus1 + k)) // ' = ' // &
+          trim(fmt(input%value(i_mus1 + k))) // &
+          ' is below ' // trim(real_names(i_mu1 + k)) // ' = ' // trim(fmt(value_or(input, i_mu1 + k, 0.0_wp))) // &
           ': static friction is at least the sliding friction')
         return
       end if
@@ -176,7 +177,7 @@ contains
     if (input%given(i_g) .and. input%value(i_g) < 0.0_wp .and. (value_or(input, i_mu1, 0.0_wp) > 0.0_wp &
         .or. value_or(input, i_mu2, 0.0_wp) > 0.0_wp .or. value_or(input, i_mus1, 0.0_wp) > 0.0_wp .or. &
         value_or(input, i_mus2, 0.0_wp) > 0.0_wp)) then
-      call raise(error, status_input, 'g = ' // fmt(input%value(i_g)) // &
+      call raise(error, status_input, 'g = ' // trim(fmt(input%value(i_g))) // &
         ' is negative with friction: the normal force m g must not pull the bodies off the surface')
       return
     end if
@@ -185,20 +186,20 @@ contains
     if (allocated(error)) return
     if (input%given(i_x_left) .and. input%given(i_x_right)) then
       if (input%value(i_x_left) >= input%value(i_x_right)) then
-        call raise(error, status_input, 'x_left = ' // fmt(input%value(i_x_left)) // &
-          ' must be less than x_right = ' // fmt(input%value(i_x_right)))
+        call raise(error, status_input, 'x_left = ' // trim(fmt(input%value(i_x_left))) // &
+          ' must be less than x_right = ' // trim(fmt(input%value(i_x_right))))
         return
       end if
     end if
     if (input%given(i_d_max) .and. .not. input%given(i_d_min) .and. input%value(i_d_max) < 0.0_wp) then
-      call raise(error, status_input, 'd_max = ' // fmt(input%value(i_d_max)) // ' is negative, but ' // &
+      call raise(error, status_input, 'd_max = ' // trim(fmt(input%value(i_d_max))) // ' is negative, but ' // &
         'without d_min the bodies meet at x2 = x1 (d_min = 0): give d_min to let them pass')
       return
     end if
     if (input%given(i_d_min) .and. input%given(i_d_max)) then
       if (input%value(i_d_min) > input%value(i_d_max)) then
-        call raise(error, status_input, 'd_min = ' // fmt(input%value(i_d_min)) // &
-          ' must not exceed d_max = ' // fmt(input%value(i_d_max)))
+        call raise(error, status_input, 'd_min = ' // trim(fmt(input%value(i_d_min))) // &
+          ' must not exceed d_max = ' // trim(fmt(input%value(i_d_max))))
         return
       end if
     end if
@@ -218,11 +219,13 @@ contains
       scale = maxval(abs(nrm(:, k) * input%value([i_x1, i_x2])))
       if (gap < -16.0_wp * eps_wp * max(scale, abs(offset_of(input, k)))) then
         if (input%given(limit_index(k))) then
-          call raise(error, status_input, 'the initial state ' // initial_positions(input) // ' violates the ' // &
+          call raise(error, status_input, 'the initial state ' // trim(initial_positions(input)) // &
+            ' violates the ' // &
             trim(contact_names(k)) // ' constraint (' // trim(real_names(limit_index(k))) // ' = ' // &
-            fmt(limit_value(input, k)) // ')')
+            trim(fmt(limit_value(input, k))) // ')')
         else
-          call raise(error, status_input, 'the initial state ' // initial_positions(input) // ' violates the ' // &
+          call raise(error, status_input, 'the initial state ' // trim(initial_positions(input)) // &
+            ' violates the ' // &
             trim(contact_names(k)) // ' constraint (d_min = 0 by default: the bodies meet at x2 = x1)')
         end if
         return
@@ -250,7 +253,7 @@ contains
         if (.not. input%given(i)) cycle
         if (input%value(i) * input%value(i_m1 + mod(k, 2)) * abs(value_or(input, i_g, default_gravity)) > &
             huge(1.0_wp)) then
-          call raise(error, status_input, trim(real_names(i)) // ' = ' // fmt(input%value(i)) // &
+          call raise(error, status_input, trim(real_names(i)) // ' = ' // trim(fmt(input%value(i))) // &
             ': the friction bound mu m g overflows')
           return
         end if
@@ -259,13 +262,13 @@ contains
 
     if (input%given(i_t_end)) then
       if (input%value(i_t_end) <= 0.0_wp) then
-        call raise(error, status_input, 't_end = ' // fmt(input%value(i_t_end)) // ' must be positive')
+        call raise(error, status_input, 't_end = ' // trim(fmt(input%value(i_t_end))) // ' must be positive')
         return
       end if
     end if
     if (input%given(i_dt)) then
       if (input%value(i_dt) <= 0.0_wp) then
-        call raise(error, status_input, 'dt = ' // fmt(input%value(i_dt)) // ' must be positive')
+        call raise(error, status_input, 'dt = ' // trim(fmt(input%value(i_dt))) // ' must be positive')
         return
       end if
     end if
@@ -273,16 +276,16 @@ contains
     ! minutes): at least 8 ulps of t_end, so that t + dt moves the clock by dt to 1 part in 8.
     if (input%given(i_dt) .and. input%given(i_t_end)) then
       if (input%value(i_dt) < clock_resolution_ulps * spacing(abs(input%value(i_t_end)))) then
-        call raise(error, status_input, 'dt = ' // fmt(input%value(i_dt)) // ' is below the clock''s ' // &
-          'resolution at t_end = ' // fmt(input%value(i_t_end)) // ' (' // &
-          fmt(clock_resolution_ulps * spacing(abs(input%value(i_t_end)))) // ' s): the run could not advance')
+        call raise(error, status_input, 'dt = ' // trim(fmt(input%value(i_dt))) // ' is below the clock''s ' // &
+          'resolution at t_end = ' // trim(fmt(input%value(i_t_end))) // ' (' // &
+          trim(fmt(clock_resolution_ulps * spacing(abs(input%value(i_t_end))))) // ' s): the run could not advance')
         return
       end if
     end if
     ! dt_out < dt is fine: the run stops at every sample time whatever its step.
     if (input%given(i_dt_out)) then
       if (input%value(i_dt_out) <= 0.0_wp) then
-        call raise(error, status_input, 'dt_out = ' // fmt(input%value(i_dt_out)) // ' must be positive')
+        call raise(error, status_input, 'dt_out = ' // trim(fmt(input%value(i_dt_out))) // ' must be positive')
         return
       end if
     end if
@@ -290,8 +293,8 @@ contains
       if (input%value(i_t_end) / value_or(input, i_dt_out, input%value(i_dt)) > &
           value_or(input, i_max_rows, real(max_samples, wp)) - 1.0_wp) then
         call raise(error, status_input, 't_end / dt_out = ' // &
-          fmt(input%value(i_t_end) / value_or(input, i_dt_out, input%value(i_dt))) // &
-          ' output rows is over the limit of ' // fmt(value_or(input, i_max_rows, real(max_samples, wp))) // &
+          trim(fmt(input%value(i_t_end) / value_or(input, i_dt_out, input%value(i_dt)))) // &
+          ' output rows is over the limit of ' // trim(fmt(value_or(input, i_max_rows, real(max_samples, wp)))) // &
           ': set a larger dt_out (or &run max_rows)')
         return
       end if
@@ -326,7 +329,7 @@ contains
     integer, intent(in) :: i
     if (allocated(error)) return
     if (input%value(i) <= 0.0_wp) call raise(error, status_input, trim(real_names(i)) // ' = ' // &
-      fmt(input%value(i)) // ' must be positive')
+      trim(fmt(input%value(i))) // ' must be positive')
   end subroutine positive
 
   !> A work limit: a whole number from 1 to the largest default integer.
@@ -337,7 +340,7 @@ contains
     if (allocated(error) .or. .not. input%given(i)) return
     if (input%value(i) < 1.0_wp .or. input%value(i) > real(huge(1), wp) .or. &
         input%value(i) /= aint(input%value(i))) call raise(error, status_input, trim(real_names(i)) // &
-      ' = ' // fmt(input%value(i)) // ' must be a whole number from 1 to ' // fmt(huge(1)))
+      ' = ' // trim(fmt(input%value(i))) // ' must be a whole number from 1 to ' // trim(fmt(huge(1))))
   end subroutine count_limit
 
   !> Value i, when given, is not below zero.
@@ -347,7 +350,7 @@ contains
     integer, intent(in) :: i
     if (allocated(error) .or. .not. input%given(i)) return
     if (input%value(i) < 0.0_wp) call raise(error, status_input, trim(real_names(i)) // ' = ' // &
-      fmt(input%value(i)) // ' must not be negative')
+      trim(fmt(input%value(i))) // ' must not be negative')
   end subroutine nonnegative
 
   !> Restitution i, when given, is in [0, 1] and has its constraint (owner).
@@ -357,7 +360,7 @@ contains
     integer, intent(in) :: i, owner
     if (allocated(error) .or. .not. input%given(i)) return
     if (input%value(i) < 0.0_wp .or. input%value(i) > 1.0_wp) then
-      call raise(error, status_input, trim(real_names(i)) // ' = ' // fmt(input%value(i)) // &
+      call raise(error, status_input, trim(real_names(i)) // ' = ' // trim(fmt(input%value(i))) // &
         ' is outside [0, 1]')
     else if (.not. input%given(owner) .and. i /= i_r_min) then
       ! (r_min alone is the restitution of the bodies meeting: d_min = 0 by default.)
@@ -380,7 +383,7 @@ contains
         trim(real_names(i_amp)) // ' is not')
     else if (input%given(i_period)) then
       if (input%value(i_period) <= 0.0_wp) call raise(error, status_input, trim(real_names(i_period)) // &
-        ' = ' // fmt(input%value(i_period)) // ' must be positive')
+        ' = ' // trim(fmt(input%value(i_period))) // ' must be positive')
     end if
   end subroutine sine_terms
 
@@ -392,17 +395,17 @@ contains
     real(wp), intent(in) :: length, scale
     if (allocated(error)) return
     if (length <= 0.0_wp .or. length >= min_resolved_ulps * eps_wp * scale) return
-    call raise(error, status_input, what // ' = ' // fmt(length) // ' is below the resolution of ' // &
-      'the scene''s coordinates (|x| up to ' // fmt(scale) // ' m resolves ' // &
-      fmt(min_resolved_ulps * eps_wp * scale) // ' m): move the scene nearer the origin')
+    call raise(error, status_input, what // ' = ' // trim(fmt(length)) // ' is below the resolution of ' // &
+      'the scene''s coordinates (|x| up to ' // trim(fmt(scale)) // ' m resolves ' // &
+      trim(fmt(min_resolved_ulps * eps_wp * scale)) // ' m): move the scene nearer the origin')
   end subroutine resolvable
 
   !> 'x1 = .., x2 = ..' (x1 alone in a one-body scene), for messages.
   pure function initial_positions(input) result(text)
     type(scene_input), intent(in) :: input
-    character(len=:), allocatable :: text
-    text = 'x1 = ' // fmt(input%value(i_x1))
-    if (input%given(i_m2)) text = text // ', x2 = ' // fmt(input%value(i_x2))
+    character(len=2 * fmt_width + 16) :: text     ! blank padded: callers trim
+    text = 'x1 = ' // trim(fmt(input%value(i_x1)))
+    if (input%given(i_m2)) text = trim(text) // ', x2 = ' // trim(fmt(input%value(i_x2)))
   end function initial_positions
 
   !> Value i, or default when it is not given.

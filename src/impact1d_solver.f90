@@ -113,8 +113,8 @@ contains
         end if
         window_events = window_events + 1
         if (window_events > scene%max_step_events) then
-          call raise(error, status_simulation, 'at t = ' // fmt(s%t) // ': more than ' // &
-            fmt(scene%max_step_events) // ' events within one step (dt = ' // fmt(scene%dt) // &
+          call raise(error, status_simulation, 'at t = ' // trim(fmt(s%t)) // ': more than ' // &
+            trim(fmt(scene%max_step_events)) // ' events within one step (dt = ' // trim(fmt(scene%dt)) // &
             '): the contacts chatter faster than time advances (&run max_step_events)')
           return
         end if
@@ -200,7 +200,7 @@ contains
       if (constraints_hold(scene, mode, s, trial, merge(watched, 0, located))) exit
       halvings = halvings + 1
       if (halvings > max_halvings) then
-        call raise(error, status_simulation, 'at t = ' // fmt(s%t) // &
+        call raise(error, status_simulation, 'at t = ' // trim(fmt(s%t)) // &
           ': no step keeps the constraints (event location failed)')
         return
       end if
@@ -375,8 +375,8 @@ contains
       remaining = (t_stop - t) - t_lo
       h = step_length(scene%dt, remaining)
       if (h /= remaining .or. h <= 0.0_wp .or. t + h >= t_quiet) exit
-      call constant_step(h, a, t, t_lo, x, x_lo, v, v_lo)
-      t = t_stop
+      call constant_step(h, a, x, x_lo, v, v_lo)
+      t = t_stop        ! (the step ends at the stop: the clock is set to it, as in glide)
       t_lo = 0.0_wp
       stats%steps = stats%steps + 1
       if (iand(stats%steps, 4095_int64) == 0) call sink%progress(t, scene%t_end)
@@ -414,7 +414,7 @@ contains
   subroutine raise_not_finite(t, error)
     real(wp), intent(in) :: t
     type(error_type), allocatable, intent(inout) :: error
-    call raise(error, status_simulation, 'at t = ' // fmt(t) // ': the state is no longer finite')
+    call raise(error, status_simulation, 'at t = ' // trim(fmt(t)) // ': the state is no longer finite')
   end subroutine raise_not_finite
 
   !> A gap that closed exactly at a stop (its root at the step's very end) with the bodies

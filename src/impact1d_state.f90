@@ -55,13 +55,13 @@ contains
     hi = total
   end subroutine renormalise
 
-  !> One step of h under the constant acceleration a: RK4 is exact there, and its step is
-  !> the quadratic x + h v + h^2 a / 2, v + h a; every sum compensated and renormalised.
-  !> On the parts, not the state, so that a loop can keep them in registers.
-  pure subroutine constant_step(h, a, t, t_lo, x, x_lo, v, v_lo)
+  !> The bodies' step of h under the constant acceleration a: RK4 is exact there, and its
+  !> step is the quadratic x + h v + h^2 a / 2, v + h a; both sums compensated and
+  !> renormalised. On the parts, not the state, so that a loop can keep them in registers;
+  !> the clock is the caller's (a step to a stop sets it to the stop).
+  pure subroutine constant_step(h, a, x, x_lo, v, v_lo)
     real(wp), intent(in) :: h, a(2)
-    real(wp), intent(inout) :: t, t_lo, x(2), x_lo(2), v(2), v_lo(2)
-    call add_compensated(t, t_lo, h)
+    real(wp), intent(inout) :: x(2), x_lo(2), v(2), v_lo(2)
     call add_compensated(x, x_lo, h * ((v + v_lo) + (0.5_wp * h) * a))
     call add_compensated(v, v_lo, h * a)
   end subroutine constant_step

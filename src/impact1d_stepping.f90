@@ -36,8 +36,8 @@ contains
     class(rk4_type), intent(in) :: self
     type(state_type), intent(inout) :: state
     real(wp), intent(in) :: step
-    call constant_step(step, self%constant_acceleration, state%t, state%t_lo, state%x, state%x_lo, &
-      state%v, state%v_lo)
+    call add_compensated(state%t, state%t_lo, step)
+    call constant_step(step, self%constant_acceleration, state%x, state%x_lo, state%v, state%v_lo)
   end subroutine advance_constant
 
   !> Under constant forces the work and the friction loss over any stretch of one mode are

@@ -62,7 +62,7 @@ contains
       stats%steps = stats%steps + 1
       if (iand(stats%steps, 4095_int64) == 0) call sink%progress(t, scene%t_end)
       if (.not. all(abs([x, v]) <= huge(1.0_wp))) then
-        call raise(error, status_simulation, 'at t = ' // fmt(t) // ': the state is no longer finite')
+        call raise(error, status_simulation, 'at t = ' // trim(fmt(t)) // ': the state is no longer finite')
         return
       end if
       ! Collisions seen at the step's end: the slot's first, then the walls on what it left.

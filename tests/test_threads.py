@@ -96,3 +96,28 @@ def test_non_ascii_scene_and_table_paths(tmp_path):
     assert scene.f1_table.endswith("triangle_ü.dat")
     res = impact1d.simulate(scene)
     assert same(res, impact1d.simulate(impact1d.load_scene(INPUT / "case6.nml")))
+
+
+def test_threads_building_error_messages_at_once_get_their_own():
+    """Runs that fail in several threads at once each get their own message. gfortran 12
+    kept the length of a function's deferred-length string result in a static variable of
+    the caller, shared by all threads: two threads formatting numbers into messages at once
+    corrupted 6 of 20000 (and could overrun a buffer). Every run here fails with a message
+    naming its own dt."""
+    from impact1d._simulate import run_summaries
+    scene = impact1d.load_scene(INPUT / "case3.nml")
+    runs = [{"dt": -1.5 - k, "t_end": 1.0} for k in range(2000)]
+    expected = [f"dt = {-1.5 - k:g} must be positive" for k in range(2000)]
+    assert run_summaries(scene, runs)[1] == expected
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        for _ in range(5):
+            halves = list(pool.map(lambda k: run_summaries(scene, runs[k::2])[1], (0, 1)))
+            assert halves[0] == expected[0::2] and halves[1] == expected[1::2]
+
+
+def test_the_core_keeps_no_static_string_lengths():
+    """The deterministic side of the test above: the compiled core has none of gfortran's
+    static result-length variables (named slen.N.M), i.e. no function returns a string of
+    deferred length (see fmt in src/impact1d_error.f90)."""
+    from impact1d import _core
+    assert b"slen." not in Path(_core.__file__).read_bytes()

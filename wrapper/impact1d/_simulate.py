@@ -61,8 +61,9 @@ def run_summaries(scene: Scene, overrides: list):
                       dtype=np.float64).reshape(len(overrides), len(names)).T
     summary, status, codes = _api.simulate_summaries(*to_core(_with_overrides(scene, {})),
                                                      index, matrix, len(_summary_names()))
-    errors = ["" if int(code) == 0 else decode(np.asarray(text, dtype=np.uint8).tobytes())
-              for code, text in zip(status, codes.T)]
+    errors = [""] * len(overrides)
+    for j in np.flatnonzero(status):
+        errors[j] = decode(np.asarray(codes[:, j], dtype=np.uint8).tobytes())
     return dict(zip(_summary_names(), summary)), errors
 
 

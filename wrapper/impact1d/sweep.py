@@ -77,6 +77,11 @@ def _failed_row() -> dict:
     return {name: math.nan for name in SUMMARY_COLUMNS}
 
 
+def _columns(rows: list) -> dict:
+    """Summary rows as {column: float64 array} (how chunks travel: arrays, not rows)."""
+    return {name: np.array([row[name] for row in rows], dtype=np.float64) for name in SUMMARY_COLUMNS}
+
+
 def _batchable(overrides: list) -> bool:
     """Runs the core's batch entry can take: the same real fields, numbers only."""
     if not overrides or not overrides[0]:
@@ -89,13 +94,13 @@ def _batchable(overrides: list) -> bool:
 
 
 def run_chunk(scene: Scene, overrides: list, keep_results: bool = False):
-    """Run the scene once per override dict: (summary rows, error messages[, Results]).
-    A plain function of plain data, so that a Dask worker can run it. Without Results
-    wanted, runs that only change numbers go to the core in one call (no per-run glue)."""
+    """Run the scene once per override dict: ({column: array} of summaries, error
+    messages[, Results]). A plain function of plain data, so that a Dask worker can run it
+    and send back a few arrays. Without Results wanted, runs that only change numbers go to
+    the core in one call (no per-run glue)."""
     if not keep_results and _batchable(overrides):
         columns, errors = run_summaries(scene, overrides)
-        rows = [{name: columns[name][j] for name in SUMMARY_COLUMNS} for j in range(len(overrides))]
-        return rows, errors
+        return {name: np.asarray(columns[name], dtype=np.float64) for name in SUMMARY_COLUMNS}, errors
     rows, errors, results = [], [], []
     for changes in overrides:
         try:
@@ -108,7 +113,7 @@ def run_chunk(scene: Scene, overrides: list, keep_results: bool = False):
         rows.append(summarize(result))
         errors.append("")
         results.append(result if keep_results else None)
-    return (rows, errors, results) if keep_results else (rows, errors)
+    return (_columns(rows), errors, results) if keep_results else (_columns(rows), errors)
 
 
 def _runs(params) -> tuple:
@@ -214,10 +219,10 @@ def sweep(scene: Scene, params, *, workers: Optional[int] = None, client=None,
     finally:
         bar.close()
 
-    rows = [row for output in outputs for row in output[0]]
     errors = [error for output in outputs for error in output[1]]
     table = pd.DataFrame({name: [run.get(name) for run in runs] for name in names})
-    summary = pd.DataFrame(rows, columns=list(SUMMARY_COLUMNS))
+    summary = pd.DataFrame({name: (np.concatenate([output[0][name] for output in outputs])
+                                   if outputs else np.empty(0)) for name in SUMMARY_COLUMNS})
     table = pd.concat([table, summary], axis=1)
     table["error"] = errors
     # Counts are whole numbers; a failed run's are missing (pandas' nullable integers).
