@@ -32,8 +32,14 @@ _IMPACT_KINDS = ("left", "right", "slot_min", "slot_max")
 # Below this many runs a sweep stays on one thread unless asked: a pool costs more than
 # it saves on a few milliseconds of work.
 _PARALLEL_FROM = 200
-# Runs per chunk: enough that a chunk's overhead (a task, a progress update) is small.
-_CHUNK = 64
+# Runs per chunk: enough that a chunk's Python overhead (which holds the GIL) is small
+# beside its Fortran runs, few enough that every thread gets about 8 chunks (a last chunk
+# does not leave the others idle) and the progress bar moves.
+_CHUNK_MIN, _CHUNK_MAX = 16, 512
+
+
+def _chunk_size(n_runs: int, workers: int) -> int:
+    return max(_CHUNK_MIN, min(_CHUNK_MAX, n_runs // (8 * workers)))
 
 
 def summarize(result) -> dict:
@@ -188,7 +194,8 @@ def sweep(scene: Scene, params, *, workers: Optional[int] = None, client=None,
     if workers < 1:
         raise InputError(f"workers must be at least 1, got {workers}")
     keep_results = keep == "results"
-    chunks = [runs[i:i + _CHUNK] for i in range(0, len(runs), _CHUNK)]
+    size = _chunk_size(len(runs), workers)
+    chunks = [runs[i:i + size] for i in range(0, len(runs), size)]
     bar = _Progress(len(runs), progress)
     try:
         if client is not None:
@@ -197,7 +204,7 @@ def sweep(scene: Scene, params, *, workers: Optional[int] = None, client=None,
             # Few, large tasks: a task costs the scheduler and the workers' processes
             # (on the same cores here) far more than a thread's chunk does.
             workers_there = max(1, len(client.scheduler_info().get("workers", {})))
-            size = max(_CHUNK, -(-len(runs) // (4 * workers_there)))
+            size = max(_CHUNK_MIN, -(-len(runs) // (4 * workers_there)))
             chunks = [runs[i:i + size] for i in range(0, len(runs), size)]
             futures = client.map(run_chunk, [scene] * len(chunks), chunks, pure=False)
             outputs = []
