@@ -94,7 +94,7 @@ contains
     namelist /springs/ k1, x1_rest, c1, k2, x2_rest, c2, k12, d_rest, c12
     namelist /run/ t_end, dt, dt_out, method, zero_vel, max_rows, max_impulses, max_step_events
     logical :: present(size(known_groups))
-    integer :: unit, ios, j
+    integer :: ios, j
     character(len=512) :: message
     real(wp) :: values(n_real), values_other(n_real)
     character(len=1024) :: texts(4), texts_other(4)
