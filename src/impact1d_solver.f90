@@ -15,7 +15,7 @@ module impact1d_solver
   use impact1d_output, only: sink_type, run_stats, emit_sample
   use impact1d_vissim, only: run_vissim
   use impact1d_state, only: state_type, renormalise, finite_state, constant_step, &
-    constant_steps
+    constant_steps, unpack_motion, pack_motion
   use impact1d_contacts, only: gap, gap_tolerance, u_tolerance
   use impact1d_stepping, only: rk4_type, book_constant_ledger, books_ledger
   use impact1d_location, only: watch_type, refine, constraints_hold
@@ -294,12 +294,7 @@ contains
         h = scene%dt
         dv = h * rk%constant_acceleration
         half_dv = 0.5_wp * dv
-        t = s%t
-        t_lo = s%t_lo
-        x = s%x
-        x_lo = s%x_lo
-        v = s%v
-        v_lo = s%v_lo
+        call unpack_motion(s, t, t_lo, x, x_lo, v, v_lo)
         do while (n_bulk > 0)
           ! In runs of up to the next progress report.
           n = min(n_bulk, 4096_int64 - iand(stats%steps, 4095_int64))
@@ -311,12 +306,7 @@ contains
         call renormalise(t, t_lo)
         call renormalise(x, x_lo)
         call renormalise(v, v_lo)
-        s%t = t
-        s%t_lo = t_lo
-        s%x = x
-        s%x_lo = x_lo
-        s%v = v
-        s%v_lo = v_lo
+        call pack_motion(t, t_lo, x, x_lo, v, v_lo, s)
       end if
       ! The last steps: to the stop by the step rule, while they stay quiet.
       do
@@ -363,12 +353,7 @@ contains
 
     a = rk%constant_acceleration
     books = books_ledger(scene, mode)
-    t = s%t
-    t_lo = s%t_lo
-    x = s%x
-    x_lo = s%x_lo
-    v = s%v
-    v_lo = s%v_lo
+    call unpack_motion(s, t, t_lo, x, x_lo, v, v_lo)
     do
       t_stop = min(stops%sample_t, stops%t_break, stops%t_rest)
       if (.not. quiet_sample(scene, stops, t_stop)) exit
@@ -397,12 +382,7 @@ contains
       stops%j_sample = stops%j_sample + 1
       stops%sample_t = sample_time(scene, stops%j_sample)
     end do
-    s%t = t
-    s%t_lo = t_lo
-    s%x = x
-    s%x_lo = x_lo
-    s%v = v
-    s%v_lo = v_lo
+    call pack_motion(t, t_lo, x, x_lo, v, v_lo, s)
   end subroutine step_to_samples
 
   subroutine check_finite(s, error)

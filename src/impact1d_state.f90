@@ -7,7 +7,7 @@ module impact1d_state
   implicit none
   private
   public :: state_type, add_compensated, accumulate, renormalise, finite_state, constant_step, &
-    constant_steps
+    constant_steps, unpack_motion, pack_motion
 
   !> Time, positions, velocities and the ledger integrals, compensated: a micrometre bounce
   !> near a wall at x = 10 m keeps its digits, and 10^6 steps of 1e-5 s do not drift the clock
@@ -95,6 +95,30 @@ contains
     v = v_
     v_lo = v_lo_
   end subroutine constant_steps
+
+  !> A state's clock, positions and velocities with their low parts as plain variables,
+  !> which a loop of steps keeps in registers (pack_motion puts them back).
+  pure subroutine unpack_motion(s, t, t_lo, x, x_lo, v, v_lo)
+    type(state_type), intent(in) :: s
+    real(wp), intent(out) :: t, t_lo, x(2), x_lo(2), v(2), v_lo(2)
+    t = s%t
+    t_lo = s%t_lo
+    x = s%x
+    x_lo = s%x_lo
+    v = s%v
+    v_lo = s%v_lo
+  end subroutine unpack_motion
+
+  pure subroutine pack_motion(t, t_lo, x, x_lo, v, v_lo, s)
+    real(wp), intent(in) :: t, t_lo, x(2), x_lo(2), v(2), v_lo(2)
+    type(state_type), intent(inout) :: s
+    s%t = t
+    s%t_lo = t_lo
+    s%x = x
+    s%x_lo = x_lo
+    s%v = v
+    s%v_lo = v_lo
+  end subroutine pack_motion
 
   !> All of the state a run reports is finite.
   pure logical function finite_state(x, v, work)
