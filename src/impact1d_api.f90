@@ -93,7 +93,7 @@ contains
     character(len=*), intent(in) :: title, f1_table, f2_table, method
     integer(c_int), intent(in) :: progress    !< non-zero: show progress on stderr after 1 s
     integer(c_int), intent(in) :: max_samples, n_cols, max_events
-    real(c_double), intent(out) :: samples(max_samples, n_cols)
+    real(c_double), intent(out), target :: samples(max_samples, n_cols)
     integer(c_int), intent(out) :: has_column(n_cols)
     real(c_double), intent(out) :: event_t(max_events), event_v(4, max_events)
     integer(c_int), intent(out) :: event_kind(max_events)
@@ -124,7 +124,13 @@ contains
     if (failed(error, status, message)) return
     columns = present_columns(input)
     has_column(columns) = 1
-    call sink%reserve(scene%n_samples, columns)
+    ! The rows go straight into samples when it has room (else the sink keeps them and the
+    ! caller learns the size needed).
+    if (max_samples >= scene%n_samples) then
+      call sink%reserve(scene%n_samples, columns, samples)
+    else
+      call sink%reserve(scene%n_samples, columns)
+    end if
     sink%show_progress = progress /= 0
     call run(scene, sink, stats, error)
     call sink%end_progress()
@@ -138,8 +144,7 @@ contains
       message = 'internal: the result arrays are too small'
       return
     end if
-    ! The present columns first, in order (has_column says which they are).
-    samples(:n_samples, :size(columns)) = sink%samples(:n_samples, :)
+    ! The present columns first, in order (has_column says which they are): already there.
     event_t(:n_events) = sink%event_time(:n_events)
     event_kind(:n_events) = sink%event_kind(:n_events)
     event_v(:, :n_events) = sink%event_v(:, :n_events)

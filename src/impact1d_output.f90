@@ -74,6 +74,9 @@ module impact1d_output
   !> Keeps everything in arrays (the Python side copies them out).
   type, extends(sink_type) :: memory_sink
     real(wp), allocatable :: samples(:, :)      !< one column per present column, in order
+    !> Or the caller's array, when it gave one (reserve's into): the rows go straight there,
+    !> so a run's samples are written once, into memory that is already the result.
+    real(wp), pointer :: into(:, :) => null()
     integer, allocatable :: columns(:)
     integer :: n_samples = 0
     real(wp), allocatable :: event_time(:), event_v(:, :)
@@ -256,13 +259,20 @@ contains
   end subroutine end_progress
 
   !> Room for n_samples rows of the given columns (present_columns: only those are kept,
-  !> so a scene's memory is what it has).
-  subroutine memory_reserve(self, n_samples, columns)
+  !> so a scene's memory is what it has): into's first columns when given (it must have
+  !> n_samples rows and size(columns) columns at least), else an array of the sink's own.
+  subroutine memory_reserve(self, n_samples, columns, into)
     class(memory_sink), intent(inout) :: self
     integer, intent(in) :: n_samples, columns(:)
+    real(wp), intent(inout), target, optional :: into(:, :)
     self%columns = columns
     if (allocated(self%samples)) deallocate(self%samples)
-    allocate(self%samples(n_samples, size(columns)))
+    self%into => null()
+    if (present(into)) then
+      self%into => into
+    else
+      allocate(self%samples(n_samples, size(columns)))
+    end if
     self%n_samples = 0
     if (allocated(self%event_time)) deallocate(self%event_time, self%event_v, self%event_kind)
     allocate(self%event_time(64), self%event_v(4, 64), self%event_kind(64))
@@ -308,7 +318,11 @@ contains
     class(memory_sink), intent(inout) :: self
     real(wp), intent(in) :: row(n_columns)
     self%n_samples = self%n_samples + 1
-    self%samples(self%n_samples, :) = row(self%columns)
+    if (associated(self%into)) then
+      self%into(self%n_samples, :size(self%columns)) = row(self%columns)
+    else
+      self%samples(self%n_samples, :) = row(self%columns)
+    end if
   end subroutine memory_put_sample
 
   subroutine memory_put_event(self, t, kind, v_before, v_after)

@@ -267,3 +267,25 @@ def test_progress_only_when_asked(capfd):
     err = capfd.readouterr().err
     assert "impact1d: " in err and "% (t = " in err and "of 20000.0 s)" in err
     assert res.t[-1] == LONG_RUN["t_end"]
+
+
+def test_flat_simulate_says_what_room_it_needs():
+    """The flat API writes a run's rows straight into the caller's array; when that array
+    (or the event arrays) is too small it says so with the sizes needed (status 3), and a
+    call with those sizes gives the rows simulate() returns."""
+    from impact1d._scene import _api, to_core
+    from impact1d._simulate import COLUMNS
+    scene = impact1d.load_scene(INPUT / "case5.nml")
+    expected = impact1d.simulate(scene)
+    core = to_core(scene)
+    for rows, events in ((3, 2000), (len(expected.t) + 1, 2)):
+        out = _api.simulate(*core, 0, rows, len(COLUMNS), events)
+        status, n_samples, n_events = int(out[-2]), int(out[5]), int(out[6])
+        assert status == 3
+        assert (n_samples, n_events) == (len(expected.t), len(expected.events))
+    samples, has_column, *_, status, message = _api.simulate(*core, 0, n_samples, len(COLUMNS), n_events)
+    assert int(status) == 0
+    present = [name for name, flag in zip(COLUMNS, has_column) if flag]
+    assert present == list(expected.columns)
+    for k, name in enumerate(present):
+        np.testing.assert_array_equal(samples[:, k], getattr(expected, name))
