@@ -100,7 +100,9 @@ contains
       n_impulses = n_impulses + 1
       if (n_impulses > scene%max_impulses) then
         call raise(error, status_simulation, 'at t = ' // trim(fmt(s%t)) // ': the impacts did not settle after ' &
-          // trim(fmt(scene%max_impulses)) // ' impulses (&run max_impulses)')
+          // trim(fmt(scene%max_impulses)) // ' impulses (typically a light body squeezed between a much ' // &
+          'heavier one and a wall or stop: the impulses pass back and forth, more of them the larger ' // &
+          'the mass ratio; raise &run max_impulses)')
         return
       end if
       v_before = s%v

@@ -115,7 +115,9 @@ contains
         if (window_events > scene%max_step_events) then
           call raise(error, status_simulation, 'at t = ' // trim(fmt(s%t)) // ': more than ' // &
             trim(fmt(scene%max_step_events)) // ' events within one step (dt = ' // trim(fmt(scene%dt)) // &
-            '): the contacts chatter faster than time advances (&run max_step_events)')
+            '): the contacts chatter faster than the run can follow (typically a contact with ' // &
+            'restitution at or near 1 pressed shut, whose bounces never die out: lower that ' // &
+            'restitution, or raise &run max_step_events)')
           return
         end if
         call event_log%flush_releases(scene, s%t, .false., sink, stats)

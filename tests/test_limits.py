@@ -70,7 +70,7 @@ def test_work_limits_are_run_options():
     chain = impact1d.Scene(m1=1.0, m2=1e4, x_left=0.0, r_left=1.0, d_min=1.0, r_min=1.0,
                            x1=0.0, x2=1.0, v2=-1.0, t_end=0.1, dt=1e-3)
     assert len(impact1d.simulate(chain).events) > 300
-    with pytest.raises(impact1d.SimulationError, match=r"after 100 impulses \(&run max_impulses\)"):
+    with pytest.raises(impact1d.SimulationError, match=r"after 100 impulses .*raise &run max_impulses\)"):
         impact1d.simulate(chain, max_impulses=100)
     shrunk = dict(x_right=0.01, d_min=0.001, d_max=0.002, x1=0.001, x2=0.0025, t_end=1.0)
     with pytest.raises(impact1d.SimulationError, match=r"more than 3 events within one step .*max_step_events"):
