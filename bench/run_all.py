@@ -278,9 +278,9 @@ def performance_md(perf, info) -> str:
                ["runs", "impact1d (median, per call)", "SciPy DOP853 (median, per call)",
                 "median of the paired ratios", "range of the ratios"]),
         "",
-        f"Called in a loop, as a sweep or a study does, impact1d is {bt['ratio_median']:.0f} "
+        f"Called in a loop, as a sweep or a study does, impact1d is {bt['ratio_median']:.1f} "
         f"times faster; one call at a time, each right after the other tool's, "
-        f"{c3['ratio_median']:.0f} times: there each call starts with the caches the other "
+        f"{c3['ratio_median']:.1f} times: there each call starts with the caches the other "
         "left, which costs impact1d's short run (mostly its Python glue) proportionally more. "
         f"Against the issue's target of 100 times this {verdict_100} it by the first measure "
         f"and {verdict_single} it by the second. On this polynomial scene SciPy is exact at "

@@ -140,8 +140,8 @@ def performance_section(data) -> str:
                 f"{r['workers1_no_samples']:.0f} | {ms['workers1_no_samples']:.3f} | "
                 f"{r['workers1_no_samples'] / r['loop_no_samples']:.2f}x the loop |"]
     out += ["", f"Peak memory of a whole sweep process: {mem[sizes[0]]:.0f} MiB for {sizes[0]} "
-            f"runs, {mem[sizes[-1]]:.0f} MiB for {sizes[-1]} runs: the table's rows are what "
-            "grows (no run's samples are kept).", "",
+            f"runs, {mem[sizes[-1]]:.0f} MiB for {sizes[-1]} runs: no run's samples are kept, "
+            "only the table's row of each run.", "",
             "Targets of issue 11: `workers=1` at 3x the loop, `workers=2` at 1.8x `workers=1`, "
             "Dask within 25% of `workers=2`. A sweep runs its chunks through the core's batch "
             "entry (one call per chunk, a summary sink that keeps no samples, the GIL released)."]
