@@ -1,7 +1,7 @@
 !> What the event log has said and still owes (METHOD.md 6): which contacts rest, which
-!> bodies are at rest, rests logged at a bounce series' accumulation time, and releases
-!> held back until time moves on (a contact that closes again at the same instant never
-!> opened).
+!> bodies are at rest, rests logged at a bounce series' accumulation time, releases held
+!> back until time moves on (a contact that closes again at the same instant never
+!> opened), and the velocity scale of the instant's impulses.
 module impact1d_event_log
   use impact1d_kinds, only: wp
   use impact1d_scene, only: scene_type, n_contacts
@@ -22,6 +22,11 @@ module impact1d_event_log
     real(wp) :: release_v(2, n_contacts) = 0.0_wp
     !> When impulses last moved each body off its rest (see the stick log at the event point).
     real(wp) :: rest_lost_time(2) = -huge(1.0_wp)
+    !> The last event point's instant and the velocity scale its impulses came from: a
+    !> further event point at the same instant keeps that scale (impulses redistribute
+    !> velocity but cannot create precision, however many event points they take).
+    real(wp) :: scale_time = -huge(1.0_wp)
+    real(wp) :: scale(2) = 0.0_wp
   contains
     procedure :: flush_pending_rest
     procedure :: flush_releases

@@ -73,6 +73,7 @@ contains
     acc = mode%acceleration(f)
     if (initial) acc = f / scene%mass     ! no mode yet: the free accelerations set the scale
     entry_scale = abs(s%v) + abs(acc) * scene%dt
+    if (same_instant(scene, s%t, event_log%scale_time)) entry_scale = max(entry_scale, event_log%scale)
     do i = 1, 2
       if (scene%static_friction(i) == 0.0_wp) cycle
       if (i == which - 100 .or. abs(s%v(i)) <= velocity_rounding * abs(acc(i)) * scene%dt) &
@@ -111,6 +112,9 @@ contains
       if (all(scene%normal(:, k) /= 0.0_wp)) entry_scale = maxval(entry_scale)
       call log_event(sink, stats, s%t, event_impact + k, v_before, v_after)
     end do
+
+    event_log%scale_time = s%t
+    event_log%scale = entry_scale
 
     ! Contacts left with a rounding-level normal velocity are closed and still.
     call zero_stopped(scene, s, acc, entry_scale)

@@ -472,6 +472,24 @@ def test_plastic_pile_up_against_a_wall(r_left, r_min):
         assert (res.x1[-1], res.x2[-1]) == pytest.approx((0.0, 0.0), abs=AT_REST_TOL)
 
 
+@pytest.mark.parametrize("m2", [2.5, 5.0, 100.0])
+def test_heavier_body_onto_one_resting_on_a_plastic_wall_settles(m2):
+    """m1 rests on a plastic wall; a heavier m2 hits it at 1 m/s (bodies meet, r_min = 1):
+    the impulses pass between the wall and the pair, m2 keeping (m2 - m1)/(m2 + m1) of its
+    speed each time, until it is at rounding level: both end at rest on the wall, the wall
+    took all the momentum. (The impulses took several event points at t = 1, and each one
+    started from the speeds it met: from m2 = 2.5 on, the tiny speeds left by one became the
+    scale of the next, and the series ran on to underflow or never ended.)"""
+    scene = S(m1=1.0, m2=m2, x1=0.0, x2=1.0, v2=-1.0, x_left=0.0, r_left=0.0,
+              t_end=2.0, dt=0.1, dt_out=0.5)
+    res = impact1d.simulate(scene)
+    assert events_of(res, "slot_min")["t"][0] == pytest.approx(1.0, abs=EVENT_TIME_TOL)
+    assert len(res.events) < 100 * m2          # about 32 m2 / m1 impulses, nothing more
+    assert (res.v1[-1], res.v2[-1]) == (0.0, 0.0)
+    assert (res.x1[-1], res.x2[-1]) == pytest.approx((0.0, 0.0), abs=AT_REST_TOL)
+    assert_no_penetration(res, scene)
+
+
 @pytest.mark.parametrize("r_left", [0.5, pytest.param(0.99999, marks=pytest.mark.xfail(
     strict=True, reason="engine limitation: with a near-elastic wall the lower body rattles "
     "between the wall and the upper one ever faster; the per-contact bounce-series test does "
