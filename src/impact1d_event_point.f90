@@ -116,8 +116,15 @@ contains
     event_log%scale_time = s%t
     event_log%scale = entry_scale
 
-    ! Contacts left with a rounding-level normal velocity are closed and still.
+    ! Contacts left with a rounding-level normal velocity are closed and still. Approach left
+    ! at two closed contacts that no one of them can remove goes jointly (their vertex: the
+    ! joint inelastic impact): removed one contact at a time it would pass back and forth, a
+    ! fraction smaller each time (a body on a wall under a heavier one).
     call zero_stopped(scene, s, acc, entry_scale)
+    if (.not. rigid_pair(closed)) then
+      call inelastic_projection(scene, closed, s%v, spread(0.0_wp, 1, n_contacts), v_after, pushed)
+      if (count(pushed) >= 2) call apply(scene, s, v_after)
+    end if
     do k = 1, n_contacts
       if (.not. closed(k)) cycle
       if (abs(normal_velocity(scene, k, s%v)) <= u_tolerance(scene, mode, s, k, entry_scale) .and. &

@@ -21,6 +21,7 @@ import numpy as np
 import pytest
 
 import impact1d
+from impact1d.sweep import summarize
 from scene_gaps import gaps
 import exact_reference
 
@@ -488,6 +489,12 @@ def test_heavier_body_onto_one_resting_on_a_plastic_wall_settles(m2):
     assert (res.v1[-1], res.v2[-1]) == (0.0, 0.0)
     assert (res.x1[-1], res.x2[-1]) == pytest.approx((0.0, 0.0), abs=AT_REST_TOL)
     assert_no_penetration(res, scene)
+    # The last impulse's rounding-level remainder goes jointly (both stop at t = 1, logged
+    # as the pair resting), not passed back and forth between wall and body over further
+    # event points: so the rest time is the impact's.
+    last = res.events[-1]
+    assert (last["kind"], last["t"], last["v1_after"], last["v2_after"]) == ("rest_slot_min", 1.0, 0.0, 0.0)
+    assert summarize(res)["t_rest"] == 1.0
 
 
 @pytest.mark.parametrize("r_left", [0.5, pytest.param(0.99999, marks=pytest.mark.xfail(
