@@ -86,6 +86,32 @@ def test_sliding_into_a_force_static_friction_holds_stops_and_stays(dt):
     assert back.v1[-1] < 0.0
 
 
+@pytest.mark.parametrize("dt", [0.1, 0.01, 1e-3])
+def test_sine_force_breaks_away_where_static_equals_sliding_friction(dt):
+    """mus = mu (the default): a body stuck under f = -5 + 2 sin(2 pi t) N breaks away when
+    the force reaches -mu m g = -4 N again, at t = 5/12 s, with zero acceleration (the net
+    force is zero there). The step's cubic dipped the velocity below zero at once, and the
+    stop was located at the break-away instant again and again (SimulationError)."""
+    scene = impact1d.Scene(m1=1.0, mu1=0.4, g=10.0, x1=0.0, f1=-5.0, f1_amp=2.0, f1_period=1.0,
+                           t_end=1.0, dt=dt)
+    res = impact1d.simulate(scene)
+    assert list(res.events["kind"]) == ["stick1", "slip1"]
+    assert res.events["t"][1] == pytest.approx(5.0 / 12.0, abs=1e-12)
+    assert res.v1[-1] < 0.0
+
+
+def test_spring_breaks_away_where_static_equals_sliding_friction():
+    """A spring k12 pulled by a constant force on body 2 (frictionless) against body 1 held
+    by friction (mus = mu = 1): body 1 breaks away when k12 d = mu m1 g, on the harmonic arc
+    d(t) = f2/k12 (1 - cos(w t)), w = sqrt(k12/m2), with zero net force on it there."""
+    scene = impact1d.Scene(m1=3.0, m2=1.0, mu1=1.0, g=10.0, f2=32.0, d_min=0.0, r_min=0.0,
+                           x1=0.0, x2=0.0, k12=28.0, d_rest=0.0, t_end=0.5, dt=1e-3)
+    t_break = math.acos(1.0 - 3.0 * 10.0 / 32.0) / math.sqrt(28.0)
+    res = impact1d.simulate(scene)
+    assert list(res.events["kind"]) == ["slip1"]
+    assert res.events["t"][0] == pytest.approx(t_break, abs=1e-10)
+
+
 def test_static_friction_is_the_vissim_methods_bound_at_rest():
     """The tutorial's scheme holds a body at rest while |f| <= mus m g too."""
     held = impact1d.simulate(one_body(m1=1.0, mu1=0.3, mus1=0.5, g=G, x1=0.0, f1=4.0,
