@@ -163,10 +163,12 @@ def performance_section(data) -> str:
                 "in the engine is the loop's too, so the ratio is 1 + glue / engine, and 3x needs "
                 f"the engine at half the glue, {glue / 2:.3f} ms. The arithmetic of the sample "
                 "steps alone, in a tight loop with nothing else (bench/sample_step_floor.f90: "
-                f"{data.get('floor_ns_per_step', 0.0):.1f} ns a step), takes {floor_ms:.3f} ms of "
-                f"that, which would leave {glue / 2 - floor_ms:.3f} ms for a run's events, checks "
-                "and set-up; a run sampled only at t_end, all of those and its steps taken in "
-                f"bulk, takes {ms['workers1_no_samples']:.3f} ms."]
+                f"{data.get('floor_ns_per_step', 0.0):.1f} ns a step), takes {floor_ms:.3f} ms"
+                + (f", which would leave {glue / 2 - floor_ms:.3f} ms for a run's events, checks "
+                   "and set-up" if floor_ms < glue / 2 else ", more than all of that, before a "
+                   "run's events, checks and set-up")
+                + "; a run sampled only at t_end, all of those and its steps taken in bulk, takes "
+                f"{ms['workers1_no_samples']:.3f} ms."]
     return "\n".join(out) + "\n"
 
 
