@@ -64,8 +64,10 @@ contains
       if (.not. have_acc_rounding) then
         acc_rounding = 1.0e3_wp * eps_wp * &
           force_scale(scene, state_force(scene, a), applied_rate(scene, a%t, a%v)) / scene%mass
-        if (.not. polynomial_forcing .and. .not. have_acc0) acc0 = mode%acceleration(state_force(scene, a))
-        have_acc0 = .not. polynomial_forcing
+        if (.not. polynomial_forcing) then
+          acc0 = mode%acceleration(state_force(scene, a))
+          have_acc0 = .true.
+        end if
       end if
       have_acc_rounding = .true.
       q = gap_tolerance_along(scene, k, a, c, acc_rounding)
