@@ -11,7 +11,8 @@ module impact1d_event_point
     kinetic_energy, joint_inelastic, inelastic_projection
   use impact1d_output, only: sink_type, run_stats, event_impact, event_rest, event_stick, event_slip
   use impact1d_state, only: state_type, add_compensated
-  use impact1d_yardsticks, only: gap_rounding, velocity_rounding, time_rounding, force_scale, same_instant
+  use impact1d_yardsticks, only: gap_rounding, velocity_rounding, time_rounding, energy_rounding, force_scale, &
+    same_instant
   use impact1d_contacts, only: gap, gap_tolerance, snap, rigid_pair, u_tolerance
   use impact1d_stepping, only: rk4_type
   use impact1d_location, only: watch_type
@@ -87,6 +88,8 @@ contains
       call inelastic_projection(scene, closed, s%v, u_tolerances(scene, mode, s, entry_scale), &
         v_after, pushed)
       if (any(pushed)) then
+        call check_dissipative(scene, s%t, v_before, v_after, error)
+        if (allocated(error)) return
         call apply(scene, s, v_after)
         if (any(pushed .and. [.false., .false., .true., .true.])) entry_scale = maxval(entry_scale)
         do k = 1, n_contacts
@@ -108,6 +111,8 @@ contains
       end if
       v_before = s%v
       v_after = impulse(scene, k, restitution_of(scene, k, closed), s%v, rigid_pair(closed))
+      call check_dissipative(scene, s%t, v_before, v_after, error)
+      if (allocated(error)) return
       call apply(scene, s, v_after)
       if (all(scene%normal(:, k) /= 0.0_wp)) entry_scale = maxval(entry_scale)
       call log_event(sink, stats, s%t, event_impact + k, v_before, v_after)
@@ -337,6 +342,23 @@ contains
     s%v(i) = 0.0_wp
     s%v_lo(i) = 0.0_wp
   end subroutine zero_velocity
+
+  !> An impact with restitutions <= 1 cannot raise the kinetic energy: if one ever does (to
+  !> more than the rounding of its sum), the engine is wrong, and the run says so rather than
+  !> return numbers booked as a negative impact loss.
+  subroutine check_dissipative(scene, t, v_before, v_after, error)
+    type(scene_type), intent(in) :: scene
+    real(wp), intent(in) :: t, v_before(2), v_after(2)
+    type(error_type), allocatable, intent(inout) :: error
+    real(wp) :: ke_before, ke_after
+    ke_before = kinetic_energy(scene, v_before)
+    ke_after = kinetic_energy(scene, v_after)
+    if (ke_after <= ke_before * (1.0_wp + energy_rounding)) return
+    call raise(error, status_simulation, 'at t = ' // trim(fmt(t)) // ': internal error: an impact ' // &
+      'raised the kinetic energy from ' // trim(fmt(ke_before)) // ' to ' // trim(fmt(ke_after)) // &
+      ' J (velocities ' // trim(fmt(v_before(1))) // ', ' // trim(fmt(v_before(2))) // ' -> ' // &
+      trim(fmt(v_after(1))) // ', ' // trim(fmt(v_after(2))) // '); please report the scene')
+  end subroutine check_dissipative
 
   !> Set new velocities at an instant, booking the kinetic energy they remove as impact loss.
   pure subroutine apply(scene, s, v_new)

@@ -21,16 +21,20 @@ contains
   !> Velocities after an impulse on contact k that leaves the normal velocity at -r times
   !> its value before. For the slot this is the tutorial's two-body formula; for a wall v' = -r v.
   !> With rigid (the bodies locked by a rigid link) a wall stops or throws back both as one
-  !> body: v' = v - (1 + r) u n_i for both, the link carrying the impulse.
+  !> body of mass m1 + m2, the link carrying the impulse: the pair's velocity is its centre of
+  !> mass's (a relative velocity the link cannot have is absorbed, as by a plastic link
+  !> impact), and the wall reverses that: v' = v_cm - (1 + r) u_cm n_i for both.
   pure function impulse(scene, k, r, v, rigid) result(v_after)
     type(scene_type), intent(in) :: scene
     integer, intent(in) :: k
     real(wp), intent(in) :: r, v(2)
     logical, intent(in), optional :: rigid
-    real(wp) :: v_after(2), p
+    real(wp) :: v_after(2), p, v_pair
     if (present(rigid)) then
       if (rigid .and. (k == i_left .or. k == i_right)) then
-        v_after = v - (1.0_wp + r) * normal_velocity(scene, k, v) * sum(scene%normal(:, k))
+        ! Written so that it is v(1) to the bit when the bodies already move together.
+        v_pair = v(1) + scene%mass(2) * (v(2) - v(1)) / sum(scene%mass)
+        v_after = v_pair - (1.0_wp + r) * normal_velocity(scene, k, [v_pair, v_pair]) * sum(scene%normal(:, k))
         return
       end if
     end if

@@ -6,7 +6,7 @@ module impact1d_yardsticks
   use impact1d_scene, only: scene_type
   implicit none
   private
-  public :: gap_rounding, velocity_rounding, time_rounding, force_scale, same_instant
+  public :: gap_rounding, velocity_rounding, time_rounding, energy_rounding, force_scale, same_instant
 
   !> Rounding of a gap, per unit it moved: a gap is exact to its own size (compensated
   !> positions, exact differences), so only what a step moved it by and the low parts count.
@@ -15,6 +15,9 @@ module impact1d_yardsticks
   real(wp), parameter :: velocity_rounding = 64.0_wp * eps_wp
   !> Instants closer than this (relative to the clock) coincide.
   real(wp), parameter :: time_rounding = 64.0_wp * eps_wp
+  !> Relative rounding of a kinetic energy after an impulse (a sum of positive terms, each
+  !> velocity a few roundings off): an elastic impact may end this much above where it began.
+  real(wp), parameter :: energy_rounding = 1024.0_wp * eps_wp
 
 contains
 
