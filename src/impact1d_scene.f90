@@ -500,10 +500,12 @@ contains
     if (input%given(i_zero_vel)) scene%zero_velocity = input%value(i_zero_vel)
     if (input%given(i_max_impulses)) scene%max_impulses = int(input%value(i_max_impulses))
     if (input%given(i_max_step_events)) scene%max_step_events = int(input%value(i_max_step_events))
-    ! Samples at j*dt_out, and at t_end when it is off that grid.
+    ! Samples at j*dt_out, and at t_end when it is off that grid. The grid always ends at
+    ! t_end (t_end > 0): a dt_out a billion times t_end rounds ratio to a grid of one sample.
     ratio = scene%t_end / scene%dt_out
     scene%n_samples = nint(ratio) + 1
     if (abs(ratio - nint(ratio)) > 1.0e-9_wp * max(1.0_wp, ratio)) scene%n_samples = floor(ratio) + 2
+    scene%n_samples = max(2, scene%n_samples)
   end subroutine build_scene
 
   !> Time of output sample j (0-based): j dt_out, and t_end for the last one.

@@ -844,3 +844,20 @@ def test_elastic_bounce_of_a_few_ulps_far_from_origin():
     res = impact1d.simulate(scene)
     assert res.steps <= 100_000
     assert_no_penetration(res, scene, tol=FAR_POSITION_TOL)
+
+
+# --- a sample spacing far beyond the run (issue 18, item 7) ----------------------------
+
+@pytest.mark.parametrize("method", ["event", "vissim"])
+@pytest.mark.parametrize("dt_out", [6.0, 6.0e9, 6.0e10, 1.0e300])
+def test_sample_grid_always_ends_at_t_end(method, dt_out):
+    """dt_out over 1e9 t_end rounded the sample grid to the t = 0 row alone: no step was
+    taken and the initial state was reported as final. The grid always ends at t_end."""
+    scene = impact1d.load_scene(INPUT / "case3.nml")
+    reference = impact1d.simulate(scene, dt_out=6.0, method=method)
+    res = impact1d.simulate(scene, dt_out=dt_out, method=method)
+    np.testing.assert_array_equal(res.t, [0.0, 6.0])
+    np.testing.assert_array_equal(res.samples, reference.samples)
+    assert len(res.events) == len(reference.events) == 41
+    row = impact1d.sweep(scene, [dict(dt_out=dt_out, method=method)], workers=1).iloc[0]
+    assert row["x1_end"] == reference.x1[-1] and row["n_impacts"] == 41 and row["steps"] > 0
