@@ -56,6 +56,21 @@ ZENO_TAIL_TIME = 1e-3    # s
 # rounding floor (the reference at 1e-15 m/s); impacts slower than this are rounding.
 NOISE_SPEED = 1e-12      # m/s
 
+# Convention difference 3: a nested Zeno series (a body rattling between a wall and the
+# other body; each wall series reopens the slot) has infinitely many rest/release cycles
+# before its accumulation, their speeds falling geometrically (scene 56: 4.1e-11,
+# 2.5e-12, 1.5e-13, 9.3e-15 m/s a cycle).  Each solver ends the nesting at its own floor
+# (the reference at ZENO_TIME 1e-13 s and 1e-15 m/s, the engine at its clock's and
+# velocities' rounding), so the last cycles' rest_/release_ entries exist in one log only.
+# Checked against a 50-digit event-driven solution (issue 18): the engine's are real
+# (scene 56's release_slot_min at 2.0849134173335839 s, exact 2.0849134173335844) and in
+# scene 12 the engine is closer to exact than the reference.  Rule: a rest_/release_ entry
+# in one log only, every velocity in it below NESTED_TAIL_SPEED, within NESTED_TAIL_TIME
+# of another rest_/release_ entry (of either log: the cluster at the accumulation), is not
+# compared.  Impacts above NOISE_SPEED, final states and every other entry still are.
+NESTED_TAIL_SPEED = 1e-11   # m/s
+NESTED_TAIL_TIME = 1e-12    # s
+
 DT = 1e-2
 N_SCENES = 150
 SEED = 20240603
@@ -100,6 +115,19 @@ def _in_tail(t, rest_times):
     return any(tr - ZENO_TAIL_TIME <= t <= tr + EVENT_TIME_TOL for tr in rest_times)
 
 
+def _persistence(kind):
+    return kind.startswith(("rest_", "release_"))
+
+
+def _in_nested_tail(e, got, want):
+    """e (a rest_/release_ entry in one log only) is a rounding-level relabelling in the
+    last cycles of a nested series: see NESTED_TAIL_SPEED."""
+    if not _persistence(e[1]) or max(abs(v) for v in e[2:]) > NESTED_TAIL_SPEED:
+        return False
+    return any(o is not e and _persistence(o[1]) and abs(o[0] - e[0]) <= NESTED_TAIL_TIME
+               for o in (*got, *want))
+
+
 def compare_events(got, want):
     """Problems (list of text) between the engine's events `got` and the reference's
     `want`, both lists of (t, kind, v1b, v2b, v1a, v2a).  Compared per kind, sorted by
@@ -123,6 +151,8 @@ def compare_events(got, want):
                     continue  # the last impacts of a Zeno series (see ZENO_TAIL_SPEED)
                 if kind[:-1] in ("stick", "slip") and _in_tail(e[0], rests.values()):
                     continue  # stops and starts inside a Zeno tail (see ZENO_TAIL_SPEED)
+                if _in_nested_tail(e, got, want):
+                    continue  # the last cycles of a nested series (see NESTED_TAIL_SPEED)
                 problems.append(f"{kind} at t = {e[0]!r} only in the {side} log {e[2:]}")
         if kind in IMPACTS:
             for i, j in pairs:
@@ -355,42 +385,13 @@ def table_folder(tmp_path_factory):
     return str(tmp_path_factory.mktemp("reference_tables"))
 
 
-# Disagreements reported to the lead (issue 3), index -> reason.  Remove an entry when
-# the engine is fixed: xfail(strict=True) then fails, as a reminder.  Checked against the
-# reference after it adopted the engine's conventions (release_<c> at the instant the
-# contact force reaches zero / friction breaks away with a zero separating acceleration
-# but a positive rate; a rigid link hits a wall as one body, v' = -r v).
-_CHATTER_LOG = ("engine bug: log entries at rounding-level velocities (<= 3e-13 m/s) while "
-                "nothing moves: a release_slot_min at 2.0849134173335844 s and a "
-                "rest_slot_min 5e-14 s later (just outside the window in which the engine "
-                "cancels a release and re-rest as one instant)")
-_NESTED = ("unadjudicated rounding tail (both solvers imperfect): a nested bounce series "
-           "(a body rattling between a wall and the other body) goes through rest/release "
-           "cycles of the slot and the wall that both solvers follow identically to ~1e-12 s "
-           "of the accumulation; they part in the last cycles, where the normal speeds are "
-           "rounding-level (<= 3e-12 m/s): rest_/release_ events there exist in one log only. The "
-           "exact solution has none of them (only impacts, then one rest per contact); final "
-           "states and all impacts above NOISE_SPEED agree")
-KNOWN_ENGINE_BUGS: dict = {
-    56: _CHATTER_LOG,
-    **{i: _NESTED for i in (6, 12, 90)},
-}
-# The engine never returns on these (an endless loop, no error): they cannot even be
-# xfailed without hanging the suite.  None left (the engine was fixed).
-ENGINE_HANGS: set = set()
-
+# Scenes once marked here as engine bugs (56, 6, 12, 90) were nested Zeno series whose
+# last cycles each solver cuts at its own floor: see NESTED_TAIL_SPEED.  A new
+# disagreement is a failure to investigate (against a 50-digit solution) before either
+# the engine or the reference changes.
 
 def _params():
-    out = []
-    for i in range(N_SCENES):
-        marks = []
-        if i in ENGINE_HANGS:
-            marks.append(pytest.mark.skip(reason="engine bug: simulate() never returns "
-                                          "(reported; would hang the suite)"))
-        elif i in KNOWN_ENGINE_BUGS:
-            marks.append(pytest.mark.xfail(strict=True, reason=KNOWN_ENGINE_BUGS[i]))
-        out.append(pytest.param(i, id=f"scene_{i:03d}_{FAMILIES[i % len(FAMILIES)]}", marks=marks))
-    return out
+    return [pytest.param(i, id=f"scene_{i:03d}_{FAMILIES[i % len(FAMILIES)]}") for i in range(N_SCENES)]
 
 
 @pytest.mark.parametrize("index", _params())
