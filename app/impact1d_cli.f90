@@ -163,6 +163,8 @@ program impact1d_cli
   if (allocated(error)) call fail(error%status, scene_path // ': ' // error%message)
   if (allocated(close_error)) call fail(close_error%status, close_error%message)
   call summary()
+  ! Not an error, but the numbers need it said beside them (a step coarse for a spring).
+  if (len(scene%warnings) > 0) write(output_unit, '(a)') '  warning   ' // scene%warnings
 
 contains
 

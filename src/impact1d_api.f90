@@ -85,7 +85,7 @@ contains
   !> springs and dampers): they fill samples' first columns, in column_names' order.
   subroutine simulate(n, values, given, title, f1_table, f2_table, method, progress, max_samples, &
       n_cols, max_events, samples, has_column, event_t, event_kind, event_v, n_samples, n_events, steps, &
-      energy_residual, status, message)
+      energy_residual, status, message, warnings)
     !f2py threadsafe
     integer(c_int), intent(in) :: n
     real(c_double), intent(in) :: values(n)
@@ -101,6 +101,7 @@ contains
     real(c_double), intent(out) :: energy_residual
     integer(c_int), intent(out) :: status
     character(len=512), intent(out) :: message
+    character(len=1024), intent(out) :: warnings   !< the scene's warnings, one per line
     type(scene_input) :: input
     type(scene_type) :: scene
     type(run_stats) :: stats
@@ -113,6 +114,7 @@ contains
     has_column = 0
     steps = 0
     energy_residual = 0.0_c_double
+    warnings = ''
     if (.not. field_count_ok(n, status, message)) return
     if (n_cols /= n_columns) then
       status = status_input
@@ -122,6 +124,7 @@ contains
     input = flat_input(values, given, title, f1_table, f2_table, method)
     call prepare_scene(input, scene, error)
     if (failed(error, status, message)) return
+    warnings = scene%warnings
     columns = present_columns(input)
     has_column(columns) = 1
     ! The rows go straight into samples when it has room (else the sink keeps them and the

@@ -6,6 +6,7 @@ module impact1d_scene
   use impact1d_error, only: error_type, raise, status_input, fmt, fmt_width
   use impact1d_forcing, only: forcing_type, table_type
   use impact1d_springs, only: springs_type, n_elements
+  use impact1d_stability, only: linear_modes, stable_step, mode_error, coarse_rate
   implicit none
   private
   public :: n_real, n_text, real_names, text_names, scene_input, scene_type, build_scene, validate
@@ -79,6 +80,8 @@ module impact1d_scene
   !> The checked model. Friction bounds: sliding c_i = mu_i m_i g, static mus_i m_i g >= c_i.
   type :: scene_type
     character(len=:), allocatable :: title, method
+    !> What the run should know but does not stop it (a coarse step), one per line; '' if none.
+    character(len=:), allocatable :: warnings
     real(wp) :: mass(2), friction(2), static_friction(2)
     type(springs_type) :: springs
     !> Bodies in the scene: 1 (m2 not given) or 2. A one-body scene keeps a body 2 at rest
@@ -498,6 +501,9 @@ contains
     scene%dt_out = scene%dt
     if (input%given(i_dt_out)) scene%dt_out = input%value(i_dt_out)
     if (input%given(i_zero_vel)) scene%zero_velocity = input%value(i_zero_vel)
+    scene%warnings = ''
+    if (scene%springs%present) call check_step(scene, error)
+    if (allocated(error)) return
     if (input%given(i_max_impulses)) scene%max_impulses = int(input%value(i_max_impulses))
     if (input%given(i_max_step_events)) scene%max_step_events = int(input%value(i_max_step_events))
     ! Samples at j*dt_out, and at t_end when it is off that grid. The grid always ends at
@@ -507,6 +513,83 @@ contains
     if (abs(ratio - nint(ratio)) > 1.0e-9_wp * max(1.0_wp, ratio)) scene%n_samples = floor(ratio) + 2
     scene%n_samples = max(2, scene%n_samples)
   end subroutine build_scene
+
+  !> RK4's step against the modes of the springs and dampers (impact1d_stability): past the
+  !> largest stable step the numbers would be garbage (positions to 1e76 with a normal exit),
+  !> so the scene is refused; a stable step that is coarse for the fastest mode gets a warning
+  !> with the error RK4 makes on that mode (a spring at w dt = 1 loses most of its energy in a
+  !> few periods without it). Each message names the element that sets the fastest rate.
+  subroutine check_step(scene, error)
+    type(scene_type), intent(inout) :: scene
+    type(error_type), allocatable, intent(inout) :: error
+    real(wp) :: k(scene%n_bodies, scene%n_bodies), c(scene%n_bodies, scene%n_bodies), h_stable
+    complex(wp) :: lambda(2 * scene%n_bodies), fastest
+    logical :: ok
+    integer :: j
+
+    call scene%springs%linear_part(scene%n_bodies, k, c)
+    call linear_modes(scene%mass(:scene%n_bodies), c, k, lambda, ok)
+    if (.not. ok) then
+      call raise(error, status_input, 'the modes of the springs and dampers could not be found ' // &
+        '(eigenvalues did not converge): please report the scene')
+      return
+    end if
+    h_stable = minval([(stable_step(lambda(j)), j = 1, size(lambda))])
+    fastest = lambda(maxloc(abs(lambda), 1))
+    if (scene%dt > h_stable) then
+      call raise(error, status_input, 'dt = ' // trim(fmt(scene%dt)) // ' is past RK4''s stability ' // &
+        'limit for this scene''s springs and dampers: its fastest mode (' // trim(mode_text(fastest)) // &
+        ', set by ' // trim(fastest_element(scene)) // ') needs dt <= ' // trim(fmt(h_stable)) // &
+        ' (the numbers would grow without bound): lower dt')
+    else if (abs(fastest) * scene%dt > coarse_rate) then
+      scene%warnings = 'dt = ' // trim(fmt(scene%dt)) // ' is coarse for this scene''s fastest mode (' // &
+        trim(mode_text(fastest)) // ', set by ' // trim(fastest_element(scene)) // '): |lambda| dt = ' // &
+        trim(fmt(abs(fastest) * scene%dt)) // ' > ' // trim(fmt(coarse_rate)) // ', so RK4''s relative ' // &
+        'error on it is about ' // trim(two_digits(mode_error(fastest, scene%dt))) // ' over each of its ' // &
+        trim(merge('periods        ', 'time constants ', aimag(fastest) /= 0.0_wp)) // &
+        ' (order dt^4: halve dt for 1/16 of it)'
+    end if
+  end subroutine check_step
+
+  !> An estimate, to two digits ('5.1E-02').
+  pure function two_digits(x) result(text)
+    real(wp), intent(in) :: x
+    character(len=12) :: text     ! blank padded: callers trim
+    write(text, '(es12.1)') x
+    text = adjustl(text)
+  end function two_digits
+
+  !> 'w = 31.6 rad/s, damping rate 0.5 1/s' for a mode lambda (for messages).
+  pure function mode_text(lambda) result(text)
+    complex(wp), intent(in) :: lambda
+    character(len=2 * fmt_width + 40) :: text     ! blank padded: callers trim
+    if (aimag(lambda) /= 0.0_wp .and. -real(lambda, wp) <= 1024.0_wp * eps_wp * abs(lambda)) then
+      text = 'w = ' // trim(fmt(abs(aimag(lambda)))) // ' rad/s, undamped'   ! (a rounding-level real part)
+    else if (aimag(lambda) /= 0.0_wp) then
+      text = 'w = ' // trim(fmt(abs(aimag(lambda)))) // ' rad/s, damping rate ' // &
+        trim(fmt(-real(lambda, wp))) // ' 1/s'
+    else
+      text = 'decay rate ' // trim(fmt(-real(lambda, wp))) // ' 1/s'
+    end if
+  end function mode_text
+
+  !> The spring or damper with the fastest rate of its own ('k12 = 1e4'): sqrt(k / m) or c / m
+  !> with m the mass it moves (the reduced mass between the bodies).
+  pure function fastest_element(scene) result(text)
+    type(scene_type), intent(in) :: scene
+    character(len=fmt_width + 24) :: text     ! blank padded: callers trim
+    real(wp) :: mass(n_elements), rate(2 * n_elements)
+    integer :: j
+    mass = [scene%mass(1), scene%mass(2), 1.0_wp / (1.0_wp / scene%mass(1) + 1.0_wp / scene%mass(2))]
+    rate = [sqrt(scene%springs%k / mass), scene%springs%c / mass]
+    j = maxloc(rate, 1)
+    if (j <= n_elements) then
+      text = trim(real_names(spring_index(j))) // ' = ' // trim(fmt(scene%springs%k(j)))
+    else
+      text = trim(real_names(spring_index(j - n_elements) + 2)) // ' = ' // &
+        trim(fmt(scene%springs%c(j - n_elements)))
+    end if
+  end function fastest_element
 
   !> Time of output sample j (0-based): j dt_out, and t_end for the last one.
   pure real(wp) function sample_time(scene, j)

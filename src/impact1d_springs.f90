@@ -23,6 +23,7 @@ module impact1d_springs
     procedure :: potential
     procedure :: damping_power
     procedure :: frequency
+    procedure :: linear_part
   end type springs_type
 
 contains
@@ -92,4 +93,27 @@ contains
     damping = self%c(1) + self%c(2) + 2.0_wp * self%c(3)
     frequency = sqrt(stiffness / minval(mass)) + damping / minval(mass)
   end function frequency
+
+  !> Stiffness and damping matrices (K, C in M x'' + C x' + K x = f) of n bodies (1 or 2:
+  !> a one-body scene has no body-2 or link element).
+  pure subroutine linear_part(self, n, k, c)
+    class(springs_type), intent(in) :: self
+    integer, intent(in) :: n
+    real(wp), intent(out) :: k(n, n), c(n, n)
+    call assemble(self%k, k)
+    call assemble(self%c, c)
+  end subroutine linear_part
+
+  !> The matrix of the three elements' coefficients (to the ground, to the ground, between).
+  pure subroutine assemble(coefficient, matrix)
+    real(wp), intent(in) :: coefficient(n_elements)
+    real(wp), intent(out) :: matrix(:, :)
+    matrix = 0.0_wp
+    matrix(1, 1) = coefficient(1)
+    if (size(matrix, 1) == 1) return
+    matrix(2, 2) = coefficient(2) + coefficient(3)
+    matrix(1, 1) = matrix(1, 1) + coefficient(3)
+    matrix(1, 2) = -coefficient(3)
+    matrix(2, 1) = -coefficient(3)
+  end subroutine assemble
 end module impact1d_springs

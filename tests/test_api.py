@@ -280,10 +280,11 @@ def test_flat_simulate_says_what_room_it_needs():
     core = to_core(scene)
     for rows, events in ((3, 2000), (len(expected.t) + 1, 2)):
         out = _api.simulate(*core, 0, rows, len(COLUMNS), events)
-        status, n_samples, n_events = int(out[-2]), int(out[5]), int(out[6])
+        status, n_samples, n_events = int(out[-3]), int(out[5]), int(out[6])
         assert status == 3
         assert (n_samples, n_events) == (len(expected.t), len(expected.events))
-    samples, has_column, *_, status, message = _api.simulate(*core, 0, n_samples, len(COLUMNS), n_events)
+    samples, has_column, *_, status, message, _warnings = _api.simulate(
+        *core, 0, n_samples, len(COLUMNS), n_events)
     assert int(status) == 0
     present = [name for name, flag in zip(COLUMNS, has_column) if flag]
     assert present == list(expected.columns)

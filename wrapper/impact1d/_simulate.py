@@ -135,6 +135,9 @@ class Result:
     energy_residual: float = 0.0       # max |residual| over the samples
     steps: Optional[int] = None        # integrator steps taken (None: read from a file)
     scene: Optional[Scene] = None
+    # What the run should know but did not stop it, one sentence each (a step that is
+    # coarse for the springs' fastest mode, with the error RK4 makes on it).
+    warnings: tuple = ()
 
     @property
     def columns(self) -> tuple:
@@ -150,6 +153,11 @@ class Result:
         title = self.scene.title if self.scene is not None else None
         return (f"Result({title!r}: {len(self.t)} samples, {len(self.events)} events, "
                 f"steps={self.steps}, energy_residual={self.energy_residual:.3g})")
+
+
+def _lines(text) -> tuple:
+    """The core's newline-separated texts as a tuple of sentences (none: ())."""
+    return tuple(line for line in decode(text).split("\n") if line.strip())
 
 
 def result_from_columns(samples: np.ndarray, events: np.ndarray, names=COLUMNS, **extra) -> Result:
@@ -186,7 +194,7 @@ def simulate(scene: Scene, *, progress: bool = False, **overrides) -> Result:
     sample_capacity, event_capacity = _sample_capacity(scene), _event_capacity
     while True:
         (samples, has_column, event_t, event_kind, event_v, n_samples, n_events, steps,
-         energy_residual, status, message) = _api.simulate(values, given, title, f1_table, f2_table, method,
+         energy_residual, status, message, warnings) = _api.simulate(values, given, title, f1_table, f2_table, method,
                                           1 if progress else 0, sample_capacity, len(COLUMNS),
                                           event_capacity)
         if int(status) != _STATUS_TOO_SMALL:
@@ -209,4 +217,5 @@ def simulate(scene: Scene, *, progress: bool = False, **overrides) -> Result:
             events["v2_before"], events["v2_after"] = event_v[1, :n_events], event_v[3, :n_events]
     # The present columns come first in the core's array.
     return result_from_columns(samples[:n_samples, :len(names)], events, names,
-                               energy_residual=float(energy_residual), steps=int(steps), scene=scene)
+                               energy_residual=float(energy_residual), steps=int(steps), scene=scene,
+                               warnings=_lines(warnings))
