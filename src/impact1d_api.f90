@@ -7,7 +7,8 @@ module impact1d_api
   use, intrinsic :: iso_c_binding, only: c_double, c_int
   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
   use impact1d_kinds, only: wp
-  use impact1d_error, only: error_type, status_ok, status_input
+  use impact1d_error, only: error_type, status_ok, status_input, status_interrupted
+  use impact1d_interrupt, only: catch_interrupts
   use impact1d_scene, only: scene_input, scene_type, n_real, n_text, real_names, text_names, &
     i_title, i_f1_table, i_f2_table, i_method, n_contacts
   use impact1d_io, only: read_scene_file, prepare_scene
@@ -125,6 +126,7 @@ contains
     call prepare_scene(input, scene, error)
     if (failed(error, status, message)) return
     warnings = scene%warnings
+    call catch_interrupts()
     columns = present_columns(input)
     has_column(columns) = 1
     ! The rows go straight into samples when it has room (else the sink keeps them and the
@@ -189,6 +191,7 @@ contains
       return
     end if
     base = flat_input(values, given, title, f1_table, f2_table, method)
+    call catch_interrupts()
     do j = 1, n_runs
       input = base
       input%value(over_index) = real(over_values(:, j), wp)
@@ -200,6 +203,11 @@ contains
       end if
       if (failed(error, status(j), message)) then
         message_codes(:, j) = [(iachar(message(k:k)), k = 1, message_length)]
+        ! An interrupt ends the batch: the runs not made say so too.
+        if (status(j) == status_interrupted) then
+          status(j + 1:) = status_interrupted
+          exit
+        end if
         cycle
       end if
       summary(:, j) = [stats%last_row([2, 3, 4, 5, 6]), &

@@ -5,11 +5,12 @@ module impact1d_error
   use impact1d_kinds, only: wp
   implicit none
   private
-  public :: error_type, raise, status_ok, status_input, status_simulation, fmt, fmt_width
+  public :: error_type, raise, status_ok, status_input, status_simulation, status_interrupted, fmt, fmt_width
 
   integer, parameter :: status_ok = 0          !< no error
   integer, parameter :: status_input = 1       !< the scene or its files are wrong: Python's InputError
   integer, parameter :: status_simulation = 2  !< the run cannot go on: Python's SimulationError
+  integer, parameter :: status_interrupted = 4 !< Ctrl-C (SIGINT) during the run: Python's KeyboardInterrupt
 
   !> An error: its class (status_input or status_simulation) and a one-line message.
   type :: error_type

@@ -5,13 +5,14 @@ module impact1d_output
   use, intrinsic :: iso_fortran_env, only: error_unit, int64
   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
   use impact1d_kinds, only: wp
-  use impact1d_error, only: error_type, raise, status_input, status_simulation, fmt
+  use impact1d_error, only: error_type, raise, status_input, status_simulation, status_interrupted, fmt
+  use impact1d_interrupt, only: interrupt_count
   use impact1d_scene, only: scene_input, real_names, n_real, i_title, i_method, i_g, i_dt_out, &
     i_dt, default_gravity, i_k1, i_k2, i_k12, i_c1, i_c2, i_c12, i_m2
   implicit none
   private
   public :: sink_type, memory_sink, summary_sink, file_sink, n_columns, column_names, n_event_kinds, event_names
-  public :: event_impact, event_rest, event_release, event_stick, event_slip, make_folder, run_stats
+  public :: event_impact, event_rest, event_release, event_stick, event_slip, make_folder, run_stats, checkpoint
   public :: emit_sample, events_path, present_columns, i_pe, i_work, i_friction_loss, i_impact_loss, &
     i_damping_loss
 
@@ -40,6 +41,8 @@ module impact1d_output
     integer :: events(n_event_kinds) = 0
     real(wp) :: last_row(n_columns) = 0.0_wp
     real(wp) :: max_residual = 0.0_wp
+    !> The interrupt count when the run started (impact1d_interrupt): a run ends when it moves on.
+    integer :: interrupt_epoch = 0
   end type run_stats
 
   !> Every sink can show progress on stderr for long runs: once a run has taken a second,
@@ -225,6 +228,18 @@ contains
       text = text // ' ' // trim(column_words(columns(k)))
     end do
   end subroutine names_of
+
+  !> Every 4096 steps of a run: progress on stderr where it is shown, and an interrupt
+  !> (Ctrl-C while Python waits for the run) ends the run within a fraction of a second.
+  subroutine checkpoint(sink, stats, t, t_end, error)
+    class(sink_type), intent(inout) :: sink
+    type(run_stats), intent(in) :: stats
+    real(wp), intent(in) :: t, t_end
+    type(error_type), allocatable, intent(inout) :: error
+    call sink%progress(t, t_end)
+    if (interrupt_count() /= stats%interrupt_epoch) &
+      call raise(error, status_interrupted, 'interrupted at t = ' // trim(fmt(t)) // ' s')
+  end subroutine checkpoint
 
   !> Called by the stepping loop every few thousand steps: cheap unless a line is due.
   subroutine progress(self, t, t_end)

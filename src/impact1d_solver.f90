@@ -12,8 +12,9 @@ module impact1d_solver
   use impact1d_scene, only: scene_type, n_contacts, sample_time
   use impact1d_modes, only: mode_type
   use impact1d_impacts, only: normal_velocity, kinetic_energy
-  use impact1d_output, only: sink_type, run_stats, emit_sample
+  use impact1d_output, only: sink_type, run_stats, emit_sample, checkpoint
   use impact1d_vissim, only: run_vissim
+  use impact1d_interrupt, only: interrupt_count
   use impact1d_state, only: state_type, renormalise, finite_state, constant_step, &
     constant_steps, unpack_motion, pack_motion
   use impact1d_contacts, only: gap, gap_tolerance, u_tolerance
@@ -54,6 +55,7 @@ contains
     logical :: located, at_stop, glided, event_due
     integer :: watched, window_events
 
+    stats%interrupt_epoch = interrupt_count()
     if (scene%method == 'vissim') then
       call run_vissim(scene, sink, stats, error)
       return
@@ -216,7 +218,10 @@ contains
       s%t_lo = 0.0_wp
     end if
     stats%steps = stats%steps + 1
-    if (iand(stats%steps, 4095_int64) == 0) call sink%progress(s%t, scene%t_end)
+    if (iand(stats%steps, 4095_int64) == 0) then
+      call checkpoint(sink, stats, s%t, scene%t_end, error)
+      if (allocated(error)) return
+    end if
     call check_finite(s, error)
   end subroutine advance
 
@@ -303,7 +308,10 @@ contains
           call constant_steps(n, h, dv, half_dv, t, t_lo, x, x_lo, v, v_lo)
           n_bulk = n_bulk - n
           stats%steps = stats%steps + n
-          if (iand(stats%steps, 4095_int64) == 0) call sink%progress(t, scene%t_end)
+          if (iand(stats%steps, 4095_int64) == 0) then
+            call checkpoint(sink, stats, t, scene%t_end, error)
+            if (allocated(error)) return       ! (an interrupt: the state is left as it is)
+          end if
         end do
         call renormalise(t, t_lo)
         call renormalise(x, x_lo)
@@ -317,7 +325,10 @@ contains
         at_stop = h == (t_stop - s%t) - s%t_lo
         call rk%advance_constant(s, h)
         stats%steps = stats%steps + 1
-        if (iand(stats%steps, 4095_int64) == 0) call sink%progress(s%t, scene%t_end)
+        if (iand(stats%steps, 4095_int64) == 0) then
+          call checkpoint(sink, stats, s%t, scene%t_end, error)
+          if (allocated(error)) return
+        end if
         if (at_stop) then
           s%t = t_stop
           s%t_lo = 0.0_wp
@@ -366,7 +377,10 @@ contains
       t = t_stop        ! (the step ends at the stop: the clock is set to it, as in glide)
       t_lo = 0.0_wp
       stats%steps = stats%steps + 1
-      if (iand(stats%steps, 4095_int64) == 0) call sink%progress(t, scene%t_end)
+      if (iand(stats%steps, 4095_int64) == 0) then
+        call checkpoint(sink, stats, t, scene%t_end, error)
+        if (allocated(error)) exit
+      end if
       if (books) then
         ! (s%x: where the last step began.)
         call book_constant_ledger(scene, mode, s%x, s%x_lo, x, x_lo, s)

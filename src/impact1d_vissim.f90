@@ -12,7 +12,7 @@ module impact1d_vissim
   use impact1d_scene, only: scene_type, n_contacts, i_left, i_right, i_slot_min, i_slot_max, &
     sample_time
   use impact1d_impacts, only: impulse, kinetic_energy
-  use impact1d_output, only: sink_type, run_stats, emit_sample, event_impact
+  use impact1d_output, only: sink_type, run_stats, emit_sample, event_impact, checkpoint
   use impact1d_loads, only: applied_force
   implicit none
   private
@@ -23,7 +23,7 @@ contains
   subroutine run_vissim(scene, sink, stats, error)
     type(scene_type), intent(in) :: scene
     class(sink_type), intent(inout) :: sink
-    type(run_stats), intent(out) :: stats
+    type(run_stats), intent(inout) :: stats   !< fresh from run (its interrupt epoch set)
     type(error_type), allocatable, intent(out) :: error
     real(wp) :: t, x(2), v(2), v_prev(2), x_new(2), v_new(2), work, friction_loss, impact_loss
     real(wp) :: ke0, pe0, h, t_sample, gap_before(n_contacts), v_hit(2), dwork, dfriction
@@ -60,7 +60,10 @@ contains
       friction_loss = friction_loss + dfriction
       damping_loss = damping_loss + ddamping
       stats%steps = stats%steps + 1
-      if (iand(stats%steps, 4095_int64) == 0) call sink%progress(t, scene%t_end)
+      if (iand(stats%steps, 4095_int64) == 0) then
+        call checkpoint(sink, stats, t, scene%t_end, error)
+        if (allocated(error)) return
+      end if
       if (.not. all(abs([x, v]) <= huge(1.0_wp))) then
         call raise(error, status_simulation, 'at t = ' // trim(fmt(t)) // ': the state is no longer finite')
         return

@@ -171,12 +171,20 @@ def to_core(scene: Scene):
     return (values, given, *texts)
 
 
+# The api's status for a run that an interrupt (SIGINT) ended.
+_STATUS_INTERRUPTED = 4
+
+
 def raise_for_status(status, message) -> None:
     """Turn an api status and message into the package's exceptions."""
     status = int(status)
     if status == 0:
         return
     text = decode(message) or f"impact1d core returned status {status}"
+    if status == _STATUS_INTERRUPTED:
+        # Ctrl-C ended the run (the core saw SIGINT at a checkpoint); Python's own handler
+        # has usually raised already by the time this line runs.
+        raise KeyboardInterrupt(text)
     if status == 1:
         raise InputError(text)
     raise SimulationError(text)

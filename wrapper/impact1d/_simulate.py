@@ -9,7 +9,8 @@ from typing import Optional
 
 import numpy as np
 
-from ._scene import REAL_FIELDS, Scene, InputError, decode, raise_for_status, to_core, _words, _api
+from ._scene import (REAL_FIELDS, Scene, InputError, decode, raise_for_status, to_core, _words, _api,
+                     _STATUS_INTERRUPTED)
 
 __all__ = ["Result", "simulate", "COLUMNS", "EVENT_DTYPE", "ONE_BODY_EVENT_DTYPE"]
 
@@ -64,6 +65,8 @@ def run_summaries(scene: Scene, overrides: list):
     errors = [""] * len(overrides)
     for j in np.flatnonzero(status):
         errors[j] = decode(np.asarray(codes[:, j], dtype=np.uint8).tobytes())
+        if status[j] == _STATUS_INTERRUPTED:
+            raise KeyboardInterrupt(errors[j])     # Ctrl-C ended the batch
     return dict(zip(_summary_names(), summary)), errors
 
 

@@ -208,9 +208,13 @@ def sweep(scene: Scene, params, *, workers: Optional[int] = None, client=None,
             chunks = [runs[i:i + size] for i in range(0, len(runs), size)]
             futures = client.map(run_chunk, [scene] * len(chunks), chunks, pure=False)
             outputs = []
-            for future, chunk in zip(futures, chunks):
-                outputs.append(future.result())
-                bar.update(len(chunk))
+            try:
+                for future, chunk in zip(futures, chunks):
+                    outputs.append(future.result())
+                    bar.update(len(chunk))
+            except KeyboardInterrupt:
+                client.cancel(futures)      # the cluster does not go on with a sweep no one waits for
+                raise
         elif workers == 1:
             outputs = []
             for chunk in chunks:
@@ -219,10 +223,16 @@ def sweep(scene: Scene, params, *, workers: Optional[int] = None, client=None,
         else:
             with ThreadPoolExecutor(max_workers=workers) as pool:
                 outputs = []
-                for chunk, output in zip(chunks, pool.map(
-                        lambda c: run_chunk(scene, c, keep_results), chunks)):
-                    outputs.append(output)
-                    bar.update(len(chunk))
+                try:
+                    for chunk, output in zip(chunks, pool.map(
+                            lambda c: run_chunk(scene, c, keep_results), chunks)):
+                        outputs.append(output)
+                        bar.update(len(chunk))
+                except KeyboardInterrupt:
+                    # The runs in progress saw the interrupt too and end at their next
+                    # checkpoint; the chunks not started are dropped.
+                    pool.shutdown(wait=True, cancel_futures=True)
+                    raise
     finally:
         bar.close()
 
