@@ -2,15 +2,16 @@
 !> streams the run to OUT.dat and OUT.events.dat, prints a summary. Any error: one line on
 !> stderr and a non-zero exit status (1 bad input, 2 the run could not go on).
 program impact1d_cli
-  use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
-  use, intrinsic :: iso_c_binding, only: c_int, c_char, c_ptr, c_null_char, c_associated
+  use, intrinsic :: iso_fortran_env, only: error_unit
+  use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char
   use impact1d_kinds, only: wp
-  use impact1d_error, only: error_type, status_input, fmt
+  use impact1d_error, only: error_type, status_input, status_simulation, fmt
   use impact1d_scene, only: scene_input, scene_type, i_t_end, i_dt, i_dt_out, i_method, i_title, &
     i_f1_table, i_f2_table
   use impact1d_io, only: read_scene_file, prepare_scene, lower
-  use impact1d_output, only: file_sink, make_folder, event_names, n_event_kinds, events_path, i_pe, i_work, &
+  use impact1d_output, only: file_sink, event_names, n_event_kinds, events_path, i_pe, i_work, &
     i_friction_loss, i_impact_loss, i_damping_loss
+  use impact1d_files, only: make_folders, resolve, write_stdout
   use impact1d_solver, only: run, run_stats
   use impact1d_version, only: version
   implicit none
@@ -35,11 +36,6 @@ program impact1d_cli
       import :: c_int
       integer(c_int), value :: fd
     end function c_isatty
-    type(c_ptr) function c_realpath(path, resolved) bind(C, name='realpath')
-      import :: c_ptr, c_char
-      character(kind=c_char), intent(in) :: path(*)
-      character(kind=c_char), intent(out) :: resolved(*)
-    end function c_realpath
   end interface
 
   character(len=*), parameter :: usage = &
@@ -55,11 +51,14 @@ program impact1d_cli
     '  --dt-out DT_OUT  time between samples (s); default dt; finer or coarser than dt' // nl // &
     '  --method NAME    event   event-driven: every impact, stop and break-away located (default)' // nl // &
     '                   vissim  the VisSim tutorial''s fixed-step scheme, O(dt) (any letter case)' // nl // &
-    '  -o OUT.dat       where the samples go (never one of the run''s own input files)' // nl // &
+    '  -o OUT.dat       where the samples go (never one of the run''s own input files; a link' // nl // &
+    '                   to a regular file is written through, a FIFO or a device refused)' // nl // &
     '  -h, --help       this text' // nl // &
     '  --version        the version' // nl // nl // &
     'Exit status: 0 done; 1 bad input (scene, tables, options, output path), nothing written;' // nl // &
-    '2 the run could not go on (the reason and the time on stderr), nothing written.' // nl // &
+    '2 the run could not go on (the reason and the time on stderr), nothing written, or the' // nl // &
+    'summary could not be written to stdout. A signal removes the temporary files and ends' // nl // &
+    'the run as it would any program (the previous output stays). Only regular files are read.' // nl // &
     'Formats and method: docs/formats.md, docs/method.md in the impact1d sources.'
   type(scene_input) :: input
   type(scene_type) :: scene
@@ -93,10 +92,10 @@ program impact1d_cli
     end if
     select case (option)
     case ('-h', '--help')
-      write(output_unit, '(a)') help
+      call say(help // nl, 'the help')
       stop
     case ('--version')
-      write(output_unit, '(a)') 'impact1d ' // version
+      call say('impact1d ' // version // nl, 'the version')
       stop
     case ('--t-end', '--dt', '--dt-out', '--method', '-o')
       if (.not. has_value) then
@@ -143,7 +142,8 @@ program impact1d_cli
   if (.not. out_given) out_path = 'output/' // stem(scene_path) // '.dat'
   call refuse_to_overwrite_inputs(out_path)
   call refuse_to_overwrite_inputs(trim(events_path(out_path)))
-  call make_parent_folders(out_path)
+  call make_folders(out_path, error)
+  if (allocated(error)) call fail(error%status, error%message)
   ! Held from creating the temporary files until they are registered: a signal in between
   ! would otherwise leave them behind.
   call hold_signals()
@@ -152,7 +152,7 @@ program impact1d_cli
     call release_signals()
     call fail(error%status, error%message)
   end if
-  call guard_temporaries(out_path // '.part' // c_null_char, trim(events_path(out_path)) // '.part' // c_null_char)
+  call guard_temporaries(sink%part // c_null_char, sink%event_part // c_null_char)
   call allow_signals()
   ! Progress only where a person watches: stderr a terminal (file descriptor 2).
   sink%show_progress = c_isatty(2_c_int) == 1
@@ -163,45 +163,61 @@ program impact1d_cli
   if (allocated(error)) call fail(error%status, scene_path // ': ' // error%message)
   if (allocated(close_error)) call fail(close_error%status, close_error%message)
   call summary()
-  ! Not an error, but the numbers need it said beside them (a step coarse for a spring).
-  if (len(scene%warnings) > 0) write(output_unit, '(a)') '  warning   ' // scene%warnings
 
 contains
 
+  !> The summary on stdout. Every number in ES with a three-digit exponent (7.73913E+157
+  !> lost its E in ES12.5).
   subroutine summary()
-    character(len=:), allocatable :: line
-    write(output_unit, '(a)') 'impact1d: ' // trim(input%text(i_title))
-    write(output_unit, '(a)') '  scene     ' // scene_path // ' (method ' // scene%method // ', dt = ' // &
-      trim(fmt(scene%dt)) // ' s, t_end = ' // trim(fmt(scene%t_end)) // ' s)'
-    write(output_unit, '(a)') '  output    ' // out_path // ' (' // trim(fmt(scene%n_samples)) // ' rows every ' // &
+    character(len=:), allocatable :: text, line
+    character(len=16) :: number
+    text = 'impact1d: ' // trim(input%text(i_title)) // nl
+    text = text // '  scene     ' // scene_path // ' (method ' // scene%method // ', dt = ' // &
+      trim(fmt(scene%dt)) // ' s, t_end = ' // trim(fmt(scene%t_end)) // ' s)' // nl
+    text = text // '  output    ' // out_path // ' (' // trim(fmt(scene%n_samples)) // ' rows every ' // &
       trim(fmt(scene%dt_out)) // ' s) and ' // trim(events_path(out_path)) // ' (' // &
-      trim(fmt(sum(stats%events))) // ' events)'
+      trim(fmt(sum(stats%events))) // ' events)' // nl
     line = ''
     do k = 1, n_event_kinds
       if (stats%events(k) > 0) line = line // ' ' // trim(event_names(k)) // ' ' // trim(fmt(stats%events(k)))
     end do
     if (len(line) == 0) line = ' none'
-    write(output_unit, '(a)') '  events   ' // line
-    if (scene%n_bodies == 2) then
-      write(output_unit, '(a, 5(a, es12.5))') '  final    ', ' t =', stats%last_row(1), '  x1 =', stats%last_row(2), &
-        '  v1 =', stats%last_row(3), '  x2 =', stats%last_row(4), '  v2 =', stats%last_row(5)
-    else
-      write(output_unit, '(a, 3(a, es12.5))') '  final    ', ' t =', stats%last_row(1), '  x1 =', stats%last_row(2), &
-        '  v1 =', stats%last_row(3)
-    end if
-    if (scene%springs%has_spring) then
-      write(output_unit, '(2(a, es12.5), a)') '  energy    KE =', stats%last_row(6), '  PE =', &
-        stats%last_row(i_pe), ' J'
-    else
-      write(output_unit, '(a, es12.5, a)') '  energy    KE =', stats%last_row(6), ' J'
-    end if
-    write(output_unit, '(a, 3(a, es12.5))', advance='no') '  ledger   ', ' work =', stats%last_row(i_work), &
-      '  friction loss =', stats%last_row(i_friction_loss), '  impact loss =', stats%last_row(i_impact_loss)
-    if (scene%springs%has_damper) write(output_unit, '(a, es12.5)', advance='no') '  damping loss =', &
-      stats%last_row(i_damping_loss)
-    write(output_unit, '(a, es9.2, a)') '  |residual| <=', stats%max_residual, ' J'
-    write(output_unit, '(a)') '  steps     ' // trim(fmt(stats%steps)) // ' RK4 steps'
+    text = text // '  events   ' // line // nl
+    text = text // '  final     t =' // es(stats%last_row(1)) // '  x1 =' // es(stats%last_row(2)) // &
+      '  v1 =' // es(stats%last_row(3))
+    if (scene%n_bodies == 2) text = text // '  x2 =' // es(stats%last_row(4)) // '  v2 =' // es(stats%last_row(5))
+    text = text // nl // '  energy    KE =' // es(stats%last_row(6))
+    if (scene%springs%has_spring) text = text // '  PE =' // es(stats%last_row(i_pe))
+    text = text // ' J' // nl // '  ledger    work =' // es(stats%last_row(i_work)) // '  friction loss =' // &
+      es(stats%last_row(i_friction_loss)) // '  impact loss =' // es(stats%last_row(i_impact_loss))
+    if (scene%springs%has_damper) text = text // '  damping loss =' // es(stats%last_row(i_damping_loss))
+    write(number, '(es10.2e3)') stats%max_residual
+    text = text // '  |residual| <=' // trim(number) // ' J' // nl
+    text = text // '  steps     ' // trim(fmt(stats%steps)) // ' RK4 steps' // nl
+    ! Not an error, but the numbers need it said beside them (a step coarse for a spring).
+    if (len(scene%warnings) > 0) text = text // '  warning   ' // scene%warnings // nl
+    call say(text, 'the summary', '(the output ' // out_path // ' is in place)')
   end subroutine summary
+
+  !> Text to stdout. Text that cannot be written (stdout closed, a full disk) is a failure,
+  !> status 2, one line on stderr (ending with note, if given): after a run the output
+  !> files are in place, but nobody saw how it went.
+  subroutine say(text, what, note)
+    character(len=*), intent(in) :: text, what
+    character(len=*), intent(in), optional :: note
+    character(len=:), allocatable :: reason
+    call write_stdout(text, reason)
+    if (len(reason) == 0) return
+    if (present(note)) reason = reason // ' ' // note
+    call fail(status_simulation, 'cannot write ' // what // ' to stdout: ' // reason)
+  end subroutine say
+
+  !> A number for the summary: ES with a three-digit exponent, which fits any double.
+  function es(x) result(text)
+    real(wp), intent(in) :: x
+    character(len=13) :: text
+    write(text, '(es13.5e3)') x
+  end function es
 
   !> Command-line argument i, whatever its length.
   function argument_text(i) result(text)
@@ -237,36 +253,20 @@ contains
   !> the run's inputs (the scene, a force table) would silently destroy it.
   subroutine refuse_to_overwrite_inputs(path)
     character(len=*), intent(in) :: path
-    character(len=:), allocatable :: target
-    target = resolved(path)
+    character(len=:), allocatable :: target, other
+    call resolve(path, target)
     if (len(target) == 0) return
-    if (target == resolved(scene_path)) call fail(status_input, 'cannot write output ' // path // &
+    call resolve(scene_path, other)
+    if (target == other) call fail(status_input, 'cannot write output ' // path // &
       ': it is the scene file ' // scene_path // ' (choose another -o)')
     do k = i_f1_table, i_f2_table
       if (len_trim(input%text(k)) == 0) cycle
-      if (target == resolved(trim(input%text(k)))) call fail(status_input, 'cannot write output ' // &
+      call resolve(trim(input%text(k)), other)
+      if (target == other) call fail(status_input, 'cannot write output ' // &
         path // ': it is the force table ' // trim(input%text(k)) // ' (choose another -o)')
     end do
   end subroutine refuse_to_overwrite_inputs
 
-  !> The absolute path of an existing file with every link resolved, '' if it does not exist.
-  function resolved(path) result(absolute)
-    character(len=*), intent(in) :: path
-    character(len=:), allocatable :: absolute
-    character(kind=c_char, len=4097) :: buffer
-    absolute = ''
-    if (.not. c_associated(c_realpath(path // c_null_char, buffer))) return
-    absolute = buffer(:index(buffer, c_null_char) - 1)
-  end function resolved
-
-  !> -o out/run1/x.dat: create out and out/run1, as the default output/ is created.
-  subroutine make_parent_folders(path)
-    character(len=*), intent(in) :: path
-    integer :: slash
-    do slash = 2, len(path)
-      if (path(slash:slash) == '/' .and. path(slash - 1:slash - 1) /= '/') call make_folder(path(:slash - 1))
-    end do
-  end subroutine make_parent_folders
 
   !> File name without folder and extension: input/case3.nml -> case3.
   function stem(path) result(name)

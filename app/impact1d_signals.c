@@ -1,8 +1,11 @@
-/* Signals for the impact1d CLI: an interrupted run (SIGINT, SIGTERM, SIGHUP) removes its
- * temporary output files and then dies of the signal as it would have without us, so no
- * `.part` file is left and the previous outputs are untouched. Only async-signal-safe
- * calls (unlink, sigaction, raise) run in the handler; the paths are copied into fixed
- * buffers before the run starts. */
+/* Signals for the impact1d CLI: a run ended by a signal (any whose default action ends the
+ * process: SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGUSR1, SIGPIPE, SIGALRM, ... and the faults
+ * SIGSEGV, SIGBUS, SIGFPE, SIGABRT) removes its temporary output files and then dies of the
+ * signal as it would have without us, so no `.part` file is left and the previous outputs
+ * are untouched. Only async-signal-safe calls (unlink, sigaction, raise) run in the
+ * handler; the paths are copied into fixed buffers before the run starts. Our handler
+ * replaces gfortran's backtrace handler (SIGQUIT, SIGSEGV, ...): the death is the default
+ * one, without a backtrace. */
 #include <signal.h>
 #include <string.h>
 #include <unistd.h>
@@ -11,7 +14,37 @@
 
 static char temporary[2][MAX_PATH_BYTES];
 static volatile sig_atomic_t n_temporary = 0;
-static const int handled[] = {SIGINT, SIGTERM, SIGHUP};
+/* Every signal whose default action is to end the process (Term or Core in signal(7)),
+ * but SIGKILL, which cannot be caught; the real-time signals are added at run time. */
+static const int handled[] = {
+    SIGHUP, SIGINT, SIGQUIT, SIGILL, SIGTRAP, SIGABRT, SIGBUS, SIGFPE, SIGUSR1, SIGSEGV,
+    SIGUSR2, SIGPIPE, SIGALRM, SIGTERM, SIGXCPU, SIGXFSZ, SIGVTALRM, SIGPROF, SIGSYS,
+#ifdef SIGSTKFLT
+    SIGSTKFLT,
+#endif
+#ifdef SIGIO
+    SIGIO,
+#endif
+#ifdef SIGPWR
+    SIGPWR,
+#endif
+#ifdef SIGEMT
+    SIGEMT,
+#endif
+#ifdef SIGLOST
+    SIGLOST,
+#endif
+};
+
+/* The set of signals the guard handles (and holds while the output is put in place). */
+static void handled_set(sigset_t *set)
+{
+    sigemptyset(set);
+    for (size_t i = 0; i < sizeof handled / sizeof handled[0]; ++i) sigaddset(set, handled[i]);
+#if defined(SIGRTMIN) && defined(SIGRTMAX)
+    for (int sig = SIGRTMIN; sig <= SIGRTMAX; ++sig) sigaddset(set, sig);
+#endif
+}
 
 static void remove_temporaries_and_die(int sig)
 {
@@ -26,8 +59,7 @@ static void remove_temporaries_and_die(int sig)
 static void signal_mask(int how)
 {
     sigset_t set;
-    sigemptyset(&set);
-    for (size_t i = 0; i < sizeof handled / sizeof handled[0]; ++i) sigaddset(&set, handled[i]);
+    handled_set(&set);
     sigprocmask(how, &set, NULL);
 }
 
@@ -35,6 +67,7 @@ static void signal_mask(int how)
 void impact1d_guard_temporaries(const char *first, const char *second)
 {
     struct sigaction action;
+    sigset_t set;
     const char *paths[2] = {first, second};
     n_temporary = 0;
     for (int i = 0; i < 2; ++i) {
@@ -44,12 +77,15 @@ void impact1d_guard_temporaries(const char *first, const char *second)
     }
     memset(&action, 0, sizeof action);
     action.sa_handler = remove_temporaries_and_die;
-    sigemptyset(&action.sa_mask);
-    for (size_t i = 0; i < sizeof handled / sizeof handled[0]; ++i) {
+    /* One signal at a time: a second one waits until the first has removed the files. */
+    handled_set(&set);
+    action.sa_mask = set;
+    for (int sig = 1; sig < NSIG; ++sig) {
         struct sigaction previous;
-        /* A signal the caller ignores (nohup) stays ignored. */
-        sigaction(handled[i], NULL, &previous);
-        if (previous.sa_handler != SIG_IGN) sigaction(handled[i], &action, NULL);
+        if (!sigismember(&set, sig)) continue;
+        /* A signal the caller ignores (nohup, SIGPIPE under some shells) stays ignored. */
+        if (sigaction(sig, NULL, &previous) != 0 || previous.sa_handler == SIG_IGN) continue;
+        sigaction(sig, &action, NULL);
     }
 }
 

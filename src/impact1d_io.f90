@@ -8,6 +8,7 @@ module impact1d_io
     i_m1, i_m2, i_mu1, i_mu2, i_g, i_r_left, i_r_right, i_r_min, i_r_max, i_x_left, i_x_right, &
     i_d_min, i_d_max, i_x1, i_x2, i_v1, i_v2, i_f1, i_f2, i_title, i_f1_table, i_f2_table, i_method
   use impact1d_forcing, only: table_type
+  use impact1d_files, only: check_input_file
   implicit none
   private
   public :: read_scene_file, prepare_scene, read_table, lower
@@ -458,20 +459,16 @@ contains
     end subroutine fail
   end subroutine read_table
 
-  !> Open a file for reading; a missing or unreadable one, or a folder, is an input error
-  !> naming it.
+  !> Open a file for reading; a missing or unreadable one, or anything but a regular file
+  !> (check_input_file: a folder, FIFO, device), is an input error naming it.
   subroutine open_data_file(path, unit, error)
     character(len=*), intent(in) :: path
     integer, intent(out) :: unit
     type(error_type), allocatable, intent(out) :: error
     integer :: ios
     character(len=512) :: message
-    logical :: folder
-    inquire(file=path // '/.', exist=folder)
-    if (folder) then
-      call raise(error, status_input, path // ': is a folder, not a file')
-      return
-    end if
+    call check_input_file(path, error)
+    if (allocated(error)) return
     open(newunit=unit, file=path, status='old', action='read', iostat=ios, iomsg=message)
     if (ios /= 0) call raise(error, status_input, path // ': ' // trim(message))
   end subroutine open_data_file

@@ -9,10 +9,11 @@ module impact1d_output
   use impact1d_interrupt, only: interrupt_count
   use impact1d_scene, only: scene_input, real_names, n_real, i_title, i_method, i_g, i_dt_out, &
     i_dt, default_gravity, i_k1, i_k2, i_k12, i_c1, i_c2, i_c12, i_m2
+  use impact1d_files, only: output_target, make_temporary, resolve, lock_folders, unlock_folders
   implicit none
   private
   public :: sink_type, memory_sink, summary_sink, file_sink, n_columns, column_names, n_event_kinds, event_names
-  public :: event_impact, event_rest, event_release, event_stick, event_slip, make_folder, run_stats, checkpoint
+  public :: event_impact, event_rest, event_release, event_stick, event_slip, run_stats, checkpoint
   public :: emit_sample, events_path, present_columns, i_pe, i_work, i_friction_loss, i_impact_loss, &
     i_damping_loss
 
@@ -109,7 +110,10 @@ module impact1d_output
   type, extends(sink_type) :: file_sink
     integer :: unit = 0, event_unit = 0
     logical :: is_open = .false.
-    character(len=:), allocatable :: path, event_path
+    !> The names given (for messages), the files they replace (the name, or the file a
+    !> symbolic link there leads to: output_target) and this run's own temporary files
+    !> beside those (make_temporary), which a signal guard must remove.
+    character(len=:), allocatable :: path, event_path, target, event_target, part, event_part
     !> The first failed write ('file: reason'); nothing more is written after it.
     character(len=:), allocatable :: write_failure
     !> The columns this scene has, in order.
@@ -143,11 +147,6 @@ module impact1d_output
       import :: c_int, c_char
       character(kind=c_char), intent(in) :: path(*)
     end function c_unlink
-    integer(c_int) function c_mkdir(path, mode) bind(C, name='mkdir')
-      import :: c_int, c_char
-      character(kind=c_char), intent(in) :: path(*)
-      integer(c_int), value :: mode
-    end function c_mkdir
   end interface
 
   character(len=*), parameter :: row_format = '(*(es25.16e3))'
@@ -373,24 +372,32 @@ contains
     type(error_type), allocatable, intent(out) :: error
     integer :: ios, k
     character(len=512) :: message
-    character(len=:), allocatable :: header
-    logical :: folder
+    character(len=:), allocatable :: header, samples_file, events_file
 
     self%path = path
     self%event_path = trim(events_path(path))
-    folder = is_folder(path)
-    if (path(len(path):) == '/' .or. folder) then
+    if (path(len(path):) == '/') then
       call raise(error, status_input, 'cannot write output ' // path // ': it is a folder (give a file name)')
       return
     end if
-    open(newunit=self%unit, file=self%path // '.part', status='replace', action='write', &
-      iostat=ios, iomsg=message)
+    call output_target(self%path, self%target, error)
+    if (allocated(error)) return
+    call output_target(self%event_path, self%event_target, error)
+    if (allocated(error)) return
+    ! Two links leading to one file would make the pair one file.
+    call resolve(self%target, samples_file)
+    call resolve(self%event_target, events_file)
+    if (len(samples_file) > 0 .and. samples_file == events_file) then
+      call raise(error, status_input, 'cannot write output ' // path // ': it and its events file ' // &
+        self%event_path // ' are the same file ' // samples_file)
+      return
+    end if
+    call make_temporary(self%target, self%unit, self%part, ios, message)
     if (ios /= 0) then
       call raise(error, status_input, 'cannot write output ' // path // ': ' // trim(reason(message)))
       return
     end if
-    open(newunit=self%event_unit, file=self%event_path // '.part', status='replace', action='write', &
-      iostat=ios, iomsg=message)
+    call make_temporary(self%event_target, self%event_unit, self%event_part, ios, message)
     if (ios /= 0) then
       close(self%unit, status='delete')
       call raise(error, status_input, 'cannot write output ' // self%event_path // ': ' // trim(reason(message)))
@@ -483,28 +490,28 @@ contains
     if (.not. self%is_open) return
     self%is_open = .false.
     if (keep) then
-      call self%finish_file(self%unit, self%path)
-      call self%finish_file(self%event_unit, self%event_path)
+      call self%finish_file(self%unit, self%path, self%part)
+      call self%finish_file(self%event_unit, self%event_path, self%event_part)
     else
       close(self%unit, iostat=ios)
       close(self%event_unit, iostat=ios)
     end if
     if (keep .and. .not. allocated(self%write_failure)) then
-      call replace_pair(self%path, self%event_path, error)
+      call replace_pair(self, error)
       if (.not. allocated(error)) return
     end if
-    call remove_file(self%path // '.part')
-    call remove_file(self%event_path // '.part')
+    call remove_file(self%part)
+    call remove_file(self%event_part)
     if (keep .and. allocated(self%write_failure)) &
       call raise(error, status_simulation, 'cannot write output ' // self%write_failure)
   end subroutine file_close
 
   !> Flush and close one file, recording the first failure (a full disk often shows only here,
   !> when the last buffer goes out).
-  subroutine finish_file(self, unit, path)
+  subroutine finish_file(self, unit, path, part)
     class(file_sink), intent(inout) :: self
     integer, intent(in) :: unit
-    character(len=*), intent(in) :: path
+    character(len=*), intent(in) :: path, part
     integer :: ios
     integer(int64) :: on_disk, written
     character(len=512) :: message
@@ -520,7 +527,7 @@ contains
     if (ios /= 0) self%write_failure = path // ': ' // trim(reason(message))
     if (allocated(self%write_failure)) return
     written = self%bytes(merge(1, 2, unit == self%unit))
-    inquire(file=path // '.part', size=on_disk)
+    inquire(file=part, size=on_disk)
     if (on_disk /= written) self%write_failure = path // ': only ' // trim(fmt(on_disk)) // ' of ' // &
       trim(fmt(written)) // ' bytes reached the disk (is it full?)'
   end subroutine finish_file
@@ -542,32 +549,39 @@ contains
     line_bytes = len_trim(line) + 1
   end function line_bytes
 
-  !> Put the finished PATH.part and EVENTS.part under their final names as a pair: either
-  !> both new files end up there, or (a rename failed) both previous ones stay. The previous
-  !> files are kept as hard links (or, where links are not supported, moved aside) until
-  !> both renames have succeeded.
-  subroutine replace_pair(path, event_path, error)
-    character(len=*), intent(in) :: path, event_path
+  !> Put the finished temporary files under their final names as a pair: either both new
+  !> files end up there, or (a rename failed) both previous ones stay. The previous files
+  !> are kept as hard links (or, where links are not supported, moved aside) under this
+  !> run's own names (its temporary's with .previous for .part) until both renames have
+  !> succeeded. Runs putting outputs in the same folders do it one after the other
+  !> (lock_folders), so the pair in place is always one run's.
+  subroutine replace_pair(self, error)
+    class(file_sink), intent(in) :: self
     type(error_type), allocatable, intent(out) :: error
-    character(len=*), parameter :: aside = '.previous'
     logical :: kept(2), placed(2)
-    character(len=:), allocatable :: final(:)
-    integer :: k
+    character(len=len(self%target) + len(self%event_target)) :: final(2)
+    character(len=len(self%part) + len(self%event_part) + 4) :: part(2), aside(2)
+    integer :: k, locks(2)
     integer(c_int) :: status, undone
 
-    final = [character(len=max(len(path), len(event_path))) :: path, event_path]
+    final(1) = self%target
+    final(2) = self%event_target
+    part(1) = self%part
+    part(2) = self%event_part
+    do k = 1, 2
+      aside(k) = part(k)(:len_trim(part(k)) - len('.part')) // '.previous'
+    end do
+    call lock_folders(trim(final(1)), trim(final(2)), locks)
     kept = .false.
     placed = .false.
     do k = 1, 2
       if (.not. exists(trim(final(k)))) cycle
-      call remove_file(trim(final(k)) // aside)
-      kept(k) = c_link(trim(final(k)) // c_null_char, trim(final(k)) // aside // c_null_char) == 0
-      if (.not. kept(k)) kept(k) = &
-        c_rename(trim(final(k)) // c_null_char, trim(final(k)) // aside // c_null_char) == 0
+      kept(k) = c_link(trim(final(k)) // c_null_char, trim(aside(k)) // c_null_char) == 0
+      if (.not. kept(k)) kept(k) = c_rename(trim(final(k)) // c_null_char, trim(aside(k)) // c_null_char) == 0
     end do
     status = 0
     do k = 2, 1, -1
-      status = c_rename(trim(final(k)) // '.part' // c_null_char, trim(final(k)) // c_null_char)
+      status = c_rename(trim(part(k)) // c_null_char, trim(final(k)) // c_null_char)
       if (status /= 0) exit
       placed(k) = .true.
     end do
@@ -575,12 +589,13 @@ contains
       if (status /= 0) then
         ! Undo: the previous file back under its name (or no file, if there was none).
         if (placed(k) .and. .not. kept(k)) call remove_file(trim(final(k)))
-        if (kept(k)) undone = c_rename(trim(final(k)) // aside // c_null_char, trim(final(k)) // c_null_char)
+        if (kept(k)) undone = c_rename(trim(aside(k)) // c_null_char, trim(final(k)) // c_null_char)
       else if (kept(k)) then
-        call remove_file(trim(final(k)) // aside)
+        call remove_file(trim(aside(k)))
       end if
     end do
-    if (status /= 0) call raise(error, status_simulation, 'cannot put the finished output in place as ' // path)
+    call unlock_folders(locks)
+    if (status /= 0) call raise(error, status_simulation, 'cannot put the finished output in place as ' // self%path)
   end subroutine replace_pair
 
   logical function exists(path)
@@ -623,16 +638,4 @@ contains
     if (quote_end > 0) text = message(quote_end + 3:)
   end function reason
 
-  !> True when path names an existing folder (opening path/. succeeds only then).
-  logical function is_folder(path)
-    character(len=*), intent(in) :: path
-    inquire(file=path // '/.', exist=is_folder)
-  end function is_folder
-
-  !> Create a folder if it is missing (an existing one is fine).
-  subroutine make_folder(path)
-    character(len=*), intent(in) :: path
-    integer(c_int) :: status
-    status = c_mkdir(path // c_null_char, int(o'755', c_int))
-  end subroutine make_folder
 end module impact1d_output

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import impact1d
-from tools import find_tool
+from tools import find_tool, mounted_tmpfs
 
 ROOT = Path(__file__).resolve().parents[1]
 INPUT = ROOT / "input"
@@ -386,3 +386,56 @@ def test_summary_values_line_up(cli, tmp_path):
     column = len("  scene     ")
     for line in lines:
         assert line[column - 1] == " " and line[column] != " ", line
+
+
+def summary_numbers(text):
+    """Every 'name = number' of the summary's final, energy and ledger lines, as floats."""
+    import re
+    numbers = {}
+    for line in text.splitlines():
+        if line.split()[:1] in (["final"], ["energy"], ["ledger"]):
+            for name, value in re.findall(r"([\w |]+?) (?:=|<=)\s*(\S+)", line):
+                numbers[name.split()[-1]] = float(value)      # a lost E would not parse
+    return numbers
+
+
+def test_summary_numbers_keep_their_exponent(cli, tmp_path):
+    """KE = 5e155 J was printed '5.00000+155' (ES12.5 drops the E of a three-digit
+    exponent), which reads as no number."""
+    scene = tmp_path / "fast.nml"
+    scene.write_text("&bodies m1 = 1.0, mu1 = 0.0 /\n&initial x1 = 0.0, v1 = 1e78 /\n"
+                     "&run t_end = 1e-80, dt = 1e-81 /\n")
+    proc = run_cli(cli, scene, "-o", tmp_path / "fast.dat", cwd=tmp_path)
+    numbers = summary_numbers(proc.stdout)
+    assert numbers["KE"] == pytest.approx(5e155, rel=1e-5)
+    assert numbers["t"] == pytest.approx(1e-80, rel=1e-5) and numbers["v1"] == pytest.approx(1e78)
+    assert set(numbers) >= {"t", "x1", "v1", "KE", "work", "loss", "|residual|"}
+
+
+def test_a_file_where_a_folder_should_be_is_named(cli, tmp_path):
+    """-o a_file/x.dat said only 'Not a directory' (or 'File exists')."""
+    (tmp_path / "a_file").write_text("a file\n")
+    for out in ("a_file/x.dat", "a_file/sub/x.dat"):
+        proc = run_cli(cli, INPUT / "case3.nml", "-o", out, cwd=tmp_path, check=False)
+        assert proc.returncode == 1
+        _assert_fails_naming(proc, f"cannot write output {out}: a_file is not a folder")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a_file"]
+
+
+@pytest.fixture
+def read_only_folder(tmp_path):
+    """A read-only tmpfs, always unmounted afterwards (skipped where mount is not allowed)."""
+    with mounted_tmpfs(tmp_path / "ro", "ro,size=64k") as folder:
+        yield folder
+
+
+def test_read_only_file_system_is_named(cli, tmp_path, read_only_folder):
+    """-o ro/sub/x.dat said 'No such file or directory': the folder ro/sub could not be
+    made, and why is the message."""
+    proc = run_cli(cli, INPUT / "case3.nml", "-o", "ro/sub/x.dat", cwd=tmp_path, check=False)
+    assert proc.returncode == 1
+    _assert_fails_naming(proc, "cannot make the folder ro/sub: Read-only file system")
+    proc = run_cli(cli, INPUT / "case3.nml", "-o", "ro/x.dat", cwd=tmp_path, check=False)
+    assert proc.returncode == 1
+    _assert_fails_naming(proc, "ro/x.dat: Read-only file system")
+    assert list(read_only_folder.iterdir()) == []

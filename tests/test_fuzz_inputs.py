@@ -2,6 +2,7 @@
 with finite numbers, or an InputError / SimulationError with a one-line message; never
 another exception, a crash or a hang. Seeded, so a failure reproduces."""
 
+import os
 import random
 import subprocess
 from pathlib import Path
@@ -118,3 +119,118 @@ def test_mutated_scenes_through_the_cli(tmp_path):
             lines = done.stderr.decode("utf-8", errors="replace").strip().splitlines()
             assert len(lines) == 1 and lines[0].startswith("impact1d: "), f"mutation {n}: {lines}"
             assert not any(b < 32 for b in done.stderr.rstrip(b"\n")), f"mutation {n}"
+
+
+# --- special files (issue 18, item 4): every kind of file in every role ---------------
+
+# What can stand where a file is expected: only a regular file (or a link to one) is read
+# or replaced; the others are refused at once, naming the path and what it is. A FIFO,
+# /dev/zero as input blocked or read forever; as output, a FIFO or a link was replaced.
+KINDS = {"fifo": "FIFO", "device": "character device", "folder": "folder", "socket": "socket",
+         "link": None, "link_to_fifo": "FIFO", "dangling_link": "missing file"}
+ROLES = ["scene", "dat_scene", "table", "output", "events_output"]
+SPECIAL_TIMEOUT = 20
+
+
+def make_special(folder, name, kind):
+    """A file of the given kind at folder/name; a link leads to a regular file (a scene, a
+    table or an earlier output, as the role needs) made from `regular`."""
+    path = folder / name
+    if kind == "fifo":
+        os.mkfifo(path)
+    elif kind == "device":
+        path.symlink_to("/dev/zero")      # the device itself, under a name of the role's
+    elif kind == "folder":
+        path.mkdir()
+    elif kind == "socket":
+        import socket
+        server = socket.socket(socket.AF_UNIX)
+        server.bind(str(path))
+        server.close()
+    elif kind == "link_to_fifo":
+        os.mkfifo(folder / "real_fifo")
+        path.symlink_to("real_fifo")
+    elif kind == "dangling_link":
+        path.symlink_to("nowhere")
+    return path
+
+
+def describe(path):
+    """What a path is now (the link itself, and what it leads to), to show it untouched."""
+    st = os.lstat(path)
+    target = os.readlink(path) if os.path.islink(path) else None
+    return st.st_mode & 0o170000, target
+
+
+@pytest.mark.parametrize("role", ROLES)
+@pytest.mark.parametrize("kind", list(KINDS))
+def test_special_files_in_every_role(tmp_path, kind, role):
+    cli = find_tool("impact1d")
+    scene_text = (INPUT / "case6.nml").read_text()
+    table_text = (INPUT / "triangle.dat").read_text()
+    names = {"scene": "s.nml", "dat_scene": "s.dat", "table": "triangle.dat",
+             "output": "o.dat", "events_output": "o.events.dat"}
+    name = names[role]
+    if kind == "link":
+        # A link to a regular file of the right content, in a folder of its own.
+        (tmp_path / "real").mkdir()
+        content = {"scene": scene_text, "dat_scene": (INPUT / "input1.dat").read_text(),
+                   "table": table_text}.get(role, "an earlier output\n")
+        (tmp_path / "real" / name).write_text(content)
+        (tmp_path / name).symlink_to(Path("real") / name)
+    elif kind == "device" and role in ("output", "events_output"):
+        (tmp_path / name).symlink_to("/dev/null")      # /dev/zero is not writable for all
+    else:
+        make_special(tmp_path, name, kind)
+    if role != "scene":
+        (tmp_path / "s.nml").write_text(scene_text)
+    if role != "table":
+        (tmp_path / "triangle.dat").write_text(table_text)
+    scene = "s.dat" if role == "dat_scene" else "s.nml"
+    before = describe(tmp_path / name)
+    done = subprocess.run([cli, scene, "-o", "o.dat", "--t-end", "0.1", "--dt", "1e-3"],
+                          cwd=tmp_path, capture_output=True, text=True, timeout=SPECIAL_TIMEOUT,
+                          stdin=subprocess.DEVNULL)
+    assert describe(tmp_path / name) == before, "the special file was replaced"
+    if kind == "link":
+        assert done.returncode == 0, done.stderr
+        if role in ("output", "events_output"):      # written through the link
+            assert (tmp_path / "real" / name).read_text().startswith("# impact1d")
+        return
+    assert done.returncode == 1, (done.returncode, done.stdout, done.stderr)
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and name in lines[0] and KINDS[kind] in lines[0], lines
+    # Nothing written: no output, no temporary file.
+    assert not any(p.name.startswith("o.") and p.name != name for p in tmp_path.iterdir())
+
+
+# --- concurrent writers (issue 18, item 3) -------------------------------------------
+
+N_WRITERS = 3
+N_ROUNDS = 2
+
+
+def test_concurrent_writers_of_one_output(tmp_path):
+    """Several runs of different scenes to one -o at once: each succeeds, the pair in place
+    is one run's own (as it writes it alone), and no temporary file is left."""
+    cli = find_tool("impact1d")
+    rng = random.Random(SEED)
+    scenes = sorted(INPUT.glob("case*.nml"))
+    args = ["--t-end", "10"]
+    reference = {}
+    for scene in scenes:
+        done = subprocess.run([cli, str(scene), *args, "-o", str(tmp_path / "ref.dat")],
+                              capture_output=True, timeout=RUN_TIMEOUT, stdin=subprocess.DEVNULL)
+        assert done.returncode == 0, done.stderr
+        reference[scene.name] = ((tmp_path / "ref.dat").read_bytes(),
+                                 (tmp_path / "ref.events.dat").read_bytes())
+    for _ in range(N_ROUNDS):
+        chosen = rng.sample(scenes, N_WRITERS)
+        procs = [subprocess.Popen([cli, str(scene), *args, "-o", str(tmp_path / "o.dat")],
+                                  stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                                  stdin=subprocess.DEVNULL) for scene in chosen]
+        assert [(p.wait(timeout=RUN_TIMEOUT), p.stderr.read()) for p in procs] == [(0, b"")] * N_WRITERS
+        pair = ((tmp_path / "o.dat").read_bytes(), (tmp_path / "o.events.dat").read_bytes())
+        assert pair in [reference[scene.name] for scene in chosen]
+        assert sorted(p.name for p in tmp_path.iterdir()) == ["o.dat", "o.events.dat", "ref.dat",
+                                                              "ref.events.dat"]

@@ -1,7 +1,9 @@
 """Hostile and unlucky input (issue 13 items 4, 5, 6, 8, 10; issue 12 item 5): every
 mistake is an InputError naming what is wrong, never a silently different scene."""
 
+import os
 import subprocess
+import sys
 import time
 from pathlib import Path
 
@@ -180,3 +182,120 @@ def test_last_line_without_newline(tmp_path):
     scene = impact1d.load_scene(scene_file(tmp_path, CASE3.rstrip("\n")))
     assert scene == impact1d.load_scene(INPUT / "case3.nml").__class__(
         **{**vars(impact1d.load_scene(INPUT / "case3.nml")), "source": str(tmp_path / "scene.nml")})
+
+
+# --- issue 18, item 4: only regular files are read; outputs go through links ----------
+
+# The Python calls run in a child Python with a timeout: before the fix a FIFO blocked the
+# open for ever and /dev/zero was read without end (a line of zeros, growing).
+CHILD_TIMEOUT = 60
+
+
+def child_python(tmp_path, code):
+    """Run code in a fresh Python (cwd tmp_path); its stdout, stripped."""
+    done = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True,
+                          text=True, timeout=CHILD_TIMEOUT)
+    assert done.returncode == 0, done.stderr
+    return done.stdout.strip()
+
+
+def input_error_of(tmp_path, call):
+    """The InputError message of an impact1d call made in a child Python ('' if none)."""
+    return child_python(tmp_path, "import impact1d\n"
+                                  "try:\n"
+                                  f"    {call}\n"
+                                  "except impact1d.InputError as error:\n"
+                                  "    print(error)\n")
+
+
+@pytest.mark.parametrize("path, kind", [("fifo", "FIFO"), ("/dev/zero", "character device"),
+                                        (".", "folder")])
+def test_special_file_as_scene(tmp_path, path, kind):
+    os.mkfifo(tmp_path / "fifo")
+    message = input_error_of(tmp_path, f"impact1d.load_scene({path!r})")
+    assert path in message and kind in message, message
+    assert "no such file" not in message
+
+
+@pytest.mark.parametrize("table, kind", [("fifo", "FIFO"), ("/dev/zero", "character device")])
+def test_special_file_as_force_table(tmp_path, table, kind):
+    os.mkfifo(tmp_path / "fifo")
+    scene = f"impact1d.load_scene({str(INPUT / 'case6.nml')!r})"
+    message = input_error_of(tmp_path, f"impact1d.simulate({scene}, f1_table={table!r}, t_end=0.1)")
+    assert message.startswith("f1_table: ") and table in message and kind in message, message
+
+
+def test_links_to_regular_inputs_are_read(tmp_path):
+    (tmp_path / "scene.nml").symlink_to(INPUT / "case6.nml")
+    (tmp_path / "triangle.dat").symlink_to(INPUT / "triangle.dat")
+    res = impact1d.simulate(impact1d.load_scene(tmp_path / "scene.nml"), t_end=1.0)
+    base = impact1d.simulate(impact1d.load_scene(INPUT / "case6.nml"), t_end=1.0)
+    np.testing.assert_array_equal(res.samples, base.samples)
+
+
+def test_special_output_file_is_not_read(tmp_path):
+    """read_output and impact1d-plot on a FIFO or a device: refused, not blocked."""
+    os.mkfifo(tmp_path / "fifo.dat")
+    for path, kind in (("fifo.dat", "FIFO"), ("/dev/zero", "character device")):
+        message = input_error_of(tmp_path, f"impact1d.read_output({path!r})")
+        assert path in message and kind in message, message
+        done = subprocess.run([find_tool("impact1d-plot"), path], cwd=tmp_path, capture_output=True,
+                              text=True, timeout=CHILD_TIMEOUT)
+        assert done.returncode == 1 and done.stderr.count("\n") == 1 and kind in done.stderr
+
+
+def test_outputs_are_written_through_links(tmp_path):
+    """A link to a regular file at the output's name stays a link; the file it leads to
+    gets the output (the CLI's samples and events, a plot's image, a sweep's table). Before,
+    the link was replaced by a new file."""
+    real = tmp_path / "real"
+    real.mkdir()
+    names = ["o.dat", "o.events.dat", "o.png", "t.csv"]
+    for name in names:
+        (real / name).write_text("an earlier file\n")
+        (tmp_path / name).symlink_to(Path("real") / name)
+    done = subprocess.run([find_tool("impact1d"), str(INPUT / "case3.nml"), "--dt-out", "0.5",
+                           "-o", "o.dat"], cwd=tmp_path, capture_output=True, text=True,
+                          timeout=RUN_TIMEOUT)
+    assert done.returncode == 0, done.stderr
+    from impact1d import plot
+    plot.save(impact1d.read_output(tmp_path / "o.dat"), tmp_path / "o.png")
+    done = subprocess.run([find_tool("impact1d-sweep"), str(INPUT / "case5.nml"), "--vary",
+                           "r_left=0,1", "--vary", "t_end=1", "-o", "t.csv"], cwd=tmp_path,
+                          capture_output=True, text=True, timeout=RUN_TIMEOUT)
+    assert done.returncode == 0, done.stderr
+    for name in names:
+        assert (tmp_path / name).is_symlink(), name
+        assert (real / name).read_bytes() != b"an earlier file\n", name
+    assert sorted(p.name for p in real.iterdir()) == sorted(names)       # no temporaries
+    assert (real / "o.dat").read_text().startswith("# impact1d output")
+    assert (real / "t.csv").read_text().startswith("r_left,")
+
+
+def test_special_outputs_are_refused(tmp_path):
+    """A FIFO (replaced by a file before), the standard output's descriptor link (as
+    /dev/stdout, which root replaced, writing /dev/stdout.events.dat beside it) and a link
+    to nothing: refused, untouched, nothing written."""
+    os.mkfifo(tmp_path / "fifo.dat")
+    (tmp_path / "stdout.dat").symlink_to("/proc/self/fd/1")
+    (tmp_path / "dangling.dat").symlink_to("nowhere.dat")
+    before = sorted(p.name for p in tmp_path.iterdir())
+    for name, kind in (("fifo.dat", "FIFO"), ("stdout.dat", "FIFO"),
+                       ("dangling.dat", "symbolic link to a missing file")):
+        done = subprocess.run([find_tool("impact1d"), str(INPUT / "case3.nml"), "-o", name],
+                              cwd=tmp_path, capture_output=True, text=True, timeout=RUN_TIMEOUT)
+        assert done.returncode == 1 and done.stderr.count("\n") == 1, done.stderr
+        assert name in done.stderr and kind in done.stderr, done.stderr
+        done = subprocess.run([find_tool("impact1d-sweep"), str(INPUT / "case5.nml"), "--vary",
+                               "r_left=0,1", "-o", name], cwd=tmp_path, capture_output=True,
+                              text=True, timeout=RUN_TIMEOUT)
+        assert done.returncode == 1 and done.stderr.count("\n") == 1, done.stderr
+        assert name in done.stderr and kind in done.stderr, done.stderr
+    from impact1d import plot
+    with pytest.raises(impact1d.InputError, match="fifo.png: it is a FIFO"):
+        os.mkfifo(tmp_path / "fifo.png")
+        plot.save(impact1d.simulate(impact1d.load_scene(INPUT / "case3.nml"), t_end=1.0),
+                  tmp_path / "fifo.png")
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(before + ["fifo.png"])
+    assert (tmp_path / "fifo.dat").is_fifo() and (tmp_path / "fifo.png").is_fifo()
+    assert os.readlink(tmp_path / "stdout.dat") == "/proc/self/fd/1"

@@ -1,5 +1,7 @@
-"""Nothing lost (issue 13, item 1): a full disk or a signal never replaces the previous
-output with a truncated one, never leaves a temporary file, and never exits 0.
+"""Nothing lost (issue 13, item 1; issue 18, items 3, 5, 8, 9): a full disk, a signal or
+another run writing the same output never replaces the previous output with a truncated
+or mixed one, never leaves a temporary file, and never exits 0; a report on stdout that
+cannot be written is a failure too.
 
 The full-disk tests run on a real small file system: a 256 KiB tmpfs mounted for the
 test (CI runs as root); where mounting is not permitted they are skipped with the reason.
@@ -8,15 +10,18 @@ test (CI runs as root); where mounting is not permitted they are skipped with th
 import os
 import signal
 import subprocess
+import sys
+import threading
 import time
 from pathlib import Path
 
 import pytest
 
-from tools import find_tool
+from tools import find_tool, mounted_tmpfs
 
 ROOT = Path(__file__).resolve().parents[1]
 CASE3 = ROOT / "input" / "case3.nml"
+CASE5 = ROOT / "input" / "case5.nml"
 # A CLI run of a seed case on a busy 2-core machine takes well under this.
 RUN_TIMEOUT = 120
 # How long to wait for a long run to open its temporary file before giving up.
@@ -32,16 +37,8 @@ def cli():
 @pytest.fixture
 def small_disk(tmp_path):
     """A 256 KiB tmpfs, always unmounted afterwards."""
-    mount_point = tmp_path / "small"
-    mount_point.mkdir()
-    done = subprocess.run(["mount", "-t", "tmpfs", "-o", f"size={TMPFS_BYTES}", "tmpfs",
-                           str(mount_point)], capture_output=True, text=True)
-    if done.returncode != 0:
-        pytest.skip(f"cannot mount a small tmpfs here: {done.stderr.strip() or done.returncode}")
-    try:
+    with mounted_tmpfs(tmp_path / "small", f"size={TMPFS_BYTES}") as mount_point:
         yield mount_point
-    finally:
-        subprocess.run(["umount", str(mount_point)], check=True)
 
 
 def fill_disk(folder):
@@ -63,6 +60,11 @@ def run(cli, *args, cwd):
 def snapshot(folder):
     """Every file in folder with its bytes."""
     return {p.name: p.read_bytes() for p in sorted(folder.iterdir()) if p.is_file()}
+
+
+def temporaries(folder):
+    """Temporary files of any naming (o.dat.part, o.dat.PID-N.part, t.PID-N.part.csv)."""
+    return sorted(p.name for p in folder.iterdir() if ".part" in p.name or ".previous" in p.name)
 
 
 def previous_output(cli, folder):
@@ -111,30 +113,123 @@ def test_rewrite_replaces_the_pair_and_leaves_no_temporaries(cli, tmp_path):
     assert len(rows) == 13      # t = 0, 0.5, ..., 6
 
 
-@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM, signal.SIGHUP],
-                         ids=["SIGINT", "SIGTERM", "SIGHUP"])
-def test_signal_removes_temporaries(cli, tmp_path, sig):
-    before = previous_output(cli, tmp_path)
-    # 5 * 10^6 rows: minutes of writing, so the signal lands in the middle of the run.
-    proc = subprocess.Popen([cli, str(CASE3), "--t-end", "5000", "-o", str(tmp_path / "o.dat")],
+# Every signal whose default action ends the process, but SIGKILL (which none can catch):
+# gfortran's runtime handles SIGQUIT (a backtrace) and the faults itself unless the guard
+# does. SIGSEGV and SIGABRT stand for the faults, SIGRTMIN for the real-time signals.
+ENDING_SIGNALS = ["SIGINT", "SIGTERM", "SIGHUP", "SIGQUIT", "SIGUSR1", "SIGUSR2", "SIGALRM",
+                  "SIGPIPE", "SIGVTALRM", "SIGPROF", "SIGXCPU", "SIGXFSZ", "SIGSEGV", "SIGABRT",
+                  "SIGRTMIN"]
+
+
+def start_long_run(cli, folder, name="o.dat", scene=CASE3):
+    """A CLI run of 5 * 10^6 rows (minutes of writing), returned once it has written to its
+    temporary file, so that a signal lands in the middle of the run."""
+    proc = subprocess.Popen([cli, str(scene), "--t-end", "5000", "-o", str(folder / name)],
                             cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
                             stdin=subprocess.DEVNULL, start_new_session=True)
+    deadline = time.monotonic() + START_TIMEOUT
+    while not any(p.stat().st_size > 0 for p in folder.glob(name + "*part")):
+        if proc.poll() is not None or time.monotonic() > deadline:
+            proc.kill()
+            raise AssertionError(f"the run never started writing: {proc.stderr.read()}")
+        time.sleep(0.02)
+    return proc
+
+
+@pytest.mark.parametrize("name", ENDING_SIGNALS)
+def test_signal_removes_temporaries(cli, tmp_path, name):
+    sig = getattr(signal, name)
+    before = previous_output(cli, tmp_path)
+    proc = start_long_run(cli, tmp_path)
     try:
-        deadline = time.monotonic() + START_TIMEOUT
-        part = tmp_path / "o.dat.part"
-        while not (part.exists() and part.stat().st_size > 0):
-            assert proc.poll() is None, proc.stderr.read()
-            assert time.monotonic() < deadline, "the run never started writing"
-            time.sleep(0.02)
         proc.send_signal(sig)
         returncode = proc.wait(timeout=RUN_TIMEOUT)
+        stderr = proc.stderr.read().decode(errors="replace")
     finally:
         if proc.poll() is None:
             proc.kill()
             proc.wait()
-    # The run dies of the signal as an unguarded one would (a shell shows 128 + signal).
-    assert returncode == -sig
+    # The run dies of the signal as an unguarded one would (a shell shows 128 + signal),
+    # without gfortran's backtrace.
+    assert returncode == -sig, (returncode, stderr)
+    assert "Backtrace" not in stderr and "Program received" not in stderr, stderr
     assert snapshot(tmp_path) == before
+
+
+def test_concurrent_runs_leave_one_runs_pair(cli, tmp_path):
+    """Two runs of different scenes to the same -o (they shared the temporary o.dat.part:
+    one exited 0 with the other's samples in place and a mixed events file, the other 2
+    with a false "only -1 of N bytes reached the disk"). Each run's pair, written alone,
+    is the reference: the pair in place must be one of them, both runs succeed, no
+    temporary is left."""
+    scenes = {"a": CASE3, "b": CASE5}
+    args = ["--t-end", "30"]          # 30001 rows, 7.5 MB: the two runs overlap
+    reference = {}
+    for key, scene in scenes.items():
+        done = run(cli, scene, *args, "-o", tmp_path / f"{key}.dat", cwd=ROOT)
+        assert done.returncode == 0, done.stderr
+        reference[key] = ((tmp_path / f"{key}.dat").read_bytes(),
+                          (tmp_path / f"{key}.events.dat").read_bytes())
+    assert reference["a"][0] != reference["b"][0] and reference["a"][1] != reference["b"][1]
+    for _ in range(3):
+        procs = [subprocess.Popen([cli, str(scene), *args, "-o", str(tmp_path / "o.dat")], cwd=ROOT,
+                                  stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                                  stdin=subprocess.DEVNULL) for scene in scenes.values()]
+        outcomes = [(proc.wait(timeout=RUN_TIMEOUT), proc.stderr.read()) for proc in procs]
+        assert outcomes == [(0, ""), (0, "")]
+        pair = ((tmp_path / "o.dat").read_bytes(), (tmp_path / "o.events.dat").read_bytes())
+        assert pair in reference.values(), "the pair in place is not one run's"
+        assert temporaries(tmp_path) == []
+
+
+def test_concurrent_whole_writes_keep_one_whole_file(tmp_path):
+    """impact1d-sweep's and the plots' writer, two writers at once on one path (threads,
+    each held until both have written): they shared one temporary name, the second
+    truncated the first's file, and one of them failed to rename it."""
+    from impact1d._files import write_whole
+
+    target = tmp_path / "t.csv"
+    both_written = threading.Barrier(2, timeout=RUN_TIMEOUT)
+    failures = []
+
+    def writer(text):
+        def write(temporary):
+            with open(temporary, "w") as handle:
+                handle.write(text * 1000)
+            both_written.wait()
+
+        try:
+            write_whole(target, write)
+        except Exception as error:     # noqa: BLE001 - the test reports any failure
+            failures.append(error)
+
+    threads = [threading.Thread(target=writer, args=(text,)) for text in ("a,b\n", "c,d\n")]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    assert failures == []
+    assert target.read_text() in ("a,b\n" * 1000, "c,d\n" * 1000)
+    assert temporaries(tmp_path) == []
+
+
+def test_concurrent_sweeps_leave_one_whole_table(tmp_path):
+    sweep = find_tool("impact1d-sweep")
+    grids = {"a": ["--vary", "r_left=0:0.9:40"], "b": ["--vary", "r_right=0:0.9:30"]}
+    common = [str(CASE5), "--vary", "t_end=2", "--workers", "1"]
+    reference = {}
+    for key, grid in grids.items():
+        done = subprocess.run([sweep, *common, *grid, "-o", str(tmp_path / f"{key}.csv")],
+                              capture_output=True, text=True, timeout=RUN_TIMEOUT)
+        assert done.returncode == 0, done.stderr
+        reference[key] = (tmp_path / f"{key}.csv").read_bytes()
+    for _ in range(3):
+        procs = [subprocess.Popen([sweep, *common, *grid, "-o", str(tmp_path / "t.csv")],
+                                  stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+                 for grid in grids.values()]
+        assert [(proc.wait(timeout=RUN_TIMEOUT), proc.stderr.read()) for proc in procs] == [(0, "")] * 2
+        assert (tmp_path / "t.csv").read_bytes() in reference.values()
+        assert temporaries(tmp_path) == []
 
 
 def test_plot_on_full_disk_keeps_previous_image(small_disk):
@@ -148,3 +243,71 @@ def test_plot_on_full_disk_keeps_previous_image(small_disk):
         plot.save(result, png)
     assert png.read_bytes() == b"previous image"
     assert sorted(p.name for p in small_disk.iterdir()) == ["case3.png", "fill"]
+
+
+# --- the Python commands: interrupted, or with nowhere to report --------------------
+
+# impact1d-sweep's main() in a Python that says "ready" on stdout once it is imported, so
+# that SIGINT lands in the sweep (2000 runs of case 3 for 200 s each: minutes of work).
+SWEEP_UNTIL_READY = ("import sys, impact1d.sweep_cli as cli; print('ready', flush=True); "
+                     "sys.exit(cli.main(sys.argv[1:]))")
+
+
+def test_interrupted_sweep_is_one_line_and_130(tmp_path):
+    table = tmp_path / "t.csv"
+    table.write_text("the previous table\n")
+    proc = subprocess.Popen([sys.executable, "-c", SWEEP_UNTIL_READY, str(CASE3), "--vary",
+                             "r_left=0:0.95:2000", "--vary", "t_end=200", "--workers", "1",
+                             "-o", str(table)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True)
+    try:
+        assert proc.stdout.readline() == "ready\n", proc.stderr.read()
+        time.sleep(0.2)       # into the runs; a signal earlier in main() is handled the same
+        proc.send_signal(signal.SIGINT)
+        returncode = proc.wait(timeout=RUN_TIMEOUT)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    stderr = proc.stderr.read()
+    assert returncode == 130, stderr
+    assert stderr.count("\n") == 1 and stderr.startswith("impact1d-sweep: interrupted"), stderr
+    assert table.read_text() == "the previous table\n"
+    assert temporaries(tmp_path) == []
+
+
+def run_with_stdout(command, stdout, cwd=ROOT):
+    """Run a command with stdout on /dev/full ('full') or closed ('closed')."""
+    if stdout == "closed":
+        command = ["sh", "-c", 'exec "$@" >&-', "sh", *command]
+    with open(os.devnull if stdout == "closed" else "/dev/full", "w") as sink:
+        return subprocess.run(list(map(str, command)), cwd=cwd, stdout=sink, stderr=subprocess.PIPE,
+                              text=True, timeout=RUN_TIMEOUT, stdin=subprocess.DEVNULL,
+                              env={**os.environ, "MPLBACKEND": "Agg"})
+
+
+def assert_one_line_failure(done, prog, status):
+    assert done.returncode == status, (done.returncode, done.stderr)
+    assert done.stderr.count("\n") == 1 and done.stderr.startswith(prog + ": "), done.stderr
+    assert "stdout" in done.stderr and "Traceback" not in done.stderr
+
+
+@pytest.mark.parametrize("stdout", ["full", "closed"])
+def test_cli_summary_that_cannot_be_written_fails(cli, tmp_path, stdout):
+    """gfortran's writes to stdout report no error: the run exited 0 with its summary lost."""
+    done = run_with_stdout([cli, CASE3, "--dt-out", "0.5", "-o", tmp_path / "o.dat"], stdout)
+    assert_one_line_failure(done, "impact1d", 2)
+    assert "o.dat is in place" in done.stderr
+    assert sorted(snapshot(tmp_path)) == ["o.dat", "o.events.dat"]
+
+
+@pytest.mark.parametrize("stdout", ["full", "closed"])
+def test_sweep_and_plot_reports_that_cannot_be_written_fail(cli, tmp_path, stdout):
+    done = run_with_stdout([find_tool("impact1d-sweep"), CASE5, "--vary", "r_left=0,0.5",
+                            "--vary", "t_end=1", "-o", tmp_path / "t.csv"], stdout)
+    assert_one_line_failure(done, "impact1d-sweep", 2)
+    assert (tmp_path / "t.csv").is_file()
+    assert run(cli, CASE3, "--dt-out", "0.5", "-o", tmp_path / "o.dat", cwd=ROOT).returncode == 0
+    for args in ([tmp_path / "o.dat"], [tmp_path / "t.csv", "--x", "r_left"]):
+        done = run_with_stdout([find_tool("impact1d-plot"), *args], stdout)
+        assert_one_line_failure(done, "impact1d-plot", 1)

@@ -127,3 +127,16 @@ def test_the_warning_predicts_the_error_of_the_fastest_mode(steps_per_period):
     end = complex(res.x1[-1], res.v1[-1] / w)
     measured = abs(end / start - 1)
     assert predicted == pytest.approx(measured, rel=0.05)   # two digits printed
+
+
+def test_the_cli_summary_carries_the_warning(tmp_path):
+    import subprocess
+    from tools import find_tool
+    scene = tmp_path / "spring.nml"
+    scene.write_text("&bodies m1 = 2.0 /\n&initial x1 = 0.1 /\n&springs k1 = 800.0, x1_rest = 0.0 /\n"
+                     "&run t_end = 1.0, dt = 0.05 /\n")
+    out = subprocess.run([find_tool("impact1d"), str(scene), "-o", str(tmp_path / "o.dat")],
+                         capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    warning = [line for line in out.stdout.splitlines() if line.strip().startswith("warning")]
+    assert len(warning) == 1 and "k1 = 800.0" in warning[0] and "coarse" in warning[0]

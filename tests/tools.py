@@ -1,15 +1,20 @@
 """Where the tests find the command-line tools: beside the running interpreter first, so
 that `.venv/bin/python -m pytest tests` tests that environment's install without an
-activated venv (or a PATH that leads elsewhere)."""
+activated venv (or a PATH that leads elsewhere). And a small file system mounted for a
+test (a full disk, a read-only one)."""
 
 from __future__ import annotations
 
+import contextlib
 import os
 import shutil
+import subprocess
 import sys
 import sysconfig
 from importlib import metadata
 from pathlib import Path
+
+import pytest
 
 
 def find_tool(name: str) -> str:
@@ -36,3 +41,19 @@ def find_tool(name: str) -> str:
         f"the {name} executable is neither beside {sys.executable} nor recorded by the "
         f"installed impact1d package nor on PATH: install the package (make setup)")
     return found
+
+
+@contextlib.contextmanager
+def mounted_tmpfs(folder: Path, options: str):
+    """A tmpfs mounted on folder (made here) with the given mount options, always
+    unmounted afterwards; the test is skipped with the reason where mounting is not
+    permitted (CI runs as root)."""
+    folder.mkdir()
+    done = subprocess.run(["mount", "-t", "tmpfs", "-o", options, "tmpfs", str(folder)],
+                          capture_output=True, text=True)
+    if done.returncode != 0:
+        pytest.skip(f"cannot mount a tmpfs ({options}) here: {done.stderr.strip() or done.returncode}")
+    try:
+        yield folder
+    finally:
+        subprocess.run(["umount", str(folder)], check=True)

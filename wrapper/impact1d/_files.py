@@ -1,17 +1,102 @@
-"""Files written whole: under a temporary name beside the target, then renamed, so a full
-disk or an interrupt leaves the previous file (or none), never a truncated one."""
+"""The file rules of the Python side, as the CLI's (src/impact1d_files.f90): only regular
+files are read; files are written whole, under a temporary name of this process's own
+beside the target, then renamed, so a full disk, an interrupt or another process writing
+the same file leaves the previous file (or none, or the other's whole file), never a
+truncated or mixed one."""
 
+from __future__ import annotations
+
+import errno
 import os
+import secrets
+import stat
+import sys
+
+from ._scene import InputError
+
+_KINDS = ((stat.S_ISDIR, "a folder"), (stat.S_ISFIFO, "a FIFO (named pipe)"),
+          (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"),
+          (stat.S_ISSOCK, "a socket"))
+
+
+def _kind(mode) -> str:
+    for test, name in _KINDS:
+        if test(mode):
+            return name
+    return "not a regular file"
+
+
+def check_input(path, what="file") -> None:
+    """Refuse, before anything opens it, a path that is not a regular file (or a link to
+    one): a FIFO or a device would block or never end. InputError names the path and what
+    it is, or says that there is no such file."""
+    try:
+        mode = os.stat(path).st_mode
+    except FileNotFoundError:
+        missing = "it is a symbolic link to a missing file" if os.path.islink(path) else "no such file"
+        raise InputError(f"cannot open {what} '{os.fsdecode(path)}': {missing}") from None
+    except OSError as error:
+        raise InputError(f"cannot open {what} '{os.fsdecode(path)}': {error.strerror}") from None
+    if not stat.S_ISREG(mode):
+        raise InputError(f"cannot open {what} '{os.fsdecode(path)}': it is {_kind(mode)}, "
+                         "not a regular file (only regular files are read)")
+
+
+def output_target(path) -> str:
+    """The file writing `path` replaces: `path` when it is missing or a regular file, the
+    file a symbolic link there leads to when it is one to a regular file (written through:
+    the link stays). InputError for anything else: a folder, FIFO, device or socket, or a
+    link to nothing."""
+    path = os.fspath(path)
+    try:
+        mode = os.stat(path).st_mode
+    except FileNotFoundError:
+        if os.path.islink(path):
+            raise InputError(f"cannot write {path}: it is a symbolic link to a missing file") from None
+        return path
+    if not stat.S_ISREG(mode):
+        raise InputError(f"cannot write {path}: it is {_kind(mode)}, not a regular file")
+    return os.path.realpath(path) if os.path.islink(path) else path
+
+
+def _create_temporary(target) -> str:
+    """A new empty file beside target, TARGET_STEM.PID-N.part.EXT (the extension still
+    tells writers the format), created exclusively: never another process's."""
+    root, ext = os.path.splitext(target)
+    while True:
+        temporary = f"{root}.{os.getpid()}-{secrets.token_hex(3)}.part{ext}"
+        try:
+            os.close(os.open(temporary, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))
+            return temporary
+        except FileExistsError:
+            continue
 
 
 def write_whole(path, write) -> None:
-    """Call write(temporary_path), then put that file in place as `path`."""
-    root, ext = os.path.splitext(os.fspath(path))
-    temporary = f"{root}.part{ext}"      # the extension still tells writers the format
+    """Call write(temporary_path), then put that file in place as `path` (through a
+    symbolic link at `path`: output_target)."""
+    target = output_target(path)
+    temporary = _create_temporary(target)
     try:
         write(temporary)
-        os.replace(temporary, path)
+        os.replace(temporary, target)
     except BaseException:
-        if os.path.exists(temporary):
+        if os.path.lexists(temporary):
             os.remove(temporary)
+        raise
+
+
+def print_line(text) -> None:
+    """Print a line on stdout now; OSError when it cannot be written (a full disk, a closed
+    stdout): a command's report that nobody can read is a failure, not a success. After a
+    failure stdout goes to /dev/null, so that Python's own flush at exit does not fail
+    again with a traceback."""
+    if sys.stdout is None:         # Python found file descriptor 1 closed
+        raise OSError(errno.EBADF, os.strerror(errno.EBADF))
+    try:
+        print(text, file=sys.stdout, flush=True)
+    except OSError:
+        null = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(null, sys.stdout.fileno())
+        os.close(null)
         raise

@@ -7,6 +7,7 @@ import os
 import numpy as np
 
 from ._scene import REAL_FIELDS, TEXT_FIELDS, Scene, InputError
+from ._files import check_input
 from ._simulate import (COLUMNS, OPTIONAL_COLUMNS, EVENT_DTYPE, ONE_BODY_EVENT_DTYPE, Result,
                         result_from_columns)
 
@@ -58,8 +59,7 @@ def read_output(path) -> Result:
     when it exists, and the scene recorded in the header (`source` = the scene file).
     `steps` is None (the file does not record it); energy_residual is max |residual|."""
     path = os.fspath(path)
-    if not os.path.isfile(path):
-        raise InputError(f"cannot open output file '{path}': no such file")
+    check_input(path, "output file")
     header, columns = _read_header(path)
     names = tuple(columns.split()) if columns is not None else ()
     required = tuple(name for name in COLUMNS if name not in OPTIONAL_COLUMNS)
@@ -86,8 +86,11 @@ def read_output(path) -> Result:
 
     events_file = events_path(path)
     one_body = "x2" not in names
-    events = (_read_events(events_file, one_body) if os.path.isfile(events_file)
-              else np.empty(0, dtype=ONE_BODY_EVENT_DTYPE if one_body else EVENT_DTYPE))
+    if os.path.exists(events_file):
+        check_input(events_file, "events file")     # a FIFO there would block the read
+        events = _read_events(events_file, one_body)
+    else:
+        events = np.empty(0, dtype=ONE_BODY_EVENT_DTYPE if one_body else EVENT_DTYPE)
     residual = samples[:, names.index("residual")]
     energy_residual = float(np.max(np.abs(residual))) if residual.size else 0.0
     return result_from_columns(samples, events, names, energy_residual=energy_residual,

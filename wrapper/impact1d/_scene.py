@@ -192,11 +192,10 @@ def raise_for_status(status, message) -> None:
 
 def load_scene(path) -> Scene:
     """Read a scene file: a namelist (.nml, or any other name) or a VisSim .dat file."""
+    from ._files import check_input      # here: _files needs this module's InputError
+
     path = os.fspath(path)
-    if os.path.isdir(path):
-        raise InputError(f"cannot open scene file '{path}': it is a folder, not a file")
-    if not os.path.isfile(path):
-        raise InputError(f"cannot open scene file '{path}': no such file")
+    check_input(path, "scene file")
     (values, given, title, f1_table, f2_table, method,
      status, message) = _api.read_scene(os.fsencode(path), len(REAL_FIELDS))
     raise_for_status(status, message)

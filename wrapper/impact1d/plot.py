@@ -33,7 +33,7 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.ticker import ScalarFormatter
 
-from ._files import write_whole
+from ._files import check_input, write_whole
 
 __all__ = ["figure", "save", "PANELS", "CONTACTS"]
 
@@ -518,7 +518,9 @@ def sweep(table, x, y=None, value=("t_rest",), path=None, *, dpi=100, figure_fac
     given (written whole); the Figure is returned."""
     import pandas as pd
 
-    table = table if isinstance(table, pd.DataFrame) else pd.read_csv(table)
+    if not isinstance(table, pd.DataFrame):
+        check_input(table, "sweep table")
+        table = pd.read_csv(table)
     values = [value] if isinstance(value, str) else list(value)
     for name in [x, y] + values:
         if name is not None and name not in table.columns:

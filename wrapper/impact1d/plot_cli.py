@@ -5,7 +5,8 @@
 Reads OUTPUT.dat (and OUTPUT.events.dat next to it, if present: the output's
 extension replaced by .events.dat) and writes OUTPUT.png next to it, or one PNG per panel with ``--separate``
 (OUTPUT_positions.png, ...).  ``--show`` also opens the figures in a window.
-Any error gives a one-line message on stderr and exit status 1.
+Any error (one that writing the report on stdout meets too) gives a one-line message on
+stderr and exit status 1. Only regular files are read (a FIFO or a device is refused).
 """
 
 from __future__ import annotations
@@ -74,11 +75,28 @@ def _one_line(exc):
     return text or type(exc).__name__
 
 
+def _say(line):
+    """A line on stdout; False (and the one-line error) when it cannot be written."""
+    from impact1d._files import print_line
+
+    try:
+        print_line(line)
+        return True
+    except OSError as error:
+        _fail(f"cannot write to stdout: {error.strerror or error}")
+        return False
+
+
 def main(argv=None):
     args = _parser().parse_args(argv)
     output = args.output
-    if not os.path.isfile(output):
-        return _fail(f"no such file: {output}")
+    from impact1d import InputError
+    from impact1d._files import check_input
+
+    try:
+        check_input(output)         # a FIFO or /dev/zero would never end
+    except InputError as error:
+        return _fail(str(error))
     if output.endswith((".csv", ".parquet")):
         return _plot_table(args)
     try:
@@ -105,8 +123,8 @@ def main(argv=None):
         paths = plot.save(result, png, separate=args.separate, figure_factory=factory)
     except Exception as exc:  # noqa: BLE001
         return _fail(f"cannot write {png}: {_one_line(exc)}")
-    for p in paths:
-        print(f"wrote {p}")
+    if not all(_say(f"wrote {p}") for p in paths):
+        return 1
     if args.show:
         plt.show()
     return 0
@@ -128,8 +146,7 @@ def _plot_table(args):
         plot.sweep(table, args.x, args.y, args.value or ["t_rest"], png)
     except Exception as exc:  # noqa: BLE001 - one line, whatever went wrong
         return _fail(f"cannot plot {args.output}: {_one_line(exc)}")
-    print(f"wrote {png}")
-    return 0
+    return 0 if _say(f"wrote {png}") else 1
 
 
 if __name__ == "__main__":

@@ -5,8 +5,9 @@
 NAME=a:b:n is n values from a to b (both included); NAME=v1,v2,... lists them. The table
 (CSV; Parquet for a .parquet name, with pyarrow installed) has one row per run: the
 varied fields, the run's summary and its error message (empty when it ran).
-Exit status: 0 done (rows with errors included), 1 bad input, 2 the table could not be
-written.
+Exit status: 0 done (rows with errors included), 1 bad input, 2 the table (or the line
+saying where it went) could not be written, 130 interrupted (SIGINT, Ctrl-C): the previous
+table is untouched.
 """
 
 from __future__ import annotations
@@ -19,7 +20,7 @@ import numpy as np
 
 from . import __version__
 from ._scene import InputError, load_scene
-from ._files import write_whole
+from ._files import output_target, print_line, write_whole
 from .sweep import sweep
 
 
@@ -70,6 +71,16 @@ def write_table(table, path: str) -> None:
 
 
 def main(argv=None) -> int:
+    try:
+        return _main(argv)
+    except KeyboardInterrupt:
+        # One line, as impact1d says it (a shell shows 130 for both): the table is written
+        # whole or not at all, so the previous one is as it was.
+        print("impact1d-sweep: interrupted; the table was not written", file=sys.stderr)
+        return 130
+
+
+def _main(argv) -> int:
     parser = argparse.ArgumentParser(prog="impact1d-sweep", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("scene", help="a namelist scene (.nml) or VisSim .dat file")
@@ -92,20 +103,26 @@ def main(argv=None) -> int:
             except ImportError:
                 raise InputError("-o *.parquet needs pyarrow (pip install pyarrow); "
                                  "or write .csv") from None
+        stem = os.path.splitext(os.path.basename(args.scene))[0]
+        out = args.output or os.path.join("output", f"{stem}_sweep.csv")
+        output_target(out)         # a FIFO or a folder there: refused before the runs
         scene = load_scene(args.scene)
         table = sweep(scene, parse_vary(args.vary), workers=args.workers)
     except InputError as error:
         print(f"impact1d-sweep: {error}", file=sys.stderr)
         return 1
-    stem = os.path.splitext(os.path.basename(args.scene))[0]
-    out = args.output or os.path.join("output", f"{stem}_sweep.csv")
     try:
         write_table(table, out)
     except OSError as error:
         print(f"impact1d-sweep: cannot write {out}: {error.strerror or error}", file=sys.stderr)
         return 2
     failed = int((table["error"] != "").sum())
-    print(f"impact1d-sweep: {len(table)} runs ({failed} failed) -> {out}")
+    try:
+        print_line(f"impact1d-sweep: {len(table)} runs ({failed} failed) -> {out}")
+    except OSError as error:
+        print(f"impact1d-sweep: cannot write to stdout: {error.strerror or error} "
+              f"(the table {out} is written)", file=sys.stderr)
+        return 2
     return 0
 
 
