@@ -2,6 +2,7 @@
 !> checked model the solver runs (scene_type). One validator serves the CLI and Python.
 module impact1d_scene
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+  use, intrinsic :: iso_fortran_env, only: int64
   use impact1d_kinds, only: wp, eps_wp
   use impact1d_error, only: error_type, raise, status_input, fmt, fmt_width
   use impact1d_forcing, only: forcing_type, table_type
@@ -105,7 +106,7 @@ contains
     logical, intent(in) :: require_run
     type(error_type), allocatable, intent(out) :: error
     integer :: k
-    real(wp) :: gap, scale, nrm(2, n_contacts)
+    real(wp) :: gap, scale, nrm(2, n_contacts), rows, limit
 
     do k = 1, n_real
       if (input%given(k) .and. .not. ieee_is_finite(input%value(k))) then
@@ -290,12 +291,13 @@ contains
       end if
     end if
     if (input%given(i_t_end) .and. (input%given(i_dt) .or. input%given(i_dt_out))) then
-      if (input%value(i_t_end) / value_or(input, i_dt_out, input%value(i_dt)) > &
-          value_or(input, i_max_rows, real(max_samples, wp)) - 1.0_wp) then
+      rows = row_count(input%value(i_t_end), value_or(input, i_dt_out, input%value(i_dt)))
+      limit = value_or(input, i_max_rows, real(max_samples, wp))
+      if (rows > limit) then
         call raise(error, status_input, 't_end / dt_out = ' // &
           trim(fmt(input%value(i_t_end) / value_or(input, i_dt_out, input%value(i_dt)))) // &
-          ' output rows is over the limit of ' // trim(fmt(value_or(input, i_max_rows, real(max_samples, wp)))) // &
-          ': set a larger dt_out (or &run max_rows)')
+          ' makes ' // trim(fmt_count(rows)) // ' output rows (t = 0 included), over the limit of ' // &
+          trim(fmt_count(limit)) // ': set a larger dt_out (or &run max_rows)')
         return
       end if
     end if
@@ -431,7 +433,7 @@ contains
     type(scene_type), intent(out) :: scene
     type(error_type), allocatable, intent(out) :: error
     integer :: i, k
-    real(wp) :: g, ratio
+    real(wp) :: g
 
     call validate(input, .true., error)
     if (allocated(error)) return
@@ -500,11 +502,28 @@ contains
     if (input%given(i_zero_vel)) scene%zero_velocity = input%value(i_zero_vel)
     if (input%given(i_max_impulses)) scene%max_impulses = int(input%value(i_max_impulses))
     if (input%given(i_max_step_events)) scene%max_step_events = int(input%value(i_max_step_events))
-    ! Samples at j*dt_out, and at t_end when it is off that grid.
-    ratio = scene%t_end / scene%dt_out
-    scene%n_samples = nint(ratio) + 1
-    if (abs(ratio - nint(ratio)) > 1.0e-9_wp * max(1.0_wp, ratio)) scene%n_samples = floor(ratio) + 2
+    ! (validate keeps the count within max_rows, a default integer)
+    scene%n_samples = int(row_count(scene%t_end, scene%dt_out))
   end subroutine build_scene
+
+  !> Output rows of a run: samples at j dt_out from t = 0, and at t_end when it is off that
+  !> grid (within 1e-9 of a step it is on it). Real: a refused scene's count may exceed any
+  !> integer.
+  pure real(wp) function row_count(t_end, dt_out)
+    real(wp), intent(in) :: t_end, dt_out
+    real(wp) :: ratio
+    ratio = t_end / dt_out
+    row_count = anint(ratio) + 1.0_wp
+    if (abs(ratio - anint(ratio)) > 1.0e-9_wp * max(1.0_wp, ratio)) row_count = aint(ratio) + 2.0_wp
+  end function row_count
+
+  !> A count held in a real, written as an integer (10000001, not 10000001.0).
+  pure function fmt_count(count) result(text)
+    real(wp), intent(in) :: count
+    character(len=fmt_width) :: text
+    text = fmt(count)
+    if (count < 0.5_wp * real(huge(1_int64), wp)) text = fmt(int(count, int64))
+  end function fmt_count
 
   !> Time of output sample j (0-based): j dt_out, and t_end for the last one.
   pure real(wp) function sample_time(scene, j)

@@ -180,3 +180,21 @@ def test_last_line_without_newline(tmp_path):
     scene = impact1d.load_scene(scene_file(tmp_path, CASE3.rstrip("\n")))
     assert scene == impact1d.load_scene(INPUT / "case3.nml").__class__(
         **{**vars(impact1d.load_scene(INPUT / "case3.nml")), "source": str(tmp_path / "scene.nml")})
+
+
+# --- issue 18 item 9: the row limit counts rows -----------------------------------------
+
+def test_row_limit_message_counts_the_rows(tmp_path):
+    """'10000000.0 output rows is over the limit of 10000000.0': the run would have written
+    10^7 + 1 rows (t = 0 included), and counts are integers."""
+    scene = impact1d.load_scene(INPUT / "case3.nml")
+    with pytest.raises(impact1d.InputError) as caught:
+        impact1d.simulate(scene, t_end=1.0e7, dt=1.0, dt_out=1.0)
+    assert "10000001 output rows" in str(caught.value) and "limit of 10000000:" in str(caught.value)
+    assert "10000000.0" not in str(caught.value).split("makes")[1]
+    # At the limit the run writes exactly max_rows rows; one more row is refused.
+    assert len(impact1d.simulate(scene, t_end=1.0, dt_out=0.1, max_rows=11).t) == 11
+    with pytest.raises(impact1d.InputError, match="makes 11 output rows .* limit of 10:"):
+        impact1d.simulate(scene, t_end=1.0, dt_out=0.1, max_rows=10)
+    # t_end within rounding of the grid: 11 rows, not refused as 12.
+    assert len(impact1d.simulate(scene, t_end=1.0 + 1e-12, dt_out=0.1, max_rows=11).t) == 11
