@@ -28,6 +28,8 @@ module impact1d_io
   integer, parameter :: dat_order(17) = [i_m1, i_m2, i_mu1, i_r_left, i_r_right, i_r_min, &
     i_r_max, i_x_left, i_x_right, i_d_min, i_d_max, i_x1, i_x2, i_v1, i_v2, i_f1, i_f2]
   real(wp), parameter :: dat_gravity = 10.0_wp
+  !> What read_numbers found: every number, text that is not numbers, or a value missing.
+  integer, parameter :: number_ok = 0, number_malformed = 1, number_null = 2
 
 contains
 
@@ -335,15 +337,42 @@ contains
     end subroutine fail
   end subroutine scan_groups
 
+  !> The numbers of one line (a table row, a .dat entry) as list-directed
+  !> input reads them, every one there and nothing after them. A null (', 5', '1*', a line
+  !> cut short by '/') leaves its variable as it was, an uninitialised or an earlier line's
+  !> value: a value that reads as the fill is read again over another fill, and one that
+  !> kept both is missing.
+  subroutine read_numbers(text, values, status)
+    character(len=*), intent(in) :: text
+    real(wp), intent(out) :: values(:)
+    integer, intent(out) :: status
+    real(wp) :: again(size(values)), surplus
+    integer :: ios, extra
+    values = huge(1.0_wp)
+    read(text, *, iostat=ios) values
+    again = values
+    if (ios == 0 .and. any(values == huge(1.0_wp))) then
+      again = -huge(1.0_wp)
+      read(text, *, iostat=ios) again
+    end if
+    extra = -1
+    if (ios == 0) read(text, *, iostat=extra) again, surplus
+    status = number_malformed
+    if (ios /= 0 .or. extra == 0) return
+    status = number_null
+    if (any(values == huge(1.0_wp) .and. again == -huge(1.0_wp))) return
+    status = number_ok
+  end subroutine read_numbers
+
   !> The tutorial's parameter file: 17 numbers, one per line, '#' starts a comment; an
   !> optional 18th entry names a table added to f1 (the tutorial's triangle.dat button).
   subroutine read_dat(path, input, error)
     character(len=*), intent(in) :: path
     type(scene_input), intent(inout) :: input
     type(error_type), allocatable, intent(out) :: error
-    integer :: unit, ios, n_read, line_number, extra
+    integer :: unit, ios, n_read, line_number, status
     character(len=:), allocatable :: line
-    real(wp) :: value, surplus
+    real(wp) :: value(1)
     logical :: found
 
     call open_data_file(path, unit, error)
@@ -362,16 +391,17 @@ contains
       if (.not. found) exit
       n_read = n_read + 1
       if (n_read <= size(dat_order)) then
-        extra = -1
-        read(line, *, iostat=ios) value
-        if (ios == 0) read(line, *, iostat=extra) value, surplus
-        if (ios /= 0 .or. extra == 0) then
+        ! A null (',', '1*') would leave value as the line before set it, or the first line
+        ! uninitialised.
+        call read_numbers(line, value, status)
+        if (status /= number_ok) then
           close(unit)
           call raise(error, status_input, path // ':' // trim(fmt(line_number)) // ': ''' // trim(adjustl(line)) // &
-            ''' is not one number (expected ' // trim(real_names(dat_order(n_read))) // ')')
+            trim(merge(''' holds no number  ', ''' is not one number', status == number_null)) // ' (expected ' // &
+            trim(real_names(dat_order(n_read))) // ')')
           return
         end if
-        input%value(dat_order(n_read)) = value
+        input%value(dat_order(n_read)) = value(1)
         input%given(dat_order(n_read)) = .true.
       else if (n_read == size(dat_order) + 1) then
         input%text(i_f1_table) = beside(path, trim(adjustl(line)))
@@ -404,9 +434,9 @@ contains
     character(len=*), intent(in) :: path
     type(table_type), intent(out) :: table
     type(error_type), allocatable, intent(out) :: error
-    integer :: unit, ios, line_number, n, extra
+    integer :: unit, line_number, n, status
     character(len=:), allocatable :: line
-    real(wp) :: row(2), surplus
+    real(wp) :: row(2)
     real(wp), allocatable :: t(:), f(:)
     logical :: found
 
@@ -418,11 +448,10 @@ contains
     do
       call next_data_line(unit, line, line_number, found)
       if (.not. found) exit
-      extra = -1
-      read(line, *, iostat=ios) row
-      if (ios == 0) read(line, *, iostat=extra) row, surplus
-      if (ios /= 0 .or. extra == 0) then
-        call fail(': expected two numbers "t f", got ''' // trim(adjustl(line)) // '''')
+      ! A null (', 5') would leave the row's earlier values.
+      call read_numbers(line, row, status)
+      if (status /= number_ok) then
+        call fail(': malformed row ''' // trim(adjustl(line)) // ''': expected two numbers "t f"')
         return
       end if
       if (.not. all(ieee_is_finite(row))) then

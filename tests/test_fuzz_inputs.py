@@ -3,6 +3,8 @@ with finite numbers, or an InputError / SimulationError with a one-line message;
 another exception, a crash or a hang. Seeded, so a failure reproduces."""
 
 import random
+import re
+import shutil
 import subprocess
 from pathlib import Path
 
@@ -118,3 +120,42 @@ def test_mutated_scenes_through_the_cli(tmp_path):
             lines = done.stderr.decode("utf-8", errors="replace").strip().splitlines()
             assert len(lines) == 1 and lines[0].startswith("impact1d: "), f"mutation {n}: {lines}"
             assert not any(b < 32 for b in done.stderr.rstrip(b"\n")), f"mutation {n}"
+
+
+# --- issue 18: families whose outcome is known -------------------------------------------
+# Each mutation below has one right answer: a named refusal (a broken .dat line), or the
+# scene read exactly as meant (a harmless reformatting of a .dat number).
+
+N_FAMILY = 40
+DAT_BAD = [",", "1*", ", 5", "5 5", "5 /", "/", "2*3", "x", "5,,", "1 , ,"]
+DAT_SAME = ["  {v}  ", "{v}e0", "{v}  # a note", "{v}d0"]
+
+
+def scene_of(path):
+    """A loaded scene's fields but its source."""
+    return {k: v for k, v in vars(impact1d.load_scene(path)).items() if k != "source"}
+
+
+def seeded(family):
+    return random.Random(f"{SEED}-{family}")
+
+
+def test_mutated_dat_lines_are_refused_naming_the_line_or_read_the_same(tmp_path):
+    rng = seeded("dat")
+    shutil.copy(INPUT / "triangle.dat", tmp_path / "triangle.dat")
+    for n in range(N_FAMILY):
+        source = rng.choice(sorted(INPUT.glob("input*.dat")))
+        lines = source.read_text().splitlines()
+        numbers = [i for i, line in enumerate(lines) if line.strip() and not line.lstrip().startswith("#")]
+        i = rng.choice(numbers[:17])
+        value = lines[i].split("#")[0].strip()
+        path = tmp_path / f"dat{n}.dat"
+        if rng.random() < 0.7:
+            lines[i] = rng.choice(DAT_BAD)
+            path.write_text("\n".join(lines) + "\n")
+            with pytest.raises(impact1d.InputError, match=re.escape(f"dat{n}.dat:{i + 1}: ")):
+                impact1d.load_scene(path)
+        else:
+            lines[i] = rng.choice(DAT_SAME).format(v=value)
+            path.write_text("\n".join(lines) + "\n")
+            assert scene_of(path) == {**scene_of(source), "f1_table": scene_of(path)["f1_table"]}, lines[i]

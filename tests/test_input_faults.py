@@ -1,6 +1,7 @@
 """Hostile and unlucky input (issue 13 items 4, 5, 6, 8, 10; issue 12 item 5): every
 mistake is an InputError naming what is wrong, never a silently different scene."""
 
+import re
 import subprocess
 import time
 from pathlib import Path
@@ -180,6 +181,57 @@ def test_last_line_without_newline(tmp_path):
     scene = impact1d.load_scene(scene_file(tmp_path, CASE3.rstrip("\n")))
     assert scene == impact1d.load_scene(INPUT / "case3.nml").__class__(
         **{**vars(impact1d.load_scene(INPUT / "case3.nml")), "source": str(tmp_path / "scene.nml")})
+
+
+# --- issue 18 items 6 and 9: a .dat line or a table row with a value missing -------------
+
+def dat_lines():
+    """input3.dat's lines, and the index of each line that holds a number."""
+    lines = (INPUT / "input3.dat").read_text().splitlines()
+    return lines, [i for i, line in enumerate(lines) if line.strip() and not line.startswith("#")]
+
+
+@pytest.mark.parametrize("null", [",", "1*", ", # m1"])
+def test_null_dat_line_is_refused_and_nothing_survives_a_read(tmp_path, null):
+    """A null as the first number left m1 uninitialised: the CLI saw 0.0, Python the value
+    the previous read left on the stack (4.0 after a file whose last number was 4.0)."""
+    lines, numbers = dat_lines()
+    good = list(lines)
+    good[numbers[0]] = "4.0  # m1"
+    good[numbers[-1]] = "4.0  # f2"
+    (tmp_path / "good.dat").write_text("\n".join(good) + "\n")
+    assert impact1d.load_scene(tmp_path / "good.dat").m1 == 4.0
+    bad = list(lines)
+    bad[numbers[0]] = null
+    (tmp_path / "bad.dat").write_text("\n".join(bad) + "\n")
+    with pytest.raises(impact1d.InputError, match=f"bad.dat:{numbers[0] + 1}: .* holds no number "
+                                                  r"\(expected m1\)"):
+        impact1d.load_scene(tmp_path / "bad.dat")
+    done = subprocess.run([find_tool("impact1d"), str(tmp_path / "bad.dat"), "--t-end", "1",
+                           "--dt", "1e-3", "-o", str(tmp_path / "out.dat")],
+                          capture_output=True, text=True, timeout=RUN_TIMEOUT)
+    assert done.returncode == 1 and f"bad.dat:{numbers[0] + 1}:" in done.stderr
+
+
+def test_null_dat_line_later_does_not_repeat_the_one_before(tmp_path):
+    """'1*' as x2 reused x1's 1.0 (the scene then failed on a slot it had not asked for)."""
+    lines, numbers = dat_lines()
+    lines[numbers[12]] = "1*  # x2(0)"
+    (tmp_path / "x2.dat").write_text("\n".join(lines) + "\n")
+    with pytest.raises(impact1d.InputError, match=rf"x2.dat:{numbers[12] + 1}: '1\*' holds no number "
+                                                  r"\(expected x2\)"):
+        impact1d.load_scene(tmp_path / "x2.dat")
+
+
+@pytest.mark.parametrize("row", [", 5", "0.5 ,", "1*", "0.5 /"])
+def test_malformed_table_row_is_named(tmp_path, row):
+    """', 5' took the row before's time: "time 0.0 does not increase"."""
+    (tmp_path / "table.dat").write_text(f"# t f\n0 1\n{row}\n1 2\n")
+    text = (INPUT / "case6.nml").read_text().replace("'triangle.dat'", "'table.dat'")
+    scene = impact1d.load_scene(scene_file(tmp_path, text))
+    with pytest.raises(impact1d.InputError, match=re.escape(f"table.dat:3: malformed row '{row}'")):
+        impact1d.simulate(scene, t_end=0.1)
+
 
 
 # --- issue 18 item 9: the row limit counts rows -----------------------------------------
