@@ -6,7 +6,7 @@ program impact1d_cli
   use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char
   use impact1d_kinds, only: wp
   use impact1d_error, only: error_type, status_input, status_simulation, fmt
-  use impact1d_scene, only: scene_input, scene_type, i_t_end, i_dt, i_dt_out, i_method, i_title, &
+  use impact1d_scene, only: scene_input, scene_type, set_text, i_t_end, i_dt, i_dt_out, i_method, i_title, &
     i_f1_table, i_f2_table
   use impact1d_io, only: read_scene_file, prepare_scene, lower
   use impact1d_output, only: file_sink, event_names, n_event_kinds, events_path, i_pe, i_work, &
@@ -135,7 +135,7 @@ program impact1d_cli
   if (allocated(error)) call fail(error%status, error%message)
   input%value([i_t_end, i_dt, i_dt_out]) = merge(overrides, input%value([i_t_end, i_dt, i_dt_out]), overridden)
   input%given([i_t_end, i_dt, i_dt_out]) = input%given([i_t_end, i_dt, i_dt_out]) .or. overridden
-  if (len_trim(method) > 0) input%text(i_method) = method
+  if (len_trim(method) > 0) call set_text(input, i_method, trim(method))
   call prepare_scene(input, scene, error)
   if (allocated(error)) call fail(error%status, scene_path // ': ' // error%message)
 
@@ -171,7 +171,7 @@ contains
   subroutine summary()
     character(len=:), allocatable :: text, line
     character(len=16) :: number
-    text = 'impact1d: ' // trim(input%text(i_title)) // nl
+    text = 'impact1d: ' // trim(input%text(i_title)%s) // nl
     text = text // '  scene     ' // scene_path // ' (method ' // scene%method // ', dt = ' // &
       trim(fmt(scene%dt)) // ' s, t_end = ' // trim(fmt(scene%t_end)) // ' s)' // nl
     text = text // '  output    ' // out_path // ' (' // trim(fmt(scene%n_samples)) // ' rows every ' // &
@@ -260,10 +260,10 @@ contains
     if (target == other) call fail(status_input, 'cannot write output ' // path // &
       ': it is the scene file ' // scene_path // ' (choose another -o)')
     do k = i_f1_table, i_f2_table
-      if (len_trim(input%text(k)) == 0) cycle
-      call resolve(trim(input%text(k)), other)
+      if (len_trim(input%text(k)%s) == 0) cycle
+      call resolve(trim(input%text(k)%s), other)
       if (target == other) call fail(status_input, 'cannot write output ' // &
-        path // ': it is the force table ' // trim(input%text(k)) // ' (choose another -o)')
+        path // ': it is the force table ' // trim(input%text(k)%s) // ' (choose another -o)')
     end do
   end subroutine refuse_to_overwrite_inputs
 

@@ -10,7 +10,7 @@ module impact1d_api
   use impact1d_error, only: error_type, status_ok, status_input, status_interrupted
   use impact1d_interrupt, only: catch_interrupts
   use impact1d_scene, only: scene_input, scene_type, n_real, n_text, real_names, text_names, &
-    i_title, i_f1_table, i_f2_table, i_method, n_contacts
+    i_title, i_f1_table, i_f2_table, i_method, n_contacts, set_text
   use impact1d_io, only: read_scene_file, prepare_scene
   use impact1d_output, only: memory_sink, summary_sink, column_names_text => column_names, event_names, &
     n_columns, event_impact, present_columns, i_impact_loss, i_friction_loss
@@ -48,34 +48,41 @@ contains
     names = joined(event_names)
   end subroutine event_kind_names
 
-  !> Read and check a scene file ('.dat': VisSim-style parameters; else a namelist).
-  subroutine read_scene(path, n, values, given, title, f1_table, f2_table, method, status, message)
+  !> Read and check a scene file ('.dat': VisSim-style parameters; else a namelist). The
+  !> texts (title, f1_table, f2_table, method), kept whole whatever their length, come back
+  !> as character codes: text_codes(:text_lengths(k), k). When one is longer than
+  !> text_room, status is 3 and text_lengths say the room needed: call again with it.
+  subroutine read_scene(path, n, text_room, values, given, text_codes, text_lengths, status, message)
     !f2py threadsafe
     character(len=*), intent(in) :: path
-    integer(c_int), intent(in) :: n
+    integer(c_int), intent(in) :: n, text_room
     real(c_double), intent(out) :: values(n)
     integer(c_int), intent(out) :: given(n)
-    character(len=1024), intent(out) :: title, f1_table, f2_table, method
+    integer(c_int), intent(out) :: text_codes(text_room, 4)    ! 4: n_text (f2py needs the number)
+    integer(c_int), intent(out) :: text_lengths(4)
     integer(c_int), intent(out) :: status
     character(len=512), intent(out) :: message
     type(scene_input) :: input
     type(error_type), allocatable :: error
+    integer :: k
 
     values = 0.0_c_double
     given = 0
-    title = ''
-    f1_table = ''
-    f2_table = ''
-    method = ''
+    text_codes = ichar(' ')
+    text_lengths = 0
     if (.not. field_count_ok(n, status, message)) return
     call read_scene_file(path, input, error)
     if (failed(error, status, message)) return
     values = real(input%value, c_double)
     given = merge(1_c_int, 0_c_int, input%given)
-    title = input%text(i_title)
-    f1_table = input%text(i_f1_table)
-    f2_table = input%text(i_f2_table)
-    method = input%text(i_method)
+    do k = 1, n_text
+      text_lengths(k) = len_trim(input%text(k)%s)
+      call put_codes(trim(input%text(k)%s), text_codes(:, k))
+    end do
+    if (any(text_lengths > text_room)) then
+      status = status_too_small
+      message = 'internal: the text buffers are too small'
+    end if
   end subroutine read_scene
 
   !> Check and run a scene given as flat fields. The samples fill samples(:n_samples, :) and
@@ -176,18 +183,18 @@ contains
     type(summary_sink) :: sink
     type(error_type), allocatable :: error
     character(len=message_length) :: message
-    integer :: j, k
+    integer :: j
 
     summary = ieee_value(1.0_c_double, ieee_quiet_nan)
-    message_codes = iachar(' ')
+    message_codes = ichar(' ')
     status = status_input
     if (.not. field_count_ok(n, status(1), message)) then
-      message_codes(:, 1) = [(iachar(message(k:k)), k = 1, message_length)]
+      call put_codes(message, message_codes(:, 1))
       return
     end if
     if (n_summary /= size(summary_names) .or. any(over_index < 1 .or. over_index > n)) then
       message = 'internal: bad summary size or override index'
-      message_codes(:, 1) = [(iachar(message(k:k)), k = 1, message_length)]
+      call put_codes(message, message_codes(:, 1))
       return
     end if
     base = flat_input(values, given, title, f1_table, f2_table, method)
@@ -202,7 +209,7 @@ contains
         call run(scene, sink, stats, error)
       end if
       if (failed(error, status(j), message)) then
-        message_codes(:, j) = [(iachar(message(k:k)), k = 1, message_length)]
+        call put_codes(message, message_codes(:, j))
         ! An interrupt ends the batch: the runs not made say so too.
         if (status(j) == status_interrupted) then
           status(j + 1:) = status_interrupted
@@ -234,11 +241,22 @@ contains
     type(scene_input) :: input
     input%value = real(values, wp)
     input%given = given /= 0
-    input%text(i_title) = title
-    input%text(i_f1_table) = f1_table
-    input%text(i_f2_table) = f2_table
-    input%text(i_method) = method
+    call set_text(input, i_title, title)
+    call set_text(input, i_f1_table, f1_table)
+    call set_text(input, i_f2_table, f2_table)
+    call set_text(input, i_method, method)
   end function flat_input
+
+  !> A text as character codes (byte values, 0 to 255), blank padded or cut to size(codes).
+  pure subroutine put_codes(text, codes)
+    character(len=*), intent(in) :: text
+    integer(c_int), intent(out) :: codes(:)
+    integer :: k
+    codes = ichar(' ')
+    do k = 1, min(len(text), size(codes))
+      codes(k) = ichar(text(k:k))
+    end do
+  end subroutine put_codes
 
   !> Words separated by single spaces (how names cross to Python), as long as the flat
   !> API's names (no function returns a deferred-length string: see impact1d_error's fmt).

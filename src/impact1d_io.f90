@@ -4,8 +4,8 @@ module impact1d_io
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use impact1d_kinds, only: wp
   use impact1d_error, only: error_type, raise, status_input, fmt
-  use impact1d_scene, only: scene_input, scene_type, build_scene, validate, n_real, real_names, &
-    i_m1, i_m2, i_mu1, i_mu2, i_g, i_r_left, i_r_right, i_r_min, i_r_max, i_x_left, i_x_right, &
+  use impact1d_scene, only: scene_input, scene_type, build_scene, validate, set_text, n_real, n_text, &
+    real_names, text_names, i_m1, i_m2, i_mu1, i_mu2, i_g, i_r_left, i_r_right, i_r_min, i_r_max, i_x_left, i_x_right, &
     i_d_min, i_d_max, i_x1, i_x2, i_v1, i_v2, i_f1, i_f2, i_title, i_f1_table, i_f2_table, i_method
   use impact1d_forcing, only: table_type
   use impact1d_files, only: check_input_file
@@ -13,13 +13,9 @@ module impact1d_io
   private
   public :: read_scene_file, prepare_scene, read_table, lower
 
-  !> Fills for the namelist variables before reading; a variable is given when it is not
-  !> its fill after either of two reads over different fills (see read_namelist).
-  real(wp), parameter :: absent = huge(1.0_wp)
-  character(len=*), parameter :: absent_text = achar(1), absent_text_other = achar(2)
   character(len=*), parameter :: known_groups(8) = [character(len=7) :: &
     'scene', 'bodies', 'walls', 'link', 'initial', 'forces', 'springs', 'run']
-  !> Each group's variables, for the message about a misspelt one (as the namelists below).
+  !> Each group's variables: which group a name belongs to, and the message about a misspelt one.
   character(len=*), parameter :: group_variables(size(known_groups)) = [character(len=96) :: &
     'title', 'm1, m2, mu1, mu2, mus1, mus2, g', 'x_left, r_left, x_right, r_right', 'd_min, r_min, d_max, r_max', &
     'x1, v1, x2, v2', 'f1, f2, f1_table, f2_table, f1_amp, f1_period, f1_phase, f2_amp, f2_period, f2_phase', &
@@ -29,6 +25,20 @@ module impact1d_io
   integer, parameter :: dat_order(17) = [i_m1, i_m2, i_mu1, i_r_left, i_r_right, i_r_min, &
     i_r_max, i_x_left, i_x_right, i_d_min, i_d_max, i_x1, i_x2, i_v1, i_v2, i_f1, i_f2]
   real(wp), parameter :: dat_gravity = 10.0_wp
+  character(len=*), parameter :: letters = 'abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ'
+  character(len=*), parameter :: name_chars = letters // '0123456789_'
+  !> What read_numbers found: every number, text that is not numbers, or a value missing.
+  integer, parameter :: number_ok = 0, number_malformed = 1, number_null = 2
+
+  !> A namelist file while it is parsed: its text (join_lines) and where each line starts,
+  !> the group open (0: none), the line of each group and of each variable given (0: none).
+  type :: namelist_text
+    character(len=:), allocatable :: path, flat
+    integer, allocatable :: starts(:)
+    integer :: open_group = 0
+    integer :: group_line(size(known_groups)) = 0
+    integer :: given_line(n_real + n_text) = 0
+  end type namelist_text
 
 contains
 
@@ -38,12 +48,15 @@ contains
     character(len=*), intent(in) :: path
     type(scene_input), intent(out) :: input
     type(error_type), allocatable, intent(out) :: error
-    integer :: n
+    integer :: n, k
     n = len_trim(path)
     if (n == 0) then
       call raise(error, status_input, 'no scene file given')
       return
     end if
+    do k = 1, n_text      ! every text exists, absent ('') until the file gives it
+      call set_text(input, k, '')
+    end do
     if (n > 4) then
       if (path(n - 3:n) == '.dat') then
         call read_dat(trim(path), input, error)
@@ -67,8 +80,8 @@ contains
     type(table_type) :: tables(2)
     integer :: i
     do i = 1, 2
-      if (len_trim(input%text(i_f1_table + i - 1)) == 0) cycle
-      call read_table(trim(input%text(i_f1_table + i - 1)), tables(i), error)
+      if (len_trim(input%text(i_f1_table + i - 1)%s) == 0) cycle
+      call read_table(trim(input%text(i_f1_table + i - 1)%s), tables(i), error)
       if (allocated(error)) then
         error%message = 'f' // trim(fmt(i)) // '_table: ' // error%message
         return
@@ -77,112 +90,290 @@ contains
     call build_scene(input, tables, scene, error)
   end subroutine prepare_scene
 
+  !> A namelist scene, read by its own parser: gfortran's namelist reader took an '&initial'
+  !> inside a quoted title for the group, and passed over a variable with no value
+  !> ('v1 = ,', 'v2 = 1*', 'f2 /') or given twice. Groups '&name ... /' ('$name', and '&end'
+  !> or '$end' for '/'), items 'name = value' apart by blanks, commas or semicolons, '!'
+  !> comments. Quoted text ('...' or "...", a doubled quote standing for one) is never
+  !> scanned for groups, ends or separators. A number is read as list-directed input reads
+  !> it: the same digits give the same double as the namelist reader did.
   subroutine read_namelist(path, input, error)
     character(len=*), intent(in) :: path
     type(scene_input), intent(inout) :: input
     type(error_type), allocatable, intent(out) :: error
-    real(wp) :: m1, m2, mu1, mu2, g, x_left, r_left, x_right, r_right, d_min, r_min, d_max, r_max
-    real(wp) :: x1, v1, x2, v2, f1, f2, f1_amp, f1_period, f1_phase, f2_amp, f2_period, f2_phase
-    real(wp) :: t_end, dt, dt_out, zero_vel, max_rows, max_impulses, max_step_events
-    real(wp) :: mus1, mus2, k1, x1_rest, c1, k2, x2_rest, c2, k12, d_rest, c12
-    character(len=1024) :: title, f1_table, f2_table, method
-    namelist /scene/ title
-    namelist /bodies/ m1, m2, mu1, mu2, mus1, mus2, g
-    namelist /walls/ x_left, r_left, x_right, r_right
-    namelist /link/ d_min, r_min, d_max, r_max
-    namelist /initial/ x1, v1, x2, v2
-    namelist /forces/ f1, f2, f1_table, f2_table, f1_amp, f1_period, f1_phase, f2_amp, f2_period, f2_phase
-    namelist /springs/ k1, x1_rest, c1, k2, x2_rest, c2, k12, d_rest, c12
-    namelist /run/ t_end, dt, dt_out, method, zero_vel, max_rows, max_impulses, max_step_events
-    logical :: present(size(known_groups))
-    integer :: ios, j
-    character(len=512) :: message
-    real(wp) :: values(n_real), values_other(n_real)
-    character(len=1024) :: texts(4), texts_other(4)
-    character(len=:), allocatable :: lines(:), reason
+    character(len=:), allocatable :: lines(:)
+    type(namelist_text) :: nml
+    integer :: j, k
 
-    call scan_groups(path, present, error)
-    if (allocated(error)) return
-    ! The namelist reader reads the file's lines as an internal file: reading the file itself
-    ! it hit its end on a last line without a newline ("in &run: End of file").
     call read_all_lines(path, lines, error)
     if (allocated(error)) return
-    do j = 1, size(known_groups)
-      if (any(trim(known_groups(j)) == ['bodies ', 'initial', 'run    ']) .and. .not. present(j)) then
-        call raise(error, status_input, path // ': the required group &' // trim(known_groups(j)) // &
-          ' is missing')
+    nml%path = path
+    call join_lines(lines, nml%flat, nml%starts, k)
+    if (k > 0) then
+      call raise(error, status_input, path // ':' // trim(fmt(k)) // ': a quote opened on this line is not ' // &
+        'closed on it (quoted text is one line; a quote inside it is written twice: ''it''''s'')')
+      return
+    end if
+    if (len_trim(nml%flat) == 0) then
+      call raise(error, status_input, path // ': the file is empty')
+      return
+    end if
+    j = 1
+    do while (j <= len(nml%flat))
+      call next_item(nml, j, input, error)
+      if (allocated(error)) return
+    end do
+    if (nml%open_group > 0) then
+      call raise(error, status_input, path // ':' // trim(fmt(nml%group_line(nml%open_group))) // ': the group &' // &
+        trim(known_groups(nml%open_group)) // ' has no closing ''/'' (every group ends with /)')
+      return
+    end if
+    do k = 1, size(known_groups)
+      if (any(trim(known_groups(k)) == ['bodies ', 'initial', 'run    ']) .and. nml%group_line(k) == 0) then
+        call raise(error, status_input, path // ': the required group &' // trim(known_groups(k)) // ' is missing')
         return
       end if
     end do
-
-    ! Whether a variable was given cannot depend on its value: the file is read twice, over
-    ! two different fills; a variable the file sets reads the same both times.
-    call read_groups(absent, absent_text, values, texts)
-    if (allocated(error)) return
-    call read_groups(-absent, absent_text_other, values_other, texts_other)
-    if (allocated(error)) return
-    input%given = .not. (values == absent .and. values_other == -absent)
-    input%value = merge(values, 0.0_wp, input%given)
-    title = texts(1)
-    f1_table = texts(2)
-    f2_table = texts(3)
-    method = texts(4)
-    do j = 1, size(texts)
-      if (texts(j) /= absent_text .or. texts_other(j) /= absent_text_other) cycle
-      if (j == 1) title = absent_text
-      if (j == 2) f1_table = absent_text
-      if (j == 3) f2_table = absent_text
-      if (j == 4) method = absent_text
-    end do
-    input%text(i_title) = given_text(title)
-    input%text(i_f1_table) = beside(path, given_text(f1_table))
-    input%text(i_f2_table) = beside(path, given_text(f2_table))
-    input%text(i_method) = lower(given_text(method))
-
-  contains
-
-    !> Every variable set to fill (texts to text_fill), then every group present read.
-    subroutine read_groups(fill, text_fill, values, texts)
-      real(wp), intent(in) :: fill
-      character(len=*), intent(in) :: text_fill
-      real(wp), intent(out) :: values(n_real)
-      character(len=1024), intent(out) :: texts(4)
-      m1 = fill; m2 = fill; mu1 = fill; mu2 = fill; g = fill
-      x_left = fill; r_left = fill; x_right = fill; r_right = fill
-      d_min = fill; r_min = fill; d_max = fill; r_max = fill
-      x1 = fill; v1 = fill; x2 = fill; v2 = fill; f1 = fill; f2 = fill
-      f1_amp = fill; f1_period = fill; f1_phase = fill
-      f2_amp = fill; f2_period = fill; f2_phase = fill
-      t_end = fill; dt = fill; dt_out = fill; zero_vel = fill
-      max_rows = fill; max_impulses = fill; max_step_events = fill
-      mus1 = fill; mus2 = fill; k1 = fill; x1_rest = fill; c1 = fill; k2 = fill; x2_rest = fill
-      c2 = fill; k12 = fill; d_rest = fill; c12 = fill
-      title = text_fill; f1_table = text_fill; f2_table = text_fill; method = text_fill
-      do j = 1, size(known_groups)
-        if (.not. present(j)) cycle
-        select case (trim(known_groups(j)))
-        case ('scene'); read(lines, nml=scene, iostat=ios, iomsg=message)
-        case ('bodies'); read(lines, nml=bodies, iostat=ios, iomsg=message)
-        case ('walls'); read(lines, nml=walls, iostat=ios, iomsg=message)
-        case ('link'); read(lines, nml=link, iostat=ios, iomsg=message)
-        case ('initial'); read(lines, nml=initial, iostat=ios, iomsg=message)
-        case ('forces'); read(lines, nml=forces, iostat=ios, iomsg=message)
-        case ('springs'); read(lines, nml=springs, iostat=ios, iomsg=message)
-        case ('run'); read(lines, nml=run, iostat=ios, iomsg=message)
-        end select
-        if (ios /= 0) then
-          call plain_reason(trim(message), j, reason)
-          call raise(error, status_input, path // ': in &' // trim(known_groups(j)) // ': ' // reason)
-          return
-        end if
-      end do
-      values = [m1, m2, mu1, mu2, g, x_left, r_left, x_right, r_right, d_min, r_min, d_max, r_max, &
-        x1, v1, x2, v2, f1, f2, f1_amp, f1_period, f1_phase, f2_amp, f2_period, f2_phase, t_end, dt, &
-        dt_out, zero_vel, max_rows, max_impulses, max_step_events, mus1, mus2, k1, x1_rest, c1, k2, &
-        x2_rest, c2, k12, d_rest, c12]
-      texts = [title, f1_table, f2_table, method]
-    end subroutine read_groups
   end subroutine read_namelist
+
+  !> The file's lines as one text with the '!' comments cut, tabs and carriage returns as
+  !> blanks (outside quotes) and a blank for each line's end; starts(l) is where line l
+  !> begins (starts(size(lines) + 1) one past the end). open_quote is the first line whose
+  !> quote is not closed on it, else 0.
+  pure subroutine join_lines(lines, flat, starts, open_quote)
+    character(len=*), intent(in) :: lines(:)
+    character(len=:), allocatable, intent(out) :: flat
+    integer, allocatable, intent(out) :: starts(:)
+    integer, intent(out) :: open_quote
+    character :: quote, c
+    integer :: l, k, at
+    allocate(character(len=sum(len_trim(lines)) + size(lines)) :: flat)
+    allocate(starts(size(lines) + 1))
+    open_quote = 0
+    at = 1
+    do l = 1, size(lines)
+      starts(l) = at
+      quote = ' '
+      do k = 1, len_trim(lines(l))
+        c = lines(l)(k:k)
+        if (quote /= ' ') then
+          if (c == quote) quote = ' '
+        else if (c == '!') then
+          exit
+        else if (c == '''' .or. c == '"') then
+          quote = c
+        else if (c == achar(9) .or. c == achar(13)) then
+          c = ' '
+        end if
+        flat(at:at) = c
+        at = at + 1
+      end do
+      if (quote /= ' ' .and. open_quote == 0) open_quote = l
+      flat(at:at) = ' '
+      at = at + 1
+    end do
+    starts(size(lines) + 1) = at
+    flat = flat(:at - 1)
+  end subroutine join_lines
+
+  !> The item at or after j: a group's start or end, or an assignment; j moves past it.
+  subroutine next_item(nml, j, input, error)
+    type(namelist_text), intent(inout) :: nml
+    integer, intent(inout) :: j
+    type(scene_input), intent(inout) :: input
+    type(error_type), allocatable, intent(inout) :: error
+    integer :: k, line
+    ! Between a group's items, commas and semicolons are separators; outside, text.
+    k = verify(nml%flat(j:), merge(' ,;', '   ', nml%open_group > 0))
+    if (k == 0) then
+      j = len(nml%flat) + 1
+      return
+    end if
+    j = j + k - 1
+    if (nml%flat(j:j) == '&' .or. nml%flat(j:j) == '$') then
+      call group_mark(nml, j, error)
+    else if (nml%open_group == 0) then
+      line = line_at(nml, j)
+      call raise(error, status_input, nml%path // ':' // trim(fmt(line)) // ': text outside any group: ''' // &
+        trim(nml%flat(j:nml%starts(line + 1) - 1)) // '''')
+    else if (nml%flat(j:j) == '/') then
+      nml%open_group = 0
+      j = j + 1
+    else
+      call assignment(nml, j, input, error)
+    end if
+  end subroutine next_item
+
+  !> '&name' (or '$name') at j: a group opens, or '&end' closes the open one.
+  subroutine group_mark(nml, j, error)
+    type(namelist_text), intent(inout) :: nml
+    integer, intent(inout) :: j
+    type(error_type), allocatable, intent(inout) :: error
+    character(len=:), allocatable :: name
+    integer :: finish, group, k, line
+    finish = name_end(nml%flat, j + 1)
+    name = lower(nml%flat(j + 1:finish))
+    line = line_at(nml, j)
+    j = finish + 1
+    if (name == 'end' .and. nml%open_group > 0) then
+      nml%open_group = 0
+      return
+    end if
+    if (nml%open_group > 0) then
+      call raise(error, status_input, nml%path // ':' // trim(fmt(line)) // ': the group &' // &
+        trim(known_groups(nml%open_group)) // ' (line ' // trim(fmt(nml%group_line(nml%open_group))) // &
+        ') has no closing ''/'' before &' // name)
+      return
+    end if
+    group = 0
+    do k = 1, size(known_groups)
+      if (trim(known_groups(k)) == name) group = k
+    end do
+    if (group == 0) then
+      call raise(error, status_input, nml%path // ':' // trim(fmt(line)) // ': unknown group &' // name // &
+        ' (groups: &scene &bodies &walls &link &initial &forces &springs &run)')
+    else if (nml%group_line(group) > 0) then
+      call raise(error, status_input, nml%path // ':' // trim(fmt(line)) // ': the group &' // name // &
+        ' is given twice (lines ' // trim(fmt(nml%group_line(group))) // ' and ' // trim(fmt(line)) // ')')
+    else
+      nml%group_line(group) = line
+      nml%open_group = group
+    end if
+  end subroutine group_mark
+
+  !> 'name = value' at j, inside the open group: the variable must be one of the group's,
+  !> given once, with a value.
+  subroutine assignment(nml, j, input, error)
+    type(namelist_text), intent(inout) :: nml
+    integer, intent(inout) :: j
+    type(scene_input), intent(inout) :: input
+    type(error_type), allocatable, intent(inout) :: error
+    character(len=:), allocatable :: name, value, context
+    integer :: finish, field, k, line
+    line = line_at(nml, j)
+    context = nml%path // ':' // trim(fmt(line)) // ': in &' // trim(known_groups(nml%open_group)) // ': '
+    finish = name_end(nml%flat, j)
+    name = lower(nml%flat(j:finish))
+    field = field_index(name, nml%open_group)
+    if (field == 0) then
+      k = scan(nml%flat(j:) // ' ', ' ,;=/')
+      call raise(error, status_input, context // 'unknown variable ''' // nml%flat(j:j + k - 2) // ''' (&' // &
+        trim(known_groups(nml%open_group)) // ' has: ' // trim(group_variables(nml%open_group)) // ')')
+      return
+    end if
+    k = verify(nml%flat(finish + 1:) // '=', ' ') + finish
+    if (.not. is_at(nml%flat, k, '=')) then
+      if (k > len(nml%flat) .or. scan(nml%flat(k:min(k, len(nml%flat))), ',;/&$' // letters) > 0) then
+        call raise(error, status_input, context // name // ' has no value (write ' // name // ' = ...)')
+      else
+        call raise(error, status_input, context // name // ' is followed by ''' // &
+          trim(nml%flat(k:nml%starts(line_at(nml, k) + 1) - 1)) // ''' where ''='' belongs')
+      end if
+      return
+    end if
+    if (nml%given_line(field) > 0) then
+      call raise(error, status_input, context // name // ' is given twice (lines ' // &
+        trim(fmt(nml%given_line(field))) // ' and ' // trim(fmt(line)) // ')')
+      return
+    end if
+    j = value_end(nml%flat, k + 1, nml%open_group)
+    value = trim(adjustl(nml%flat(k + 1:j - 1)))
+    if (len(value) > 0) then
+      if (scan(value(len(value):), ',;') > 0) value = trim(value(:len(value) - 1))
+    end if
+    call take_value(nml%path, field, name, value, input, error)
+    if (allocated(error)) error%message = context // error%message
+    nml%given_line(field) = line
+  end subroutine assignment
+
+  !> Where the value that starts at k ends: at the next '/', group mark or item outside
+  !> quotes. An item starts at a name after a comma, a name followed by '=', or a variable
+  !> of the group; a value is anything else ('1.0 2.0', '(1.0, 2.0)' and '0,5' are one
+  !> value each, so that the message can quote it).
+  pure integer function value_end(flat, k, group) result(e)
+    character(len=*), intent(in) :: flat
+    integer, intent(in) :: k, group
+    character :: quote, c
+    logical :: boundary, after_comma
+    integer :: finish, next
+    quote = ' '
+    boundary = .true.
+    after_comma = .false.
+    do e = k, len(flat)
+      c = flat(e:e)
+      if (quote /= ' ') then
+        if (c == quote) quote = ' '
+        boundary = .false.
+        after_comma = .false.
+        cycle
+      end if
+      if (c == '/') return
+      if (boundary .and. (c == '&' .or. c == '$') .and. e < len(flat)) then
+        if (index(letters, flat(e + 1:e + 1)) > 0) return
+      end if
+      if (boundary .and. index(letters, c) > 0) then
+        if (after_comma) return
+        finish = name_end(flat, e)
+        next = verify(flat(finish + 1:) // '=', ' ') + finish
+        if (is_at(flat, next, '=')) return
+        if (field_index(lower(flat(e:finish)), group) > 0) return
+      end if
+      if (c == '''' .or. c == '"') quote = c
+      if (c == ',' .or. c == ';') then
+        after_comma = .true.
+      else if (c /= ' ') then
+        after_comma = .false.
+      end if
+      boundary = scan(c, ' ,;') > 0
+    end do
+    e = len(flat) + 1
+  end function value_end
+
+  !> Put one variable's value into the input: a real must be one number, a text quoted.
+  subroutine take_value(path, field, name, value, input, error)
+    character(len=*), intent(in) :: path, name, value
+    integer, intent(in) :: field
+    type(scene_input), intent(inout) :: input
+    type(error_type), allocatable, intent(inout) :: error
+    character(len=:), allocatable :: text
+    real(wp) :: number(1)
+    integer :: status
+    logical :: ok
+    ! In a namelist a comma always separates: '0,5' is not one number.
+    status = number_malformed
+    if (field <= n_real .and. scan(value, ',;') == 0) call read_numbers(value, number, status)
+    if (len(value) == 0) then
+      call raise(error, status_input, name // ' has no value (write ' // name // ' = ...)')
+    else if (status == number_null .or. (value(len(value):) == '*' .and. &
+        verify(value(:len(value) - 1), '0123456789') == 0)) then
+      ! 'r*' alone, a repeat count of nothing, is a null.
+      call raise(error, status_input, name // ' = ' // value // ' has no value (a null: write ' // name // ' = ...)')
+    else if (field <= n_real .and. (value == '+' .or. value == '-')) then
+      call raise(error, status_input, '''' // name // ' = ' // value // ''' has no number after its sign')
+    else if (status == number_malformed .and. field <= n_real) then
+      if (decimal_comma(value)) then
+        call raise(error, status_input, name // ' = ''' // value // ''' is not a number (a decimal comma? ' // &
+          'write a point)')
+      else
+        call raise(error, status_input, name // ' = ''' // value // ''' is not a number')
+      end if
+    else if (field <= n_real) then
+      input%value(field) = number(1)
+      input%given(field) = .true.
+    else
+      call unquote(value, text, ok)
+      if (.not. ok) then
+        call raise(error, status_input, name // ' = ' // value // ' is not one quoted text (write ' // name // &
+          ' = ''...'')')
+      else if (field - n_real == i_method) then
+        call set_text(input, i_method, lower(text))
+      else if (field - n_real == i_title) then
+        call set_text(input, i_title, text)
+      else
+        call set_text(input, field - n_real, trim(beside(path, text)))
+      end if
+    end if
+  end subroutine take_value
 
   !> Every line of a file, as the records of an internal file (blank-padded to the longest).
   subroutine read_all_lines(path, lines, error)
@@ -210,131 +401,116 @@ contains
     close(unit)
   end subroutine read_all_lines
 
-  !> The namelist reader's message in plain words: a misspelt variable gets the group's names.
-  subroutine plain_reason(message, group, text)
-    character(len=*), intent(in) :: message
+  !> Whether text has character c at position k (false beyond its end).
+  pure logical function is_at(text, k, c)
+    character(len=*), intent(in) :: text
+    integer, intent(in) :: k
+    character, intent(in) :: c
+    is_at = .false.
+    if (k >= 1 .and. k <= len(text)) is_at = text(k:k) == c
+  end function is_at
+
+  !> Line of position j of a namelist's joined text.
+  pure integer function line_at(nml, j)
+    type(namelist_text), intent(in) :: nml
+    integer, intent(in) :: j
+    line_at = count(nml%starts(:size(nml%starts) - 1) <= j)
+  end function line_at
+
+  !> The last position of the name (letters, digits, '_') that starts at j; j - 1 if none.
+  pure integer function name_end(text, j)
+    character(len=*), intent(in) :: text
+    integer, intent(in) :: j
+    name_end = verify(text(j:) // ' ', name_chars) + j - 2
+  end function name_end
+
+  !> Variable `name` of group `group`: 1..n_real a real field, n_real + i text field i; 0
+  !> when the group has no such variable.
+  pure integer function field_index(name, group)
+    character(len=*), intent(in) :: name
     integer, intent(in) :: group
-    character(len=:), allocatable, intent(out) :: text
-    character(len=*), parameter :: unmatched = 'Cannot match namelist object name '
-    integer :: at
-    text = message
-    at = index(message, unmatched)
-    if (at == 0) return
-    text = 'unknown variable ''' // trim(message(at + len(unmatched):)) // ''' (&' // &
-      trim(known_groups(group)) // ' has: ' // trim(group_variables(group)) // ')'
-  end subroutine plain_reason
-
-  !> Which groups the file has, and the syntax the namelist reader would pass over in silence:
-  !> a misspelt group (&wall), a group given twice, text outside any group, a group without
-  !> its closing '/', and an assignment with no number (v1 = +). Quotes and '!' comments are
-  !> followed, so a '/' inside a title does not end its group.
-  subroutine scan_groups(path, present, error)
-    character(len=*), intent(in) :: path
-    logical, intent(out) :: present(size(known_groups))
-    type(error_type), allocatable, intent(out) :: error
-    character(len=*), parameter :: blanks = ' ' // achar(9) // achar(13)
-    character(len=*), parameter :: name_chars = 'abcdefghijklmnopqrstuvwxyz' // &
-      'ABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_'
-    integer :: unit, ios, line_number, j, k, finish, group, group_line(size(known_groups)), open_group
-    character(len=:), allocatable :: line, name
-    character :: quote
-    logical :: any_content
-
-    present = .false.
-    any_content = .false.
-    group_line = 0
-    open_group = 0
-    quote = ' '
-    call open_data_file(path, unit, error)
-    if (allocated(error)) return
-    line_number = 0
-    do
-      call read_line(unit, line, ios)
-      if (ios /= 0) exit
-      line_number = line_number + 1
-      j = 1
-      do while (j <= len(line))
-        if (quote /= ' ') then
-          if (line(j:j) == quote) quote = ' '
-          j = j + 1
-          cycle
-        end if
-        if (scan(line(j:j), blanks) > 0) then
-          j = j + 1
-          cycle
-        end if
-        if (line(j:j) == '!') exit
-        any_content = .true.
-        if (line(j:j) == '&' .or. line(j:j) == '$') then
-          finish = verify(line(j + 1:) // ' ', name_chars) + j - 1
-          name = lower(line(j + 1:finish))
-          if (name == 'end' .and. open_group > 0) then
-            open_group = 0
-          else if (open_group > 0) then
-            call fail('the group &' // trim(known_groups(open_group)) // ' (line ' // &
-              trim(fmt(group_line(open_group))) // ') has no closing ''/'' before &' // name)
-            return
-          else
-            group = 0
-            do k = 1, size(known_groups)
-              if (trim(known_groups(k)) == name) group = k
-            end do
-            if (group == 0) then
-              call fail('unknown group &' // name // ' (groups: &scene &bodies &walls &link &initial &forces &springs &run)')
-              return
-            end if
-            if (present(group)) then
-              call fail('the group &' // name // ' is given twice (lines ' // trim(fmt(group_line(group))) // &
-                ' and ' // trim(fmt(line_number)) // ')')
-              return
-            end if
-            present(group) = .true.
-            group_line(group) = line_number
-            open_group = group
-          end if
-          j = finish + 1
-          cycle
-        end if
-        if (open_group == 0) then
-          call fail('text outside any group: ''' // trim(line(j:)) // '''')
-          return
-        end if
-        select case (line(j:j))
-        case ('/')
-          open_group = 0
-        case ('''', '"')
-          quote = line(j:j)
-        case ('=')
-          ! A lone sign after '=' is no value to the namelist reader: the variable would
-          ! silently stay absent.
-          k = verify(line(j + 1:) // '!', blanks) + j
-          if (k <= len(line)) then
-            finish = scan(line(k:) // ',', ' ,/!' // achar(9)) + k - 2
-            if (line(k:finish) == '+' .or. line(k:finish) == '-') then
-              call fail('''' // trim(line(:j)) // ' ' // line(k:finish) // ''' has no number after its sign')
-              return
-            end if
-          end if
-        end select
-        j = j + 1
-      end do
+    integer :: k
+    field_index = 0
+    if (len(name) == 0) return
+    if (index(', ' // trim(group_variables(group)) // ',', ', ' // name // ',') == 0) return
+    do k = 1, n_real
+      if (real_names(k) == name) field_index = k
     end do
-    close(unit)
-    if (open_group > 0) then
-      call raise(error, status_input, path // ':' // trim(fmt(group_line(open_group))) // ': the group &' // &
-        trim(known_groups(open_group)) // ' has no closing ''/'' (every group ends with /)')
-    else if (.not. any_content) then
-      call raise(error, status_input, path // ': the file is empty')
+    do k = 1, n_text
+      if (text_names(k) == name) field_index = n_real + k
+    end do
+  end function field_index
+
+  !> The text inside one quoted string ('...' or "..."), a doubled quote read as one; ok is
+  !> false for anything else (no quotes, two strings, a lone quote inside).
+  pure subroutine unquote(value, text, ok)
+    character(len=*), intent(in) :: value
+    character(len=:), allocatable, intent(out) :: text
+    logical, intent(out) :: ok
+    character(len=len(value)) :: buffer
+    character :: quote
+    integer :: k, n, m
+    text = ''
+    ok = .false.
+    n = len(value)
+    if (n < 2) return
+    quote = value(1:1)
+    if ((quote /= '''' .and. quote /= '"') .or. value(n:n) /= quote) return
+    m = 0
+    k = 2
+    do while (k < n)
+      if (value(k:k) == quote) then
+        if (k + 1 >= n .or. value(k + 1:k + 1) /= quote) return
+        k = k + 1
+      end if
+      m = m + 1
+      buffer(m:m) = value(k:k)
+      k = k + 1
+    end do
+    text = buffer(:m)
+    ok = .true.
+  end subroutine unquote
+
+  !> '0,5' or '-12,25': a number written with a decimal comma.
+  pure logical function decimal_comma(text)
+    character(len=*), intent(in) :: text
+    character(len=*), parameter :: digits = '0123456789'
+    integer :: c, first
+    c = index(text, ',')
+    first = 1
+    if (len(text) > 0) then
+      if (scan(text(1:1), '+-') > 0) first = 2
     end if
+    decimal_comma = c > first .and. c < len(text) .and. verify(text(first:max(c - 1, 0)), digits) == 0 .and. &
+      verify(text(c + 1:), digits) == 0
+  end function decimal_comma
 
-  contains
-
-    subroutine fail(what)
-      character(len=*), intent(in) :: what
-      close(unit)
-      call raise(error, status_input, path // ':' // trim(fmt(line_number)) // ': ' // what)
-    end subroutine fail
-  end subroutine scan_groups
+  !> The numbers of one line (a table row, a .dat entry, a namelist value) as list-directed
+  !> input reads them, every one there and nothing after them. A null (', 5', '1*', a line
+  !> cut short by '/') leaves its variable as it was, an uninitialised or an earlier line's
+  !> value: a value that reads as the fill is read again over another fill, and one that
+  !> kept both is missing.
+  subroutine read_numbers(text, values, status)
+    character(len=*), intent(in) :: text
+    real(wp), intent(out) :: values(:)
+    integer, intent(out) :: status
+    real(wp) :: again(size(values)), surplus
+    integer :: ios, extra
+    values = huge(1.0_wp)
+    read(text, *, iostat=ios) values
+    again = values
+    if (ios == 0 .and. any(values == huge(1.0_wp))) then
+      again = -huge(1.0_wp)
+      read(text, *, iostat=ios) again
+    end if
+    extra = -1
+    if (ios == 0) read(text, *, iostat=extra) again, surplus
+    status = number_malformed
+    if (ios /= 0 .or. extra == 0) return
+    status = number_null
+    if (any(values == huge(1.0_wp) .and. again == -huge(1.0_wp))) return
+    status = number_ok
+  end subroutine read_numbers
 
   !> The tutorial's parameter file: 17 numbers, one per line, '#' starts a comment; an
   !> optional 18th entry names a table added to f1 (the tutorial's triangle.dat button).
@@ -342,9 +518,9 @@ contains
     character(len=*), intent(in) :: path
     type(scene_input), intent(inout) :: input
     type(error_type), allocatable, intent(out) :: error
-    integer :: unit, ios, n_read, line_number, extra
+    integer :: unit, ios, n_read, line_number, status
     character(len=:), allocatable :: line
-    real(wp) :: value, surplus
+    real(wp) :: value(1)
     logical :: found
 
     call open_data_file(path, unit, error)
@@ -353,7 +529,7 @@ contains
     call read_line(unit, line, ios)
     line = adjustl(line)
     if (ios == 0 .and. len(line) > 0) then
-      if (line(1:1) == '#') input%text(i_title) = adjustl(line(2:))
+      if (line(1:1) == '#') call set_text(input, i_title, trim(adjustl(line(2:))))
     end if
     rewind(unit)
     n_read = 0
@@ -363,19 +539,20 @@ contains
       if (.not. found) exit
       n_read = n_read + 1
       if (n_read <= size(dat_order)) then
-        extra = -1
-        read(line, *, iostat=ios) value
-        if (ios == 0) read(line, *, iostat=extra) value, surplus
-        if (ios /= 0 .or. extra == 0) then
+        ! A null (',', '1*') would leave value as the line before set it, or the first line
+        ! uninitialised.
+        call read_numbers(line, value, status)
+        if (status /= number_ok) then
           close(unit)
           call raise(error, status_input, path // ':' // trim(fmt(line_number)) // ': ''' // trim(adjustl(line)) // &
-            ''' is not one number (expected ' // trim(real_names(dat_order(n_read))) // ')')
+            trim(merge(''' holds no number  ', ''' is not one number', status == number_null)) // ' (expected ' // &
+            trim(real_names(dat_order(n_read))) // ')')
           return
         end if
-        input%value(dat_order(n_read)) = value
+        input%value(dat_order(n_read)) = value(1)
         input%given(dat_order(n_read)) = .true.
       else if (n_read == size(dat_order) + 1) then
-        input%text(i_f1_table) = beside(path, trim(adjustl(line)))
+        call set_text(input, i_f1_table, trim(beside(path, trim(adjustl(line)))))
       else
         close(unit)
         call raise(error, status_input, path // ':' // trim(fmt(line_number)) // &
@@ -405,9 +582,9 @@ contains
     character(len=*), intent(in) :: path
     type(table_type), intent(out) :: table
     type(error_type), allocatable, intent(out) :: error
-    integer :: unit, ios, line_number, n, extra
+    integer :: unit, line_number, n, status
     character(len=:), allocatable :: line
-    real(wp) :: row(2), surplus
+    real(wp) :: row(2)
     real(wp), allocatable :: t(:), f(:)
     logical :: found
 
@@ -419,11 +596,10 @@ contains
     do
       call next_data_line(unit, line, line_number, found)
       if (.not. found) exit
-      extra = -1
-      read(line, *, iostat=ios) row
-      if (ios == 0) read(line, *, iostat=extra) row, surplus
-      if (ios /= 0 .or. extra == 0) then
-        call fail(': expected two numbers "t f", got ''' // trim(adjustl(line)) // '''')
+      ! A null (', 5') would leave the row's earlier values.
+      call read_numbers(line, row, status)
+      if (status /= number_ok) then
+        call fail(': malformed row ''' // trim(adjustl(line)) // ''': expected two numbers "t f"')
         return
       end if
       if (.not. all(ieee_is_finite(row))) then
@@ -521,13 +697,6 @@ contains
     slash = index(scene_path, '/', back=.true.)
     if (slash > 0) resolved = scene_path(:slash) // path
   end function beside
-
-  pure function given_text(text) result(given)
-    character(len=*), intent(in) :: text
-    character(len=len(text)) :: given    ! blank padded
-    given = ''
-    if (text /= absent_text) given = text
-  end function given_text
 
   !> text in lower case (ASCII letters only): group and method names are case-insensitive.
   pure function lower(text) result(low)

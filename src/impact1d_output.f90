@@ -410,10 +410,10 @@ contains
     self%n_bodies = merge(2, 1, input%given(i_m2))
     self%event_bytes = line_bytes(event_format, 0.0_wp, 2 * self%n_bodies, event_names(1))
     call self%put_line(self%unit, '# impact1d output')
-    call self%put_line(self%unit, '# title = ' // trim(input%text(i_title)))
+    call self%put_line(self%unit, '# title = ' // trim(input%text(i_title)%s))
     if (allocated(input%source)) call self%put_line(self%unit, '# scene = ' // input%source)
-    if (len_trim(input%text(i_method)) > 0) then
-      call self%put_line(self%unit, '# method = ' // trim(input%text(i_method)))
+    if (len_trim(input%text(i_method)%s) > 0) then
+      call self%put_line(self%unit, '# method = ' // trim(input%text(i_method)%s))
     else
       call self%put_line(self%unit, '# method = event')
     end if

@@ -2,6 +2,7 @@
 !> checked model the solver runs (scene_type). One validator serves the CLI and Python.
 module impact1d_scene
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+  use, intrinsic :: iso_fortran_env, only: int64
   use impact1d_kinds, only: wp, eps_wp
   use impact1d_error, only: error_type, raise, status_input, fmt, fmt_width
   use impact1d_forcing, only: forcing_type, table_type
@@ -15,7 +16,7 @@ module impact1d_scene
     i_r_min, i_d_max, i_r_max, i_x1, i_v1, i_x2, i_v2, i_f1, i_f2, i_f1_amp, i_f1_period, &
     i_f1_phase, i_f2_amp, i_f2_period, i_f2_phase, i_t_end, i_dt, i_dt_out, i_mus1, i_mus2, &
     i_k1, i_x1_rest, i_c1, i_k2, i_x2_rest, i_c2, i_k12, i_d_rest, i_c12
-  public :: sample_time
+  public :: sample_time, set_text
   public :: i_title, i_f1_table, i_f2_table, i_method, default_gravity
 
   integer, parameter :: n_real = 43, n_text = 4
@@ -69,11 +70,19 @@ module impact1d_scene
   !> The smallest step, in units of the clock's spacing at t_end.
   real(wp), parameter :: clock_resolution_ulps = 8.0_wp
 
-  !> A scene as written: values and texts, each given or absent.
+  !> One text of a scene (title, table path, method), kept whole whatever its length. (Not
+  !> an array of deferred-length strings: gfortran 12 copies such a component wrongly when
+  !> a scene_input is assigned, the texts after the first coming out blank.)
+  type :: scene_text
+    character(len=:), allocatable :: s
+  end type scene_text
+
+  !> A scene as written: values and texts, each given or absent (an empty text is absent).
+  !> Every maker of a scene_input sets all its texts (set_text), '' when absent.
   type :: scene_input
     real(wp) :: value(n_real) = 0.0_wp
     logical :: given(n_real) = .false.
-    character(len=1024) :: text(n_text) = ''
+    type(scene_text) :: text(n_text)
     character(len=:), allocatable :: source
   end type scene_input
 
@@ -108,8 +117,14 @@ contains
     logical, intent(in) :: require_run
     type(error_type), allocatable, intent(out) :: error
     integer :: k
-    real(wp) :: gap, scale, nrm(2, n_contacts)
+    real(wp) :: gap, scale, nrm(2, n_contacts), rows, limit
 
+    do k = 1, n_text
+      if (.not. allocated(input%text(k)%s)) then
+        call raise(error, status_input, 'internal: ' // trim(text_names(k)) // ' was never set (set_text)')
+        return
+      end if
+    end do
     do k = 1, n_real
       if (input%given(k) .and. .not. ieee_is_finite(input%value(k))) then
         call raise(error, status_input, trim(real_names(k)) // ' = ' // trim(fmt(input%value(k))) // &
@@ -130,7 +145,7 @@ contains
           return
         end if
       end do
-      if (len_trim(input%text(i_f2_table)) > 0) then
+      if (len_trim(input%text(i_f2_table)%s) > 0) then
         call raise(error, status_input, 'f2_table is given but m2 is not: a scene without m2 has one body ' // &
           '(give m2 for a second one)')
         return
@@ -293,18 +308,19 @@ contains
       end if
     end if
     if (input%given(i_t_end) .and. (input%given(i_dt) .or. input%given(i_dt_out))) then
-      if (input%value(i_t_end) / value_or(input, i_dt_out, input%value(i_dt)) > &
-          value_or(input, i_max_rows, real(max_samples, wp)) - 1.0_wp) then
+      rows = row_count(input%value(i_t_end), value_or(input, i_dt_out, input%value(i_dt)))
+      limit = value_or(input, i_max_rows, real(max_samples, wp))
+      if (rows > limit) then
         call raise(error, status_input, 't_end / dt_out = ' // &
           trim(fmt(input%value(i_t_end) / value_or(input, i_dt_out, input%value(i_dt)))) // &
-          ' output rows is over the limit of ' // trim(fmt(value_or(input, i_max_rows, real(max_samples, wp)))) // &
-          ': set a larger dt_out (or &run max_rows)')
+          ' makes ' // trim(fmt_count(rows)) // ' output rows (t = 0 included), over the limit of ' // &
+          trim(fmt_count(limit)) // ': set a larger dt_out (or &run max_rows)')
         return
       end if
     end if
-    if (len_trim(input%text(i_method)) > 0) then
-      if (trim(input%text(i_method)) /= 'event' .and. trim(input%text(i_method)) /= 'vissim') then
-        call raise(error, status_input, "method = '" // trim(input%text(i_method)) // &
+    if (len_trim(input%text(i_method)%s) > 0) then
+      if (trim(input%text(i_method)%s) /= 'event' .and. trim(input%text(i_method)%s) /= 'vissim') then
+        call raise(error, status_input, "method = '" // trim(input%text(i_method)%s) // &
           "' is unknown: the methods are 'event' and 'vissim'")
         return
       end if
@@ -434,14 +450,14 @@ contains
     type(scene_type), intent(out) :: scene
     type(error_type), allocatable, intent(out) :: error
     integer :: i, k
-    real(wp) :: g, ratio
+    real(wp) :: g
 
     call validate(input, .true., error)
     if (allocated(error)) return
 
-    scene%title = trim(input%text(i_title))
+    scene%title = trim(input%text(i_title)%s)
     scene%method = 'event'
-    if (len_trim(input%text(i_method)) > 0) scene%method = trim(input%text(i_method))
+    if (len_trim(input%text(i_method)%s) > 0) scene%method = trim(input%text(i_method)%s)
     scene%mass = input%value([i_m1, i_m2])
     scene%normal = contact_normals(input)
     if (.not. input%given(i_m2)) then
@@ -485,7 +501,7 @@ contains
 
     do i = 1, 2
       if (input%given(i_f1 + i - 1)) scene%forcing%constant(i) = input%value(i_f1 + i - 1)
-      scene%forcing%has_table(i) = len_trim(input%text(i_f1_table + i - 1)) > 0
+      scene%forcing%has_table(i) = len_trim(input%text(i_f1_table + i - 1)%s) > 0
       if (scene%forcing%has_table(i)) scene%forcing%table(i) = tables(i)
       k = i_f1_amp + 3 * (i - 1)
       scene%forcing%has_sine(i) = input%given(k)
@@ -506,12 +522,8 @@ contains
     if (allocated(error)) return
     if (input%given(i_max_impulses)) scene%max_impulses = int(input%value(i_max_impulses))
     if (input%given(i_max_step_events)) scene%max_step_events = int(input%value(i_max_step_events))
-    ! Samples at j*dt_out, and at t_end when it is off that grid. The grid always ends at
-    ! t_end (t_end > 0): a dt_out a billion times t_end rounds ratio to a grid of one sample.
-    ratio = scene%t_end / scene%dt_out
-    scene%n_samples = nint(ratio) + 1
-    if (abs(ratio - nint(ratio)) > 1.0e-9_wp * max(1.0_wp, ratio)) scene%n_samples = floor(ratio) + 2
-    scene%n_samples = max(2, scene%n_samples)
+    ! (validate keeps the count within max_rows, a default integer)
+    scene%n_samples = int(row_count(scene%t_end, scene%dt_out))
   end subroutine build_scene
 
   !> RK4's step against the modes of the springs and dampers (impact1d_stability): past the
@@ -590,6 +602,36 @@ contains
         trim(fmt(scene%springs%c(j - n_elements)))
     end if
   end function fastest_element
+
+  !> Output rows of a run: samples at j dt_out from t = 0, and at t_end when it is off that
+  !> grid (within 1e-9 of a step it is on it). Real: a refused scene's count may exceed any
+  !> integer.
+  pure real(wp) function row_count(t_end, dt_out)
+    real(wp), intent(in) :: t_end, dt_out
+    real(wp) :: ratio
+    ratio = t_end / dt_out
+    row_count = anint(ratio) + 1.0_wp
+    if (abs(ratio - anint(ratio)) > 1.0e-9_wp * max(1.0_wp, ratio)) row_count = aint(ratio) + 2.0_wp
+    ! The grid always ends at t_end (t_end > 0): a dt_out a billion times t_end rounds the
+    ! ratio to a grid of the t = 0 row alone.
+    row_count = max(2.0_wp, row_count)
+  end function row_count
+
+  !> A count held in a real, written as an integer (10000001, not 10000001.0).
+  pure function fmt_count(count) result(text)
+    real(wp), intent(in) :: count
+    character(len=fmt_width) :: text
+    text = fmt(count)
+    if (count < 0.5_wp * real(huge(1_int64), wp)) text = fmt(int(count, int64))
+  end function fmt_count
+
+  !> Text field i (i_title, i_f1_table, i_f2_table, i_method) := text, kept whole.
+  pure subroutine set_text(input, i, text)
+    type(scene_input), intent(inout) :: input
+    integer, intent(in) :: i
+    character(len=*), intent(in) :: text
+    input%text(i)%s = text
+  end subroutine set_text
 
   !> Time of output sample j (0-based): j dt_out, and t_end for the last one.
   pure real(wp) function sample_time(scene, j)

@@ -4,6 +4,8 @@ another exception, a crash or a hang. Seeded, so a failure reproduces."""
 
 import os
 import random
+import re
+import shutil
 import subprocess
 from pathlib import Path
 
@@ -234,3 +236,130 @@ def test_concurrent_writers_of_one_output(tmp_path):
         assert pair in [reference[scene.name] for scene in chosen]
         assert sorted(p.name for p in tmp_path.iterdir()) == ["o.dat", "o.events.dat", "ref.dat",
                                                               "ref.events.dat"]
+
+
+# --- issue 18: families whose outcome is known -------------------------------------------
+# Each mutation below has one right answer: a named refusal (a null or a duplicate value, a
+# broken .dat line), or the scene read exactly as meant (quoted '&', '/', ',' in a title or
+# a table path, a harmless reformatting of a .dat number).
+
+N_FAMILY = 40
+ASSIGNMENT = re.compile(r"(\b[a-z_][a-z0-9_]*)(\s*=\s*)('[^']*'|[^,/\s]+)")
+NULLS = ["{name} = ", "{name} = 1*", "{name}", "{name} =  "]
+TITLE_PIECES = ["&initial x1 = 5.0 /", "&run", "/", "$end", "&end", ",", ";", "=", "!", "'",
+                '"', "x2 = 9", " ", "abc", "&", "$", "1*", "&bodies m1 = 0 /"]
+PATH_PIECES = ["&", "$", "!", ",", ";", "=", "'", "&run ", "&run dt = 1 ", "&initial ", "end", "a b", "x"]
+DAT_BAD = [",", "1*", ", 5", "5 5", "5 /", "/", "2*3", "x", "5,,", "1 , ,"]
+DAT_SAME = ["  {v}  ", "{v}e0", "{v}  # a note", "{v}d0"]
+
+
+def assignments(text):
+    """(line number, start, end, name) of every 'name = value' in the scene's groups."""
+    found = []
+    for number, line in enumerate(text.splitlines(), 1):
+        if line.lstrip().startswith("!"):
+            continue
+        found += [(number, m.start(), m.end(), m.group(1)) for m in ASSIGNMENT.finditer(line)]
+    return found
+
+
+def scene_of(path):
+    """A loaded scene's fields but its source."""
+    return {k: v for k, v in vars(impact1d.load_scene(path)).items() if k != "source"}
+
+
+def seeded(family):
+    return random.Random(f"{SEED}-{family}")
+
+
+def test_null_values_are_refused_naming_variable_and_line(tmp_path):
+    rng = seeded("null")
+    for n in range(N_FAMILY):
+        case = rng.choice(sorted(INPUT.glob("case*.nml")))
+        lines = case.read_text().splitlines()
+        number, start, end, name = rng.choice(assignments(case.read_text()))
+        line = lines[number - 1]
+        lines[number - 1] = line[:start] + rng.choice(NULLS).format(name=name) + line[end:]
+        path = tmp_path / f"null{n}.nml"
+        path.write_text("\n".join(lines) + "\n")
+        with pytest.raises(impact1d.InputError, match=re.escape(f"null{n}.nml:{number}: ") + f".*{name}.* has no value"):
+            impact1d.load_scene(path)
+
+
+def test_duplicate_values_are_refused_naming_both_lines(tmp_path):
+    rng = seeded("duplicate")
+    for n in range(N_FAMILY):
+        case = rng.choice(sorted(INPUT.glob("case*.nml")))
+        text = case.read_text()
+        lines = text.splitlines()
+        number, start, end, name = rng.choice(assignments(text))
+        copy = lines[number - 1][start:end]
+        if rng.random() < 0.5:                                   # on the same line
+            lines[number - 1] = lines[number - 1][:end] + ", " + copy + lines[number - 1][end:]
+            second = number
+        else:                                                    # on a line of its own
+            slash = lines[number - 1].rindex("/")
+            lines[number - 1:number] = [lines[number - 1][:slash], "    " + copy + " /"]
+            second = number + 1
+        path = tmp_path / f"twice{n}.nml"
+        path.write_text("\n".join(lines) + "\n")
+        with pytest.raises(impact1d.InputError,
+                           match=re.escape(f"twice{n}.nml:{second}: ") + f".*{name} is given twice "
+                           rf"\(lines {number} and {second}\)"):
+            impact1d.load_scene(path)
+
+
+def quoted(text, rng):
+    """text as a namelist string, in single or double quotes (the quote inside doubled)."""
+    quote = rng.choice("'\"")
+    return quote + text.replace(quote, quote * 2) + quote
+
+
+def test_quoted_group_marks_and_separators_in_titles_are_text(tmp_path):
+    rng = seeded("title")
+    base = INPUT / "case3.nml"
+    expected = scene_of(base)
+    for n in range(N_FAMILY):
+        title = "".join(rng.choice(TITLE_PIECES) for _ in range(rng.randint(1, 8)))
+        text = base.read_text().replace("'Test case 3: conservation of energy'", quoted(title, rng))
+        path = tmp_path / f"title{n}.nml"
+        path.write_text(text)
+        assert scene_of(path) == {**expected, "title": title.strip() or None}, title
+
+
+def test_quoted_group_marks_and_separators_in_table_paths_are_text(tmp_path):
+    rng = seeded("path")
+    base = (INPUT / "case6.nml").read_text()
+    reference = impact1d.simulate(impact1d.load_scene(INPUT / "case6.nml"), t_end=1.0)
+    for n in range(N_FAMILY // 2):
+        parts = ["".join(rng.choice(PATH_PIECES) for _ in range(rng.randint(1, 4))) for _ in range(2)]
+        relative = Path(f"t{n}", *parts, "triangle.dat")
+        (tmp_path / relative).parent.mkdir(parents=True)
+        (tmp_path / relative).write_text((INPUT / "triangle.dat").read_text())
+        path = tmp_path / f"path{n}.nml"
+        path.write_text(base.replace("'triangle.dat'", quoted(str(relative), rng)))
+        scene = impact1d.load_scene(path)
+        assert scene.f1_table == str(tmp_path / relative)
+        if n < 3:
+            assert np.array_equal(impact1d.simulate(scene, t_end=1.0).x1, reference.x1)
+
+
+def test_mutated_dat_lines_are_refused_naming_the_line_or_read_the_same(tmp_path):
+    rng = seeded("dat")
+    shutil.copy(INPUT / "triangle.dat", tmp_path / "triangle.dat")
+    for n in range(N_FAMILY):
+        source = rng.choice(sorted(INPUT.glob("input*.dat")))
+        lines = source.read_text().splitlines()
+        numbers = [i for i, line in enumerate(lines) if line.strip() and not line.lstrip().startswith("#")]
+        i = rng.choice(numbers[:17])
+        value = lines[i].split("#")[0].strip()
+        path = tmp_path / f"dat{n}.dat"
+        if rng.random() < 0.7:
+            lines[i] = rng.choice(DAT_BAD)
+            path.write_text("\n".join(lines) + "\n")
+            with pytest.raises(impact1d.InputError, match=re.escape(f"dat{n}.dat:{i + 1}: ")):
+                impact1d.load_scene(path)
+        else:
+            lines[i] = rng.choice(DAT_SAME).format(v=value)
+            path.write_text("\n".join(lines) + "\n")
+            assert scene_of(path) == {**scene_of(source), "f1_table": scene_of(path)["f1_table"]}, lines[i]

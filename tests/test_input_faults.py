@@ -2,6 +2,8 @@
 mistake is an InputError naming what is wrong, never a silently different scene."""
 
 import os
+import re
+import shutil
 import subprocess
 import sys
 import time
@@ -299,3 +301,227 @@ def test_special_outputs_are_refused(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(before + ["fifo.png"])
     assert (tmp_path / "fifo.dat").is_fifo() and (tmp_path / "fifo.png").is_fifo()
     assert os.readlink(tmp_path / "stdout.dat") == "/proc/self/fd/1"
+
+
+# --- issue 18 item 6: parsing holes that changed the scene silently --------------------
+
+def line_of(text, needle):
+    """1-based number of the first line of `text` holding `needle`."""
+    return next(n for n, line in enumerate(text.splitlines(), 1) if needle in line)
+
+
+def case3_values():
+    scene = impact1d.load_scene(INPUT / "case3.nml")
+    return {k: v for k, v in vars(scene).items() if k not in ("title", "source")}
+
+
+@pytest.mark.parametrize("title", [
+    "x &initial x1 = 5.0, x2 = 7.0 /",      # replaced the real &initial group
+    "Table 1 &initial conditions",           # refused as "unknown variable 'conditions''"
+    "&run t_end = 1 / $end &end",
+    "a, b = c; d ! not a comment",
+])
+def test_group_marks_inside_a_quoted_title_are_text(tmp_path, title):
+    text = CASE3.replace("'Test case 3: conservation of energy'", "'" + title + "'")
+    scene = impact1d.load_scene(scene_file(tmp_path, text))
+    assert scene.title == title
+    assert {k: v for k, v in vars(scene).items() if k not in ("title", "source")} == case3_values()
+
+
+def test_double_quotes_and_doubled_quotes_in_a_title(tmp_path):
+    for written, meant in [('"say ""&initial x1 = 5 /"" now"', 'say "&initial x1 = 5 /" now'),
+                           ("'it''s &run / done'", "it's &run / done")]:
+        text = CASE3.replace("'Test case 3: conservation of energy'", written)
+        scene = impact1d.load_scene(scene_file(tmp_path, text))
+        assert scene.title == meant and scene.x1 == 1.0 and scene.v1 == -9.0
+
+
+@pytest.mark.parametrize("old, new, name", [
+    ("v1 = -9.0", "v1 = ", "v1"),             # 'v1 = ,': v1 was absent (0)
+    ("v2 = 1.0", "v2 = 1*", "v2"),            # a null: v2 was absent
+    ("f2 = 0.0 /", "f2 /", "f2"),             # no '=' at all
+    ("x2 = 2.5, v2 = 1.0", "x2 = 2.5, v2 =", "v2"),
+])
+def test_variable_without_a_value_is_refused(tmp_path, old, new, name):
+    message = refused(tmp_path, CASE3.replace(old, new), f"{name}.* has no value")
+    assert f"scene.nml:{line_of(CASE3, old)}:" in message
+
+
+def test_variable_given_twice_is_refused(tmp_path):
+    """m1 = 1.0, m1 = 7.0 ran with m1 = 7 without a word."""
+    message = refused(tmp_path, CASE3.replace("m1 = 1.0,", "m1 = 1.0, m1 = 7.0,"),
+                      r"m1 is given twice \(lines 3 and 3\)")
+    assert "scene.nml:3:" in message
+    text = CASE3.replace("g = 10.0 /", "g = 10.0,\n         m1 = 7.0 /")
+    refused(tmp_path, text, r":4: in &bodies: m1 is given twice \(lines 3 and 4\)")
+
+
+def dat_lines():
+    """input3.dat's lines, and the index of each line that holds a number."""
+    lines = (INPUT / "input3.dat").read_text().splitlines()
+    return lines, [i for i, line in enumerate(lines) if line.strip() and not line.startswith("#")]
+
+
+@pytest.mark.parametrize("null", [",", "1*", ", # m1"])
+def test_null_dat_line_is_refused_and_nothing_survives_a_read(tmp_path, null):
+    """A null as the first number left m1 uninitialised: the CLI saw 0.0, Python the value
+    the previous read left on the stack (4.0 after a file whose last number was 4.0)."""
+    lines, numbers = dat_lines()
+    good = list(lines)
+    good[numbers[0]] = "4.0  # m1"
+    good[numbers[-1]] = "4.0  # f2"
+    (tmp_path / "good.dat").write_text("\n".join(good) + "\n")
+    assert impact1d.load_scene(tmp_path / "good.dat").m1 == 4.0
+    bad = list(lines)
+    bad[numbers[0]] = null
+    (tmp_path / "bad.dat").write_text("\n".join(bad) + "\n")
+    with pytest.raises(impact1d.InputError, match=f"bad.dat:{numbers[0] + 1}: .* holds no number "
+                                                  r"\(expected m1\)"):
+        impact1d.load_scene(tmp_path / "bad.dat")
+    done = subprocess.run([find_tool("impact1d"), str(tmp_path / "bad.dat"), "--t-end", "1",
+                           "--dt", "1e-3", "-o", str(tmp_path / "out.dat")],
+                          capture_output=True, text=True, timeout=RUN_TIMEOUT)
+    assert done.returncode == 1 and f"bad.dat:{numbers[0] + 1}:" in done.stderr
+
+
+def test_null_dat_line_later_does_not_repeat_the_one_before(tmp_path):
+    """'1*' as x2 reused x1's 1.0 (the scene then failed on a slot it had not asked for)."""
+    lines, numbers = dat_lines()
+    lines[numbers[12]] = "1*  # x2(0)"
+    (tmp_path / "x2.dat").write_text("\n".join(lines) + "\n")
+    with pytest.raises(impact1d.InputError, match=rf"x2.dat:{numbers[12] + 1}: '1\*' holds no number "
+                                                  r"\(expected x2\)"):
+        impact1d.load_scene(tmp_path / "x2.dat")
+
+
+def test_core_keeps_no_input_state_between_calls():
+    """No module variable, SAVEd local or initialised local (which Fortran SAVEs) in the
+    core's sources: a read or a run may only leave state in what it returns."""
+    declaration = re.compile(r"^\s*(real|integer|logical|character|complex|type\s*\(|class\s*\()[^:]*::(.*)$",
+                             re.I)
+    block_start = re.compile(r"^\s*(abstract\s+interface|interface|type\s*(,|::|\s+\w))", re.I)
+    block_end = re.compile(r"^\s*end\s*(interface|type)\b", re.I)
+    found = []
+    for path in sorted((ROOT / "src").glob("*.f90")):
+        in_procedures = in_block = False
+        for number, line in enumerate(path.read_text().splitlines(), 1):
+            code = line.split("!")[0]
+            in_procedures = in_procedures or re.match(r"^contains\s*$", code) is not None
+            if not in_procedures and block_start.match(code):
+                in_block = True
+            if block_end.match(code):
+                in_block = False
+            if re.match(r"^\s*(save|common|data)\b(?!\s*=)", code, re.I):
+                found.append(f"{path.name}:{number}: {line.strip()}")
+            match = declaration.match(code)
+            if not match or in_block or re.search(r"\bparameter\b", code.split("::")[0], re.I):
+                continue
+            if not in_procedures:
+                found.append(f"{path.name}:{number}: module variable: {line.strip()}")
+            elif re.search(r"\bsave\b", code.split("::")[0], re.I) or \
+                    re.search(r"(?<![=<>/])=(?!=)", match.group(2)):
+                found.append(f"{path.name}:{number}: saved local: {line.strip()}")
+    assert not found, found
+
+
+# --- issue 18 item 9: messages that named the wrong thing -------------------------------
+
+@pytest.mark.parametrize("value", ["(1.0, 2.0)", ".true.", "1.0_8", "0x1p0", "1.0 2.0", "--1", "1.5$"])
+def test_bad_value_is_named_as_a_bad_value(tmp_path, value):
+    """All were 'unknown variable' ('1.5$': "no closing '/' before &")."""
+    message = refused(tmp_path, CASE3.replace("m1 = 1.0", "m1 = " + value),
+                      re.escape(f"scene.nml:3: in &bodies: m1 = '{value}' is not a number"))
+    assert "unknown variable" not in message and "closing" not in message
+
+
+def test_decimal_comma_is_suggested(tmp_path):
+    """m2 = 0,5 gave "unknown variable '5'"."""
+    refused(tmp_path, CASE3.replace("m2 = 2.0", "m2 = 0,5"),
+            re.escape("in &bodies: m2 = '0,5' is not a number (a decimal comma?"))
+
+
+@pytest.mark.parametrize("row", [", 5", "0.5 ,", "1*", "0.5 /"])
+def test_malformed_table_row_is_named(tmp_path, row):
+    """', 5' took the row before's time: "time 0.0 does not increase"."""
+    (tmp_path / "table.dat").write_text(f"# t f\n0 1\n{row}\n1 2\n")
+    text = (INPUT / "case6.nml").read_text().replace("'triangle.dat'", "'table.dat'")
+    scene = impact1d.load_scene(scene_file(tmp_path, text))
+    with pytest.raises(impact1d.InputError, match=re.escape(f"table.dat:3: malformed row '{row}'")):
+        impact1d.simulate(scene, t_end=0.1)
+
+
+def long_folder(tmp_path, pieces=6):
+    """A folder whose path from tmp_path is over 1,200 characters (names of 200)."""
+    folder = tmp_path
+    for k in range(pieces):
+        folder = folder / (chr(ord("a") + k) * 200)
+    folder.mkdir(parents=True)
+    return folder
+
+
+def test_table_path_of_any_length(tmp_path):
+    """A path over 1,024 characters was cut there and refused as 'is a folder'."""
+    folder = long_folder(tmp_path)
+    shutil.copy(INPUT / "triangle.dat", folder / "triangle.dat")
+    relative = str((folder / "triangle.dat").relative_to(tmp_path))
+    assert len(relative) > 1024
+    text = (INPUT / "case6.nml").read_text().replace("'triangle.dat'", f"'{relative}'")
+    scene = impact1d.load_scene(scene_file(tmp_path, text))
+    assert scene.f1_table == str(folder / "triangle.dat")
+    expected = impact1d.simulate(impact1d.load_scene(INPUT / "case6.nml"), t_end=1.0)
+    assert np.array_equal(impact1d.simulate(scene, t_end=1.0).x1, expected.x1)
+    out = tmp_path / "out.dat"
+    done = subprocess.run([find_tool("impact1d"), str(tmp_path / "scene.nml"), "--t-end", "1",
+                           "-o", str(out)], capture_output=True, text=True, timeout=RUN_TIMEOUT)
+    assert done.returncode == 0, done.stderr
+    assert np.array_equal(np.loadtxt(out)[:, 1], expected.x1)
+
+
+def test_batch_runs_keep_every_text(tmp_path):
+    """A batch (simulate_summaries, sweep's engine) copies the scene for each run: with the
+    texts as one array of deferred-length strings gfortran 12 copied them wrongly (the
+    table path came out as garbage)."""
+    folder = long_folder(tmp_path, pieces=2)
+    shutil.copy(INPUT / "triangle.dat", folder / "triangle.dat")
+    scene = impact1d.load_scene(INPUT / "case6.nml")
+    scene.f1_table = str(folder / "triangle.dat")
+    scene.title = "t" * 2000
+    scene.t_end = 1.0
+    table = impact1d.sweep(scene, {"r_left": [0.5, 1.0]})
+    assert (table["error"] == "").all(), list(table["error"])
+    for r_left, x1_end in zip(table["r_left"], table["x1_end"]):
+        assert x1_end == impact1d.simulate(scene, r_left=r_left).x1[-1]
+
+
+def test_long_title_is_kept_whole(tmp_path):
+    """A title was cut at 1,024 characters (the namelist's buffer), in Python as at the CLI."""
+    title = "A long title " + "x" * 3000 + " end"
+    text = CASE3.replace("'Test case 3: conservation of energy'", f"'{title}'")
+    path = scene_file(tmp_path, text)
+    assert impact1d.load_scene(path).title == title
+    dat = (INPUT / "input3.dat").read_text().replace("# Test case 3: conservation of energy", "# " + title)
+    assert impact1d.load_scene(scene_file(tmp_path, dat, "long.dat")).title == title
+    res = impact1d.simulate(impact1d.load_scene(INPUT / "case3.nml"), title=title, t_end=0.01)
+    assert res.scene.title == title
+    out = tmp_path / "out.dat"
+    done = subprocess.run([find_tool("impact1d"), str(path), "--t-end", "0.01", "-o", str(out)],
+                          capture_output=True, text=True, timeout=RUN_TIMEOUT)
+    assert done.returncode == 0, done.stderr
+    assert f"# title = {title}\n" in out.read_text()
+    assert impact1d.read_output(out).scene.title == title
+
+
+def test_row_limit_message_counts_the_rows(tmp_path):
+    """'10000000.0 output rows is over the limit of 10000000.0': the run would have written
+    10^7 + 1 rows (t = 0 included), and counts are integers."""
+    scene = impact1d.load_scene(INPUT / "case3.nml")
+    with pytest.raises(impact1d.InputError) as caught:
+        impact1d.simulate(scene, t_end=1.0e7, dt=1.0, dt_out=1.0)
+    assert "10000001 output rows" in str(caught.value) and "limit of 10000000:" in str(caught.value)
+    assert "10000000.0" not in str(caught.value).split("makes")[1]
+    # At the limit the run writes exactly max_rows rows; one more row is refused.
+    assert len(impact1d.simulate(scene, t_end=1.0, dt_out=0.1, max_rows=11).t) == 11
+    with pytest.raises(impact1d.InputError, match="makes 11 output rows .* limit of 10:"):
+        impact1d.simulate(scene, t_end=1.0, dt_out=0.1, max_rows=10)
+    # t_end within rounding of the grid: 11 rows, not refused as 12.
+    assert len(impact1d.simulate(scene, t_end=1.0 + 1e-12, dt_out=0.1, max_rows=11).t) == 11

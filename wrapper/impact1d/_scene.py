@@ -30,8 +30,11 @@ class SimulationError(RuntimeError):
     """A run could not go on (api status 2)."""
 
 
-# Length of the api's fixed text buffers (character(len=1024) in impact1d_api).
-TEXT_LEN = 1024
+# Room load_scene first gives the core for each text (title, table paths, method); a
+# longer one makes the core say how long, and the call is repeated with that room.
+TEXT_ROOM = 1024
+# The api's status for "the arrays given were too small" (it returns the sizes needed).
+STATUS_TOO_SMALL = 3
 
 # The api's field order, written out so that the dataclass below is static and
 # readable; checked against _api.field_names() at import (one source of truth).
@@ -133,13 +136,10 @@ assert _SCENE_FIELDS == REAL_FIELDS + TEXT_FIELDS + ("source",)
 
 
 def _fortran_text(value) -> bytes:
-    # The api takes character(len=*) and blank-pads it into its buffers itself. Text goes
-    # as UTF-8 bytes (f2py accepts only ASCII str), as the CLI reads it from files.
-    text = b"" if value is None else os.fsencode(value) if isinstance(value, os.PathLike) \
+    # The api takes character(len=*), of any length, and keeps it whole. Text goes as
+    # UTF-8 bytes (f2py accepts only ASCII str), as the CLI reads it from files.
+    return b"" if value is None else os.fsencode(value) if isinstance(value, os.PathLike) \
         else str(value).encode("utf-8", errors="surrogateescape")
-    if len(text) > TEXT_LEN:
-        raise InputError(f"text longer than {TEXT_LEN} bytes: {decode(text[:60])}...")
-    return text
 
 
 def to_core(scene: Scene):
@@ -196,11 +196,16 @@ def load_scene(path) -> Scene:
 
     path = os.fspath(path)
     check_input(path, "scene file")
-    (values, given, title, f1_table, f2_table, method,
-     status, message) = _api.read_scene(os.fsencode(path), len(REAL_FIELDS))
+    room = TEXT_ROOM
+    while True:
+        (values, given, codes, lengths,
+         status, message) = _api.read_scene(os.fsencode(path), len(REAL_FIELDS), room)
+        if int(status) != STATUS_TOO_SMALL or int(max(lengths)) <= room:
+            break
+        room = int(max(lengths))        # a text longer than the room: again, with its length
     raise_for_status(status, message)
     kwargs = {name: (float(values[i]) if given[i] else None)
               for i, name in enumerate(REAL_FIELDS)}
-    for name, text in zip(TEXT_FIELDS, (title, f1_table, f2_table, method)):
-        kwargs[name] = decode(text) or None
+    for k, name in enumerate(TEXT_FIELDS):
+        kwargs[name] = decode(np.asarray(codes[:lengths[k], k], dtype=np.uint8).tobytes()) or None
     return Scene(**kwargs, source=path)

@@ -11,6 +11,7 @@ import numpy as np
 
 from ._scene import (REAL_FIELDS, Scene, InputError, decode, raise_for_status, to_core, _words, _api,
                      _STATUS_INTERRUPTED)
+from ._scene import STATUS_TOO_SMALL as _STATUS_TOO_SMALL
 
 __all__ = ["Result", "simulate", "COLUMNS", "EVENT_DTYPE", "ONE_BODY_EVENT_DTYPE"]
 
@@ -34,8 +35,6 @@ if _words(_api.column_names()) != COLUMNS:
 
 _OVERRIDABLE = tuple(f.name for f in dataclasses.fields(Scene))
 
-# The api's status for "the arrays given were too small" (it returns the sizes needed).
-_STATUS_TOO_SMALL = 3
 # Room for events a run starts with (most runs log fewer), and the most a hint asks for.
 _EVENT_CAPACITY = 256
 _EVENT_CAPACITY_MAX = 1 << 22
