@@ -2,8 +2,8 @@
 
 Pure Python with mpmath at DPS = 50 digits, written from the physics of docs/method.md and
 /work/shared/METHOD.md section 9 ("Any number of bodies"), sharing no code with the
-Fortran engine nor with tests/exact_reference.py (the two-body reference it is checked
-against, tests/test_exact_nbody.py).  It is the yardstick for the engine's coming N-body
+Fortran engine and no physics with tests/exact_reference.py (the two-body reference it is
+checked against, tests/test_exact_nbody.py; only its table reader and Horner's rule).  It is the yardstick for the engine's coming N-body
 generalisation (issue 19, "Mechanisms as data").
 
 Scope.  N >= 1 point bodies on a line, numbered 1..N (the ground is end 0, at x = 0).
@@ -85,13 +85,21 @@ Zeno (METHOD 5).  A contact that separates after an impulse with r < 1 under an
 acceleration that brings it back, u = n.v > 0, a = n.a < 0: its remaining bounce series
 lasts 2 u / (|a| (1 - r)).  When that is below ZENO_TIME the contact takes an r = 0
 impulse now and `rest_<contact>` is logged at the accumulation time t + 2 u/(|a|(1-r)).
-Accumulations over several contacts (METHOD 9) are not summed: such a series is followed
-impact by impact (it may exhaust MAX_EVENTS).
+Accumulations over several contacts (METHOD 9: a body rattling between a wall and a
+heavier body pushed onto it, or between two bodies): the event points with impacts repeat
+a pattern (the same set of contacts, period p <= CYCLE_POINTS) while the contacts' normal
+velocities shrink by a ratio rho < 1 per period (the cycle map's dominant rate, measured on
+the last two periods, consistent to CYCLE_FIT); when the rest of the series,
+dt rho / (1 - rho) with dt the last period, lasts less than ZENO_TIME, all the cycle's
+contacts are closed now (their gaps, of the order of the series' tiny flights, set to 0,
+their normal velocities made zero in the mass metric) and their rests are logged at the
+accumulation time.  Until then such a series is followed impact by impact, rest and release
+of a contact inside each cycle included.
 
 Event log (conventions of tests/exact_reference.py and the engine, README 'Inputs'):
 - impacts: kind = the limit's name, one entry per impulse with the velocities before and
   after it (a joint projection: one entry per contact that took an impulse, each with the
-  velocities before and after the projection);
+  velocities before and after the projection, Event.joint set);
 - `rest_<contact>`: a contact becomes held and was not in contact (also at t = 0, e.g. a
   rigid link); at the accumulation time for a Zeno series;
 - `release_<contact>`: a contact in contact stops being held and its gap starts to grow
@@ -111,23 +119,25 @@ residual = KE - KE0 - W + D + Q, exact to the working precision.
 
 Public API:
     solve(scene, t_end=None) -> Solution
-        .events (list of Event(t, kind, subject, before, after)), .final (x, v) tuples,
+        .events (list of Event(t, kind, subject, before, after, joint)), .final (x, v),
         .phases, .state(t) -> (x, v), .ledger (dict), .impacts(), .t_end, .model
     from_two_body(scene) -> the N-body scene dict of a tutorial one- or two-body scene
         (dict or impact1d.Scene), with f_table paths read
     two_body_events(solution) -> [(t, kind, v1b, v2b, v1a, v2a)] as floats (the log
         format of tests/exact_reference.py; v2 = 0.0 for one body)
-    read_table(path), lemke(Q, q, tol)
+    lemke(Q, q, tol), first_nonpositive(c, s_max) (earliest root of a cubic)
 All numbers come back as mpf; float(...) them to compare with the engine.
 """
 
 from __future__ import annotations
 
-import math
+import bisect
 from dataclasses import dataclass, field
 from typing import NamedTuple
 
 from mpmath import mp, mpf
+
+from exact_reference import _peval, read_table   # (file reading, Horner: no physics shared)
 
 DPS = 50
 DEFAULT_G = 9.80665
@@ -153,6 +163,10 @@ with mp.workdps(DPS):
     # written in decimal, 0.6 - 0.3 - 0.3 != 0).
     INITIAL_TOUCH = mpf(10) ** -12
 
+# A multi-contact bounce series: a cycle of at most CYCLE_POINTS event points, its normal
+# velocities and durations geometric to CYCLE_FIT (relative) over the last two periods.
+CYCLE_POINTS = 12
+CYCLE_FIT = 1e-3
 MAX_EVENTS = 100_000
 MAX_IMPULSES = 100_000
 MAX_STALLS = 1_000
@@ -173,21 +187,10 @@ class Event(NamedTuple):
     subject: object    # the limit's name, or the body number (1-based)
     before: tuple      # velocities of all bodies before
     after: tuple       # and after
+    joint: bool = False  # an impact of a joint inelastic projection (several contacts at once)
 
 
 # --- forcing -------------------------------------------------------------------------
-
-def read_table(path):
-    """A two-column `t f` file (comments after '#') -> (times, values) as floats."""
-    times, values = [], []
-    with open(path, encoding="utf-8") as handle:
-        for line in handle:
-            words = line.split("#", 1)[0].split()
-            if words:
-                times.append(float(words[0]))
-                values.append(float(words[1]))
-    return times, values
-
 
 class Forcing:
     """f_i(t) = constant_i + table_i(t): value, right derivative, next corner."""
@@ -199,45 +202,24 @@ class Forcing:
         self.breaks = sorted({t for tab in self.tables if tab for t in tab[0]})
 
     @staticmethod
-    def _segment(times, t):
-        """Index of the last corner at or before t (-1 before the first)."""
-        k = -1
-        for j, tj in enumerate(times):
-            if tj <= t:
-                k = j
-        return k
+    def _table(tab, t):
+        """(value, right slope) of a piecewise-linear table, constant outside its corners."""
+        ts, fs = tab
+        k = bisect.bisect_right(ts, t) - 1          # the last corner at or before t
+        if k < 0 or k >= len(ts) - 1:
+            return fs[max(k, 0)], mpf(0)
+        slope = (fs[k + 1] - fs[k]) / (ts[k + 1] - ts[k])
+        return fs[k] + (t - ts[k]) * slope, slope
 
     def force(self, t):
-        out = list(self.constants)
-        for i, tab in enumerate(self.tables):
-            if tab is None:
-                continue
-            ts, fs = tab
-            k = self._segment(ts, t)
-            if k < 0:
-                out[i] += fs[0]
-            elif k >= len(ts) - 1:
-                out[i] += fs[-1]
-            else:
-                out[i] += fs[k] + (t - ts[k]) / (ts[k + 1] - ts[k]) * (fs[k + 1] - fs[k])
-        return out
+        return [c + (self._table(tab, t)[0] if tab else 0) for c, tab in zip(self.constants, self.tables)]
 
     def rate(self, t):
-        out = [mpf(0)] * len(self.constants)
-        for i, tab in enumerate(self.tables):
-            if tab is None:
-                continue
-            ts, fs = tab
-            k = self._segment(ts, t)
-            if 0 <= k < len(ts) - 1:
-                out[i] = (fs[k + 1] - fs[k]) / (ts[k + 1] - ts[k])
-        return out
+        return [self._table(tab, t)[1] if tab else mpf(0) for tab in self.tables]
 
     def next_break(self, t):
-        for tb in self.breaks:
-            if tb > t:
-                return tb
-        return mp.inf
+        k = bisect.bisect_right(self.breaks, t)
+        return self.breaks[k] if k < len(self.breaks) else mp.inf
 
     def scale(self):
         """The largest |force| and |rate| any body sees (for tolerances)."""
@@ -248,34 +230,24 @@ class Forcing:
                 continue
             ts, fs = tab
             force += max(abs(f) for f in fs)
-            for k in range(len(ts) - 1):
-                rate = max(rate, abs((fs[k + 1] - fs[k]) / (ts[k + 1] - ts[k])))
+            rate = max([rate] + [abs((fs[k + 1] - fs[k]) / (ts[k + 1] - ts[k])) for k in range(len(ts) - 1)])
         return force, rate
 
 
 # --- polynomials -----------------------------------------------------------------------
 
-def _peval(c, s):
-    """c[0] + c[1] s + c[2] s^2 + ... and its derivative (Horner)."""
-    p, dp = mpf(0), mpf(0)
-    for coef in reversed(c):
-        dp = dp * s + p
-        p = p * s + coef
-    return p, dp
-
-
-def _quadratic_roots(a, b, c):
-    """Real roots of a s^2 + b s + c (a, b may vanish), by the stable formulas."""
+def _critical_points(c):
+    """Real roots of the derivative of the cubic c (low order first): the roots of
+    3 c3 s^2 + 2 c2 s + c1, by the formula without cancellation (q = -(b + sign(b) sqrt D)/2,
+    roots q / a and c / q)."""
+    a, b, c = 3 * c[3], 2 * c[2], c[1]
     if a == 0:
         return [] if b == 0 else [-c / b]
     disc = b * b - 4 * a * c
     if disc < 0:
         return []
-    q = -(b + (mp.sqrt(disc) if b >= 0 else -mp.sqrt(disc))) / 2
-    roots = [q / a]
-    if q != 0:
-        roots.append(c / q)
-    return roots
+    q = -(b + mp.sqrt(disc)) / 2 if b >= 0 else (mp.sqrt(disc) - b) / 2
+    return [q / a] + ([c / q] if q != 0 else [])
 
 
 def first_nonpositive(c, s_max):
@@ -283,6 +255,14 @@ def first_nonpositive(c, s_max):
     reaches zero from above; mp.inf if it stays positive.  Exact zero coefficients at the
     low end (a gap that starts closed, a velocity that starts at zero) are divided out
     first, so c must be positive just after 0 (0 is returned if it is not)."""
+    found = bracket(c, s_max)
+    return found if not isinstance(found, tuple) else polish(*found)
+
+
+def bracket(c, s_max):
+    """The first root of c on (0, s_max] isolated: (c, lo, hi) with c(lo) > 0 >= c(hi) and c
+    monotone between (polish() finds it), or mp.inf (none), or 0 (c <= 0 at once).  The
+    roots are isolated between the critical points (closed-form roots of c')."""
     c = list(c)
     while c and c[0] == 0:
         c.pop(0)
@@ -294,24 +274,23 @@ def first_nonpositive(c, s_max):
         return mpf(0)
     if len(c) == 1:
         return mp.inf
-    d = [k * c[k] for k in range(1, len(c))] + [mpf(0), mpf(0)]
-    crit = sorted(s for s in _quadratic_roots(d[2], d[1], d[0]) if 0 < s < s_max)
+    crit = sorted(s for s in _critical_points(c + [mpf(0)] * (4 - len(c))) if 0 < s < s_max)
     lo = mpf(0)
     for hi in crit + [s_max]:
         if hi <= lo:
             continue
         if _peval(c, hi)[0] <= 0:
-            return _polish(c, lo, hi)
+            return c, lo, hi
         lo = hi
     return mp.inf
 
 
-def _polish(c, lo, hi):
+def polish(c, lo, hi):
     """The root of c in (lo, hi], c(lo) > 0 >= c(hi), c monotone there: safeguarded
-    Newton; returns a point where c <= 0, within a few ulps of the root."""
+    Newton; returns a point where c <= 0, a few ulps above the root."""
     s = hi
-    resolution = mpf(2) ** (-mp.prec + 4)
-    for _ in range(1000):
+    resolution = mpf(2) ** (-mp.prec + 6)
+    for _ in range(400):
         p, dp = _peval(c, s)
         if p > 0:
             lo = s
@@ -319,7 +298,19 @@ def _polish(c, lo, hi):
             hi = s
         if hi - lo <= resolution * hi:
             break
-        s_new = s - p / dp if dp != 0 else lo
+        step = p / dp if dp != 0 else None
+        if step is not None and abs(step) <= resolution * hi:
+            # Newton has converged to s - step: bracket it tightly (both sides checked).
+            below, above = s - step - resolution * hi, s - step + resolution * hi
+            if lo < below and _peval(c, below)[0] > 0:
+                lo = below
+            if above < hi and _peval(c, above)[0] <= 0:
+                hi = above
+            if hi - lo <= 4 * resolution * hi:
+                break
+            s = (lo + hi) / 2
+            continue
+        s_new = s - step if step is not None else lo
         if not lo < s_new < hi:
             s_new = (lo + hi) / 2
         s = s_new
@@ -557,8 +548,7 @@ class Mode:
     held: set          # limits held closed (persistent contacts)
     closed: set        # candidate limits that stay closed (held, or redundant: n.a = 0)
     stuck: set         # bodies at rest held by static friction
-    holds: list        # (value, rate): every basic variable of the clusters' LCPs, >= 0 in the mode
-    force: dict = field(default_factory=dict)   # limit -> (lambda, rate) of the held-force solution
+    holds: list        # (value, rate): the basic variables of the clusters' LCPs that decrease
 
 
 @dataclass
@@ -622,9 +612,7 @@ class _ModeSolver:
                   if self.zero_acc(M.limits[k].rate(a0), M.limits[k].rate(a1))}
         self._equalise(closed, a0, a1)
         held = self._held(closed, lam, stuck)
-        force = {k: lam.get(k, (mpf(0), mpf(0))) for k in held}
-        return Mode(a0=a0, a1=a1, sgn=sgn, held=held, closed=closed, stuck=stuck,
-                    holds=holds, force=force)
+        return Mode(a0=a0, a1=a1, sgn=sgn, held=held, closed=closed, stuck=stuck, holds=holds)
 
     def _cascade(self, bodies, cands, rest, f, df, fixed):
         """Static bounds for every body at rest; the ones that move break away and slide
@@ -769,13 +757,8 @@ class Solution:
         t = _mp(t)
         if t >= self.t_end:
             return self.final
-        chosen = self.phases[0]
-        for ph in self.phases:
-            if ph.t0 <= t:
-                chosen = ph
-            else:
-                break
-        return chosen.at(t)
+        k = bisect.bisect_right([ph.t0 for ph in self.phases], t) - 1   # the last phase begun by t
+        return self.phases[max(k, 0)].at(t)
 
 
 def solve(scene, t_end=None):
@@ -800,9 +783,10 @@ class _Run:
         self.vtol = TOL_V * v_scale
         self.sol = Solution(model=model, t_end=t_end)
         self.work = self.friction_loss = self.impact_loss = mpf(0)
+        self.history = []      # event points with impacts: (t, kinds logged, v after)
 
-    def log(self, t, kind, subject, before, after):
-        self.sol.events.append(Event(t, kind, subject, tuple(before), tuple(after)))
+    def log(self, t, kind, subject, before, after, joint=False):
+        self.sol.events.append(Event(t, kind, subject, tuple(before), tuple(after), joint))
         if len(self.sol.events) > MAX_EVENTS:
             raise RuntimeError(f"more than {MAX_EVENTS} events by t = {float(t)}")
 
@@ -855,16 +839,25 @@ class _Run:
                 coeffs = [mpf(0), nv, na0 / 2, na1 / 6]
             else:
                 coeffs = [self.gaps[k], nv, na0 / 2, na1 / 6]
-            roots[("contact", k)] = first_nonpositive(coeffs, s_max)
+            roots[("contact", k)] = bracket(coeffs, s_max)
         for i in range(M.n):
             sg = mode.sgn[i]
             if M.s[i] > 0 and sg != 0:
                 acc0 = 0 if v[i] == 0 and self.solver.zero_acc(a0[i], 0) else a0[i]
-                roots[("stop", i)] = first_nonpositive([sg * v[i], sg * acc0, sg * a1[i] / 2], s_max)
+                roots[("stop", i)] = bracket([sg * v[i], sg * acc0, sg * a1[i] / 2], s_max)
         for j, (value, rate) in enumerate(mode.holds):
             roots[("hold", j)] = max(value, mpf(0)) / -rate
 
-        s_hit = min(list(roots.values()) + [mp.inf])
+        # Polish the isolated roots in the order of their brackets, only those that can be
+        # the earliest or at the same instant as it.
+        s_hit = min([r for r in roots.values() if not isinstance(r, tuple)] + [mp.inf])
+        for key, r in sorted(((k, r) for k, r in roots.items() if isinstance(r, tuple)),
+                             key=lambda item: item[1][1]):
+            if r[1] > s_hit + SAME_TIME * max(abs(t + s_hit), mpf("1e-3")):
+                roots[key] = mp.inf   # (not needed: later than the earliest)
+                continue
+            roots[key] = polish(*r)
+            s_hit = min(s_hit, roots[key])
         if s_hit >= s_max:
             s_hit, hits = s_max, []
             t_new = t_stop
@@ -915,10 +908,13 @@ class _Run:
             for i in range(M.n):
                 if uf.find(i) in roots:
                     self.v[i] = mpf(0)
+        first = len(self.sol.events)
         self.impacts()
         self.zero_small_normal_velocities()
         mode = self.solver.solve(t, self.v, self.touching)
         mode = self.zeno(mode)
+        if self.accumulation(first):
+            mode = self.solver.solve(t, self.v, self.touching)
         self.mode = mode
         for k, lim in enumerate(M.limits):
             if k in mode.held and k not in self.in_contact:
@@ -964,6 +960,61 @@ class _Run:
             mode = self.solver.solve(self.t, self.v, self.touching)
         return mode
 
+    def accumulation(self, first):
+        """A bounce series alternating between several contacts (METHOD 9): the event
+        points with impacts repeat a pattern of p points whose contacts' normal velocities
+        shrink by a ratio rho < 1 each period (the cycle map's dominant rate, measured on
+        the last two periods).  When the rest of the series, dt rho / (1 - rho) with dt the
+        last period's duration, lasts less than ZENO_TIME, every contact of the cycle is
+        closed now (normal velocities made zero, gaps 0) and its rest is logged at the
+        accumulation time.  Returns whether it cut."""
+        # (a set: an impulse chain at one instant ends at the velocity floor, so its length
+        # is not part of the pattern)
+        kinds = tuple(sorted({e.kind for e in self.sol.events[first:]}))
+        if not any(not k.startswith(RESERVED_PREFIXES) for k in kinds):
+            return False
+        names = {lim.name: lim.index for lim in self.M.limits}
+        hist = self.history
+        hist.append((self.t, kinds, tuple(self.v)))
+        del hist[:-3 * CYCLE_POINTS]
+        for p in range(1, CYCLE_POINTS + 1):
+            if len(hist) < 2 * p + 1:
+                break
+            if any(hist[-1 - j][1] != hist[-1 - j - p][1] for j in range(p + 1)):
+                continue
+            cycle = sorted({names[k.split("_", 1)[1] if k.startswith(RESERVED_PREFIXES[:2]) else k]
+                            for j in range(p) for k in hist[-1 - j][1] if not k.startswith(("stick", "slip"))})
+            if len(cycle) < 2:
+                continue   # one contact: zeno() sums its series exactly
+            now = [self.M.limits[k].rate(hist[-1][2]) for k in cycle]
+            then = [self.M.limits[k].rate(hist[-1 - p][2]) for k in cycle]
+            norm = sum(u * u for u in then)
+            if norm == 0:
+                continue
+            rho = sum(a * b for a, b in zip(now, then)) / norm
+            dt, dt_before = hist[-1][0] - hist[-1 - p][0], hist[-1 - p][0] - hist[-1 - 2 * p][0]
+            if not 0 < rho < 1 or dt <= 0 or \
+                    sum((a - rho * b) ** 2 for a, b in zip(now, then)) > CYCLE_FIT ** 2 * norm * rho ** 2 or \
+                    abs(dt - rho * dt_before) > CYCLE_FIT * dt:
+                continue
+            remaining = dt * rho / (1 - rho)
+            if remaining >= ZENO_TIME:
+                return False
+            ke = self.M.ke(self.v)
+            for k in cycle:
+                self.touching.add(k)
+                self.gaps[k] = mpf(0)
+            self.common_velocities(cycle, cycle)
+            self.impact_loss += ke - self.M.ke(self.v)
+            for k in cycle:
+                if k not in self.in_contact:
+                    self.in_contact.add(k)
+                    name = self.M.limits[k].name
+                    self.log(self.t + remaining, "rest_" + name, name, self.v, self.v)
+            hist.clear()
+            return True
+        return False
+
     # --- impacts ---
     def impacts(self):
         M = self.M
@@ -980,14 +1031,15 @@ class _Run:
             one_link = {M.limits[k].record for k in group} <= M.rigid_records and \
                 len({M.limits[k].record for k in group}) == 1
             before, ke = tuple(self.v), M.ke(self.v)
-            if len(group) > 1 and plastic and not one_link:
+            joint = len(group) > 1 and plastic and not one_link
+            if joint:
                 pushed = self.projection(group)
             else:
                 self.impulse(pick, M.restitution(pick, self.touching))
                 pushed = [pick]
             self.impact_loss += ke - M.ke(self.v)
             for k in pushed:
-                self.log(self.t, M.limits[k].name, M.limits[k].name, before, self.v)
+                self.log(self.t, M.limits[k].name, M.limits[k].name, before, self.v, joint)
         raise RuntimeError(f"impacts at t = {float(self.t)} do not settle")
 
     def closed_group(self, start):
@@ -1054,10 +1106,15 @@ class _Run:
         M = self.M
         small = [k for k in self.touching if abs(M.limits[k].rate(self.v)) <= self.vtol]
         dirty = [k for k in small if M.limits[k].rate(self.v) != 0]
-        if not dirty:
-            return
+        if dirty:
+            self.common_velocities(small, dirty)
+
+    def common_velocities(self, limits, dirty):
+        """The velocity nearest the present one (mass metric) with zero normal velocity on
+        every given limit, changed only on the bodies joined to a `dirty` one."""
+        M = self.M
         uf = _Union(M.n)
-        for k in small:
+        for k in limits:
             uf.join_limit(M.limits[k])
         roots = {uf.find(M.limits[k].bodies[0]) for k in dirty}
         for group in uf.groups(range(M.n)):
