@@ -1037,6 +1037,8 @@ class _Run:
             else:
                 self.impulse(pick, M.restitution(pick, self.touching))
                 pushed = [pick]
+            if joint or M.restitution(pick, self.touching) == 0:
+                self.common_velocities(pushed, pushed)   # n.v = 0 exactly, not to rounding
             self.impact_loss += ke - M.ke(self.v)
             for k in pushed:
                 self.log(self.t, M.limits[k].name, M.limits[k].name, before, self.v, joint)

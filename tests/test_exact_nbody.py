@@ -320,13 +320,67 @@ def test_friction_chain_under_a_constant_push(push, held):
     assert all((v > 0) == moving for v in sol.final[1])
 
 
-def test_friction_chain_under_a_ramp_breaks_away_at_once():
-    scene = ns.friction_chain()
+@pytest.mark.parametrize("n", (8, 3, 2))
+def test_friction_chain_under_a_ramp_breaks_away_at_once(n):
+    """Two blocks: the pair holds until the push reaches s_1 + s_2 (docs/method.md 2, the
+    engine's closed form for a stuck pair), not one's sliding bound plus the other's static one."""
+    scene = ns.friction_chain(n=n)
     answer = ns.friction_chain_answer(scene)
     sol = check_closed_form(scene, answer)
     slips = [e for e in sol.events if e.kind.startswith("slip")]
-    assert len(slips) == 8 and all(e.t == answer["t_break"] for e in slips)
-    assert answer["t_break"] == mpf(33) / 8
+    assert len(slips) == n and all(e.t == answer["t_break"] for e in slips)
+    assert answer["t_break"] == {8: mpf(33) / 8, 3: mpf(12) / 8, 2: mpf(7) / 8}[n]
+
+
+def test_rigid_link_is_one_body_for_other_contacts():
+    """Bodies 2 and 3 joined by a rigid link (d_min = d_max) are hit by body 1, elastic: the
+    pair answers as one body of mass M = m2 + m3, v1' = (m1 - M) v / (m1 + M) and
+    v2' = v3' = 2 m1 v / (m1 + M), at t = gap / v; the link itself takes no impulse."""
+    m1, m2, m3, v, gap = 2.0, 1.0, 0.5, 1.5, 0.75
+    scene = dict(m=[m1, m2, m3], x=[0.0, gap, gap + 0.25], v=[v, 0.0, 0.0], t_end=1.0,
+                 contacts=[dict(a=1, b=2, d_min=0.0, r_min=1.0, name="hit"),
+                           dict(a=2, b=3, d_min=0.25, d_max=0.25, name="link")])
+    sol = nb.solve(scene)
+    big = mpf(m2 + m3)
+    after = ((m1 - big) * v / (m1 + big), 2 * m1 * v / (m1 + big), 2 * m1 * v / (m1 + big))
+    assert [(e.t, e.kind) for e in sol.events] == [(0, "rest_link_min"), (mpf(gap) / v, "hit")]
+    assert max(abs(a - b) for a, b in zip(sol.events[1].after, after)) < EXACT
+    t = 1 - mpf(gap) / v
+    assert max(abs(a - b) for a, b in zip(sol.final[0], (gap + after[0] * t, gap + after[1] * t,
+                                                         gap + 0.25 + after[2] * t))) < EXACT
+
+
+def test_body_pinned_between_plastic_contacts_stops_at_once():
+    """Body 1 resting on a plastic wall, hit by body 2 through a plastic contact: one joint
+    projection (docs/method.md 4) stops both at the instant, not a geometric series of
+    impulses; both contacts are logged as its impacts and then held."""
+    scene = dict(m=[1.0, 3.0], x=[0.0, 0.5], v=[0.0, -2.0], t_end=1.0,
+                 contacts=[dict(a=0, b=1, d_min=0.0, r_min=0.0, name="wall"),
+                           dict(a=1, b=2, d_min=0.0, r_min=0.0, name="meet")])
+    sol = nb.solve(scene)
+    assert [(e.t, e.kind, e.joint) for e in sol.events] == [
+        (0, "rest_wall", False), (0.25, "wall", True), (0.25, "meet", True), (0.25, "rest_meet", False)]
+    assert sol.events[1].after == (0, 0) and sol.final == ((0, 0), (0, 0))
+    assert sol.ledger["impact_loss"] == 6   # all of 3 * 2^2 / 2
+
+
+def test_series_over_two_contacts_is_summed_at_its_rate(monkeypatch):
+    """A light body rattling between a wall and a heavier one pushed onto it (METHOD 9): the
+    series alternates between the two contacts; cut at ZENO_TIME = 1e-16 s by the cycle's
+    geometric rate, the accumulation time is the one found following the series eight
+    decades further (1e-24 s), to far below the cut."""
+    scene = dict(m=[1.0, 4.0], x=[1.0, 2.0], v=[0.0, -1.0], f=[0.0, -4.0], t_end=3.0,
+                 contacts=[dict(a=0, b=1, d_min=0.0, r_min=0.5, name="wall"),
+                           dict(a=1, b=2, d_min=0.0, r_min=0.5, name="meet")])
+    cut = nb.solve(scene)
+    monkeypatch.setattr(nb, "ZENO_TIME", mpf(10) ** -24)
+    followed = nb.solve(scene)
+    assert len(followed.impacts()) > len(cut.impacts()) + 50
+    rests = [[(e.kind, e.t) for e in sol.events if e.kind.startswith("rest_")] for sol in (cut, followed)]
+    assert [k for k, _ in rests[0]] == [k for k, _ in rests[1]] == ["rest_wall", "rest_meet"]
+    assert abs(rests[0][0][1] - rests[1][0][1]) < 1e-22
+    assert all(abs(a.t - b.t) < EXACT for a, b in zip(cut.impacts(), followed.impacts()))
+    assert cut.final[1] == (0, 0)
 
 
 def test_builders_write_the_design_format():
