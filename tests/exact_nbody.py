@@ -442,13 +442,15 @@ class Model:
                 raise ValueError(f"{name} has {len(values)} values for {n} bodies")
             return values
 
+        if scene.get("x") is None:
+            raise ValueError("a scene needs the initial positions x")
         self.x0 = [_mp(a) for a in per_body("x", None)]
         self.v0 = [_mp(a) for a in per_body("v", 0.0)]
         mu = [_mp(a) for a in per_body("mu", 0.0)]
         mus = [_mp(b if b is not None else a) for a, b in zip(mu, per_body("mus", None))]
         if any(a < 0 for a in mu) or any(b < a for a, b in zip(mu, mus)):
             raise ValueError("friction: need 0 <= mu <= mus")
-        g = _mp(scene.get("g", DEFAULT_G) if scene.get("g") is not None else DEFAULT_G)
+        g = _mp(DEFAULT_G if scene.get("g") is None else scene["g"])
         self.c = [a * m * g for a, m in zip(mu, self.m)]      # sliding bounds
         self.s = [b * m * g for b, m in zip(mus, self.m)]     # static bounds
         tables = []
@@ -763,9 +765,11 @@ class Solution:
 
 def solve(scene, t_end=None):
     """Run an N-body scene dict exactly from t = 0 to t_end (default: the scene's)."""
+    t_end = scene.get("t_end") if t_end is None else t_end
+    if t_end is None:
+        raise ValueError("no t_end")
     with mp.workdps(DPS):
-        model = Model(scene)
-        return _Run(model, _mp(scene["t_end"] if t_end is None else t_end)).run()
+        return _Run(Model(scene), _mp(t_end)).run()
 
 
 class _Run:
