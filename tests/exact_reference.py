@@ -253,6 +253,10 @@ class Model:
         self.m = (float(_field(scene, "m1")), float(_field(scene, "m2")))
         g = float(_field(scene, "g", DEFAULT_G))
         self.c = tuple(float(_field(scene, f"mu{i}", 0.0)) * self.m[i - 1] * g for i in (1, 2))
+        # Static friction (mus >= mu, default mu): the bound a body at rest holds to; c is
+        # what a sliding body feels. A body has friction when s > 0.
+        self.s = tuple(max(float(_field(scene, f"mus{i}", 0.0) or 0.0) * self.m[i - 1] * g, self.c[i - 1])
+                       for i in (1, 2))
         # Two bodies on one line meet: without d_min the link's lower limit is at 0.
         self.contacts = [k for k in CONTACTS if _field(scene, LIMIT[k]) is not None or k == "slot_min"]
         self.limit = {k: float(_field(scene, LIMIT[k], 0.0)) for k in self.contacts}
@@ -325,7 +329,7 @@ class Model:
         return out
 
     def tolerances(self, f, df):
-        tol = 1e3 * EPS * (abs(f[0]) + abs(f[1]) + 2.0 * (self.c[0] + self.c[1])) + 1e-300
+        tol = 1e3 * EPS * (abs(f[0]) + abs(f[1]) + 2.0 * (self.s[0] + self.s[1])) + 1e-300
         tol_rate = 1e3 * EPS * (abs(df[0]) + abs(df[1]))
         return tol, tol_rate
 
@@ -417,8 +421,8 @@ class Model:
             if what == "contact":
                 holds.append((tuple(kgain[p]), 0.0, f"force_{who}"))
             else:
-                holds.append((tuple(-x for x in kgain[p]), c[who], f"friction+{who}"))
-                holds.append((tuple(kgain[p]), c[who], f"friction-{who}"))
+                holds.append((tuple(-x for x in kgain[p]), self.s[who], f"friction+{who}"))
+                holds.append((tuple(kgain[p]), self.s[who], f"friction-{who}"))
         for w, const, _ in holds:
             if not ok(w, const):
                 return None
@@ -566,7 +570,7 @@ class _Run:
                 coeffs = [self.gaps[k], M.nv(k, v), 0.5 * na0, na1 / 6.0]
             roots[("contact", k)] = first_nonpositive(coeffs, s_max)
         for i in range(2):
-            if M.c[i] == 0.0 or mode.sgn[i] == 0.0:
+            if M.s[i] == 0.0 or mode.sgn[i] == 0.0:
                 continue
             s = mode.sgn[i]
             acc0 = a0[i]
@@ -689,7 +693,7 @@ class _Run:
                     self.in_contact.discard(k)
                     self.log(t, "release_" + k, self.v, self.v)
         for i in range(2):
-            if M.c[i] == 0.0:
+            if M.s[i] == 0.0:
                 continue
             s = mode.sgn[i]
             tol_a = tol / M.m[i]
@@ -725,8 +729,8 @@ class _Run:
     def new_mode(self, f, df):
         M = self.M
         candidate = {k for k in self.touching if M.nv(k, self.v) == 0.0}
-        resting = tuple(M.c[i] > 0.0 and self.v[i] == 0.0 for i in range(2))
-        moving = tuple(math.copysign(1.0, self.v[i]) if M.c[i] > 0.0 and self.v[i] != 0.0 else 0.0
+        resting = tuple(M.s[i] > 0.0 and self.v[i] == 0.0 for i in range(2))
+        moving = tuple(math.copysign(1.0, self.v[i]) if M.s[i] > 0.0 and self.v[i] != 0.0 else 0.0
                        for i in range(2))
         return M.solve_mode(f, df, candidate, resting, moving)
 
