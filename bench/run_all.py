@@ -24,10 +24,7 @@ def _order(x):
     return "n/a" if x != x else f"{x:.2f}"
 
 
-def _table(rows, header):
-    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
-    lines += ["| " + " | ".join(r) + " |" for r in rows]
-    return "\n".join(lines)
+_table = common.markdown_table
 
 
 def accuracy_md(conv, wp, perf, info) -> str:
