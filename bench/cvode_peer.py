@@ -342,7 +342,9 @@ def _accumulation(c5, tool) -> str:
         depth = max(b[w]["depth"] for w in WALLS)
         out += (f"; the bodies pass through the walls (about t = {min(crossed):.9f}) and "
                 f"end {depth:.3g} m beyond them")
-    return out + f" ({cv['stop_reason']})"
+    if cv["stop_reason"] == "t_end reached":
+        return out + "; the loop runs on to t_end"
+    return out + f"; the loop stops on its bound ({cv['stop_reason']})"
 
 
 def performance_section(res, perf=None, siconos=None) -> str:
@@ -524,7 +526,8 @@ def accuracy_section(res) -> str:
         "a root on the far side of the crossing (the gap a rounding-level negative), and "
         "once the rebounds are as small as its error on the restarted state, roots are "
         "reported where nothing approaches the wall: "
-        f"{cv5['restarts']} restarts for {cv5['impacts']} impacts. It does not stall; it "
+        f"{cv5['restarts']} restarts for {cv5['impacts']} impacts, {cv5['empty_roots']} of "
+        "them with no impact at all. It does not stall; it "
         "passes the accumulation point wrongly. A body left just beyond its wall by a "
         "restart, with a rebound too weak to bring the gap back above zero before the "
         "force turns it round, leaves the root finder no sign change to find, and the "
