@@ -35,7 +35,7 @@ help:
 	@echo "make demo    run the scenes in input/ (the six cases, springs, stick-slip, rattle, break-away) and plot them"
 	@echo "make test    Fortran unit tests (meson test), then pytest"
 	@echo "make study   case 5's rest time over (r_left, r_right), the impact oscillator's bifurcation diagram"
-	@echo "make bench   accuracy and speed studies, Siconos as a peer (apt, if missing)"
+	@echo "make bench   accuracy and speed studies, Siconos and CVODE as peers (apt, if missing)"
 	@echo "             -> docs/accuracy.md, docs/performance.md"
 	@echo "make clean   remove .venv, build/ and output files"
 
@@ -103,8 +103,8 @@ clean:
 
 # Accuracy and speed studies (bench/): a few minutes; writes docs/accuracy.md,
 # docs/performance.md and their figures (docs/*.png). Numbers are measured, not asserted.
-.PHONY: bench siconos
-bench: setup siconos
+.PHONY: bench siconos sundials
+bench: setup siconos sundials
 	$(BIN)/python bench/run_all.py
 
 # The Siconos peer (bench/siconos_peer.py) runs under the system interpreter with Debian's
@@ -124,5 +124,23 @@ siconos:
 	    $$SUDO apt-get update -q || true; \
 	    $$SUDO apt-get install -y -q python3-siconos \
 	      || echo "note: apt-get could not install python3-siconos: the bench runs without it"; \
+	  fi; \
+	fi
+
+# The CVODE peer (bench/cvode_peer.c, compiled by bench/cvode_peer.py into build/bench) links
+# Debian's SUNDIALS: apt-get only when its CVODE header is missing. Optional, as Siconos is:
+# where it cannot be installed the bench says "not compared" for CVODE.
+sundials:
+	@if [ ! -f /usr/include/cvode/cvode.h ]; then \
+	  if [ "$$(id -u)" -eq 0 ]; then SUDO=""; \
+	  elif command -v sudo >/dev/null 2>&1; then SUDO="sudo -E"; \
+	  else SUDO="none"; fi; \
+	  if [ "$$SUDO" = none ] || ! command -v apt-get >/dev/null 2>&1; then \
+	    echo "note: SUNDIALS is not installed and apt-get cannot install it here: the bench runs without CVODE"; \
+	  else \
+	    echo "installing libsundials-dev with apt-get"; \
+	    $$SUDO apt-get update -q || true; \
+	    $$SUDO apt-get install -y -q libsundials-dev \
+	      || echo "note: apt-get could not install libsundials-dev: the bench runs without CVODE"; \
 	  fi; \
 	fi

@@ -378,6 +378,12 @@ def load_json(name: str):
     return json.loads((RESULTS / f"{name}.json").read_text())
 
 
+def markdown_table(rows, header) -> str:
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    lines += ["| " + " | ".join(r) + " |" for r in rows]
+    return "\n".join(lines)
+
+
 def fmt(x, digits=2) -> str:
     if x is None or (isinstance(x, float) and not np.isfinite(x)):
         return "n/a"

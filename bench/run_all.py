@@ -1,9 +1,9 @@
-"""`make bench`: run the convergence, work-precision and performance studies and the Siconos
-peer comparison in one process on one machine, then write docs/accuracy.md and
-docs/performance.md from the measured numbers (figures: docs/convergence.png,
-docs/work_precision.png, docs/performance.png).
+"""`make bench`: run the convergence, work-precision and performance studies, the Siconos and
+CVODE peer comparisons and the sweep study in one process on one machine, then write
+docs/accuracy.md and docs/performance.md from the measured numbers (figures:
+docs/convergence.png, docs/work_precision.png, docs/performance.png).
 
-    python bench/run_all.py                 # all four (a few minutes)
+    python bench/run_all.py                 # all of them (a few minutes)
     python bench/run_all.py --docs-only     # rewrite the docs from bench/results/*.json
 """
 
@@ -14,6 +14,7 @@ import time
 
 import common
 import convergence
+import cvode_peer
 import siconos_peer
 import sweep_study
 
@@ -24,10 +25,7 @@ def _order(x):
     return "n/a" if x != x else f"{x:.2f}"
 
 
-def _table(rows, header):
-    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
-    lines += ["| " + " | ".join(r) + " |" for r in rows]
-    return "\n".join(lines)
+_table = common.markdown_table
 
 
 def accuracy_md(conv, wp, perf, info) -> str:
@@ -240,7 +238,7 @@ def _at(study, dt):
     return next(r for r in study["methods"]["event"]["rows"] if r["dt"] == dt)
 
 
-def performance_md(perf, info) -> str:
+def performance_md(perf, info, cvode=None, siconos=None) -> str:
     c3, loop, sine, spring = perf["case3"], perf["loop"], perf["loop_sine"], perf["loop_spring"]
     sc, mem = perf["scaling"], perf["memory"]
     bt = c3["batch"]
@@ -257,7 +255,9 @@ def performance_md(perf, info) -> str:
         "",
         "![performance](performance.png)",
         "",
-        "## Case 3 against SciPy (the headline ratio)",
+        cvode_peer.performance_section(cvode, perf, siconos).rstrip(),
+        "",
+        "## Case 3 against SciPy",
         "",
         f"`impact1d.simulate(case3, dt=1e-3, dt_out=0.01)` ({c3['steps']} steps, "
         f"{c3['samples']} samples) against the SciPy DOP853 event-restart version with the "
@@ -393,18 +393,23 @@ def main(argv):
         performance.run()
         print("Siconos peer comparison ...", flush=True)
         siconos_peer.run()
+        print("CVODE peer comparison ...", flush=True)
+        cvode_peer.run()
         print("sweep study ...", flush=True)
         sweep_study.run()
         print(f"studies done in {time.perf_counter() - start:.0f} s", flush=True)
     info = common.load_json("machine") if info_path.exists() else common.machine()
     conv, wp, perf = (common.load_json(n) for n in ("convergence", "work_precision", "performance"))
-    # Siconos is optional: without results its sections say it was not compared.
+    # Siconos and CVODE are optional: without results their sections say they were not compared.
     peer = common.load_json("siconos") if (common.RESULTS / "siconos.json").exists() else None
     sweeps = common.load_json("sweep") if (common.RESULTS / "sweep.json").exists() else None
+    cvode = common.load_json("cvode") if (common.RESULTS / "cvode.json").exists() else None
     (common.DOCS / "accuracy.md").write_text(
-        accuracy_md(conv, wp, perf, info).rstrip() + "\n\n" + siconos_peer.accuracy_section(peer))
+        accuracy_md(conv, wp, perf, info).rstrip() + "\n\n" + siconos_peer.accuracy_section(peer)
+        .rstrip() + "\n\n" + cvode_peer.accuracy_section(cvode))
     (common.DOCS / "performance.md").write_text(
-        performance_md(perf, info).rstrip() + "\n\n" + siconos_peer.performance_section(peer).rstrip()
+        performance_md(perf, info, cvode, peer).rstrip() + "\n\n"
+        + siconos_peer.performance_section(peer).rstrip()
         + "\n\n" + sweep_study.performance_section(sweeps))
     print("wrote docs/accuracy.md, docs/performance.md and docs/*.png")
 

@@ -299,10 +299,7 @@ def _version_line(res):
             f"version {res['siconos']}), under {res['python']}")
 
 
-def _table(rows, header):
-    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
-    lines += ["| " + " | ".join(r) + " |" for r in rows]
-    return "\n".join(lines)
+_table = common.markdown_table
 
 
 def performance_section(res) -> str:
