@@ -151,6 +151,21 @@ class Result:
         """The run's sample columns as one (n, len(columns)) array, in `columns` order."""
         return np.column_stack([getattr(self, name) for name in self.columns])
 
+    def to_dataframe(self):
+        """The samples as a pandas DataFrame: one column per name in `columns`, in that
+        order, one row per sample (the same float64 values)."""
+        import pandas as pd
+
+        return pd.DataFrame({name: getattr(self, name) for name in self.columns},
+                            columns=list(self.columns))
+
+    def events_frame(self):
+        """The event log as a pandas DataFrame: one row per event, in order, with the
+        columns of `events` (t, kind, v1_before, [v2_before,] v1_after[, v2_after])."""
+        import pandas as pd
+
+        return pd.DataFrame(self.events, columns=list(self.events.dtype.names))
+
     def __repr__(self) -> str:
         title = self.scene.title if self.scene is not None else None
         return (f"Result({title!r}: {len(self.t)} samples, {len(self.events)} events, "
