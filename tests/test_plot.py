@@ -653,3 +653,40 @@ def test_slot_limit_beyond_the_walls_is_not_drawn():
     assert maybe_artist(pos, "slot_band") is None and maybe_artist(pos, "slot:max") is None
     np.testing.assert_allclose(artist(pos, "slot:min").get_ydata(),
                                np.clip(res.x1 + res.scene.d_min, 0.0, 10.0))
+
+
+# ----------------------------------------------------------------------------
+# messages
+
+
+class FullDiskFigure(matplotlib.figure.Figure):
+    """A figure whose save meets a full disk, reported as the OS reports it: naming the file
+    being written (the temporary one save() writes first)."""
+
+    def savefig(self, fname, *args, **kwargs):
+        import errno
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), os.fspath(fname))
+
+
+def test_write_error_names_the_file_asked_for(tmp_path):
+    target = tmp_path / "run.png"
+    with pytest.raises(OSError) as caught:
+        plot.save(case5_like(), target, figure_factory=FullDiskFigure)
+    assert caught.value.filename == str(target) and ".part" not in str(caught.value)
+    assert "No space left" in str(caught.value)
+    assert list(tmp_path.iterdir()) == []        # no temporary left behind
+
+
+@pytest.mark.skipif(not os.path.isdir("/proc/self"), reason="needs Linux /proc")
+def test_cli_write_error_names_the_png(tmp_path, cli, capsys):
+    """/proc takes no new file, even from root: making the temporary fails there."""
+    out = tmp_path / "run.dat"
+    write_cli_output(case3_like(), out)
+    assert cli.main([str(out), "-o", "/proc/impact1d_test.png"]) == 1
+    err = capsys.readouterr().err
+    assert err == "impact1d-plot: error: cannot write /proc/impact1d_test.png: No such file or directory\n"
+    table = tmp_path / "table.csv"
+    table.write_text("r_left,n_impacts,t_rest,error\n0,1,0.5,\n1,2,0.7,\n")
+    assert cli.main([str(table), "--x", "r_left", "-o", "/proc/impact1d_test.png"]) == 1
+    err = capsys.readouterr().err
+    assert ".part" not in err and "cannot write /proc/impact1d_test.png" in err

@@ -504,11 +504,15 @@ def save(result, path, separate=False, *, dpi=100, figure_factory=None):
         paths = [path]
     else:
         paths = [f"{stem}_{fig.get_label()}{ext}" for fig in figs]
-    folder = os.path.dirname(os.path.abspath(path))
-    os.makedirs(folder, exist_ok=True)
     for fig, p in zip(figs, paths):
-        write_whole(p, lambda temporary: fig.savefig(temporary, dpi=dpi))
+        _write(fig, p, dpi)
     return paths
+
+
+def _write(fig, path, dpi=100):
+    """Save `fig` to `path` whole (missing folders made; an error names `path`)."""
+    os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
+    write_whole(path, lambda temporary: fig.savefig(temporary, dpi=dpi))
 
 
 def sweep(table, x, y=None, value=("t_rest",), path=None, *, dpi=100, figure_factory=None):
@@ -546,6 +550,5 @@ def sweep(table, x, y=None, value=("t_rest",), path=None, *, dpi=100, figure_fac
         ax.set_ylabel(y)
     ax.set_title(f"{', '.join(values)} over {x}" + (f" and {y}" if y else ""))
     if path is not None:
-        os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
-        write_whole(path, lambda temporary: fig.savefig(temporary, dpi=dpi))
+        _write(fig, path, dpi)
     return fig

@@ -71,6 +71,8 @@ def _fail(message):
 
 
 def _one_line(exc):
+    if isinstance(exc, OSError) and exc.strerror:
+        return exc.strerror         # the caller names the file
     text = " ".join(str(exc).split())
     return text or type(exc).__name__
 
@@ -143,9 +145,16 @@ def _plot_table(args):
     png = args.png or _default_png(args.output)
     try:
         table = (pd.read_parquet if args.output.endswith(".parquet") else pd.read_csv)(args.output)
-        plot.sweep(table, args.x, args.y, args.value or ["t_rest"], png)
     except Exception as exc:  # noqa: BLE001 - one line, whatever went wrong
+        return _fail(f"cannot read {args.output}: {_one_line(exc)}")
+    try:
+        figure = plot.sweep(table, args.x, args.y, args.value or ["t_rest"])
+    except Exception as exc:  # noqa: BLE001
         return _fail(f"cannot plot {args.output}: {_one_line(exc)}")
+    try:
+        plot._write(figure, png)
+    except Exception as exc:  # noqa: BLE001
+        return _fail(f"cannot write {png}: {_one_line(exc)}")
     return 0 if _say(f"wrote {png}") else 1
 
 
