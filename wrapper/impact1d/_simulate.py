@@ -140,6 +140,10 @@ class Result:
     # What the run should know but did not stop it, one sentence each (a step that is
     # coarse for the springs' fastest mode, with the error RK4 makes on it).
     warnings: tuple = ()
+    # Whether `scene` holds the run's applied forces whole: False for an output file read
+    # back without its scene (its header records every force value but not the force
+    # tables' names); read_output(path, scene=...) makes it True.
+    forces_known: bool = True
 
     @property
     def columns(self) -> tuple:
