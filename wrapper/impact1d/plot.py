@@ -36,7 +36,8 @@ import warnings
 
 import numpy as np
 from matplotlib.figure import Figure
-from matplotlib.ticker import ScalarFormatter
+from matplotlib import colormaps
+from matplotlib.ticker import MaxNLocator, ScalarFormatter
 
 from ._files import check_input, write_whole
 
@@ -721,11 +722,115 @@ def _write(fig, path, dpi=100):
     write_whole(path, lambda temporary: fig.savefig(temporary, dpi=dpi))
 
 
+# Units of the sweep table's columns (summaries and the scene fields a sweep varies), for
+# the axis labels; a name not here is shown bare (a restitution, a count).
+_UNITS = {
+    "x1_end": "m", "x2_end": "m", "v1_end": "m/s", "v2_end": "m/s", "ke_end": "J",
+    "pe_end": "J", "t_rest": "s", "impact_loss": "J", "friction_loss": "J",
+    "damping_loss": "J", "energy_residual": "J",
+    "m1": "kg", "m2": "kg", "g": "m/s\u00b2", "x_left": "m", "x_right": "m", "d_min": "m",
+    "d_max": "m", "x1": "m", "x2": "m", "v1": "m/s", "v2": "m/s", "f1": "N", "f2": "N",
+    "f1_amp": "N", "f2_amp": "N", "f1_period": "s", "f2_period": "s", "f1_phase": "rad",
+    "f2_phase": "rad", "t_end": "s", "dt": "s", "dt_out": "s", "zero_vel": "m/s",
+    "k1": "N/m", "k2": "N/m", "k12": "N/m", "x1_rest": "m", "x2_rest": "m", "d_rest": "m",
+    "c1": "N s/m", "c2": "N s/m", "c12": "N s/m",
+}
+
+
+def _axis_label(name):
+    unit = _UNITS.get(name)
+    return f"{name} ({unit})" if unit else name
+
+
+def _is_count(name):
+    """Counts (n_impacts, steps, ...): whole numbers, so their axes tick at whole numbers."""
+    return name.startswith("n_") or name == "steps"
+
+
+def _number(value):
+    return f"{value:g}" if isinstance(value, (int, float, np.number)) else str(value)
+
+
+def _groups(table, x, y):
+    """The table split by its other varied fields: [(label, rows)], one item (label None)
+    when x (and y) are all that varies. A varied field is a column named as a scene field
+    with more than one value in the table (one value, as make study's t_end, is no group)."""
+    from ._scene import REAL_FIELDS, TEXT_FIELDS
+
+    fields = [name for name in table.columns if name in REAL_FIELDS + TEXT_FIELDS
+              and name not in (x, y) and table[name].nunique(dropna=False) > 1]
+    if not fields:
+        return fields, [(None, table)]
+    groups = table.groupby(fields, sort=True, dropna=False)
+    return fields, [(", ".join(f"{f} = {_number(v)}" for f, v in
+                               zip(fields, key if isinstance(key, tuple) else (key,))), rows)
+                    for key, rows in groups]
+
+
+def _column(rows, name):
+    """A column as float64, missing values (a failed run's, pandas' NA) as NaN: a gap."""
+    return rows[name].to_numpy(dtype=float, na_value=np.nan)
+
+
+def _sweep_lines(fig, table, x, values, fields, groups):
+    """One axes per summary column (quantities of different units and scales never share
+    one), a line per group of the other varied fields, each ordered along x."""
+    axes = fig.subplots(len(values), 1, sharex=True, squeeze=False)[:, 0]
+    cmap = colormaps["viridis"]
+    colors = ([cmap(v) for v in np.linspace(0.0, 0.85, len(groups))] if len(groups) > 1
+              else ["tab:blue"])
+    for ax, name in zip(axes, values):
+        for (label, rows), color in zip(groups, colors):
+            ordered = rows.sort_values(x, kind="stable")
+            ax.plot(ordered[x].to_numpy(), _column(ordered, name), marker=".", color=color,
+                    label=label, gid=f"{name}:{label}" if label else name)
+        ax.set_label(name)
+        ax.set_ylabel(_axis_label(name))
+        if _is_count(name):
+            ax.yaxis.set_major_locator(MaxNLocator(integer=True))
+        ax.grid(True, alpha=0.3)
+    for ax in axes[:-1]:
+        ax.tick_params(labelbottom=False)
+    axes[-1].set_xlabel(_axis_label(x))
+    if fields:
+        axes[0].legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0,
+                       fontsize="small", frameon=False, ncol=1 if len(groups) <= 16 else 2)
+
+
+def _sweep_maps(fig, table, x, y, value, groups):
+    """A heatmap of `value` over x and y per group of the other varied fields, on one
+    colour scale."""
+    grids = [(label, rows.pivot_table(index=y, columns=x, values=value, aggfunc="mean",
+                                      dropna=False)) for label, rows in groups]
+    numbers = np.concatenate([g.to_numpy(float).ravel() for _, g in grids])
+    finite = numbers[np.isfinite(numbers)]
+    low, high = (float(finite.min()), float(finite.max())) if finite.size else (0.0, 1.0)
+    columns = min(len(grids), 3)
+    axes = fig.subplots(-(-len(grids) // columns), columns, squeeze=False).ravel()
+    for ax, (label, grid) in zip(axes, grids):
+        mesh = ax.pcolormesh(grid.columns.to_numpy(float), grid.index.to_numpy(float),
+                             grid.to_numpy(float), shading="nearest", vmin=low, vmax=high)
+        ax.set_label(label or value)
+        ax.set_xlabel(_axis_label(x))
+        ax.set_ylabel(_axis_label(y))
+        if label:
+            ax.set_title(label, fontsize="medium")
+    for ax in axes[len(grids):]:
+        ax.set_visible(False)
+    bar = fig.colorbar(mesh, ax=list(axes[:len(grids)]), label=_axis_label(value))
+    if _is_count(value):
+        bar.locator = MaxNLocator(integer=True)
+        bar.update_ticks()
+
+
 def sweep(table, x, y=None, value=("t_rest",), path=None, *, dpi=100, figure_factory=None):
     """A figure of a sweep's table (impact1d.sweep or impact1d-sweep's CSV): with one varied
-    field `x`, a line per summary column in `value` against it; with two (`x`, `y`), a
-    heatmap of the one column `value`. Failed runs (NaN) are gaps. Saved to `path` when
-    given (written whole); the Figure is returned."""
+    field `x`, each summary column in `value` against it, on axes of its own (labelled with
+    its name and unit); with two (`x`, `y`), a heatmap of the one column `value`. When the
+    table varies other fields too, the lines are a line per value of them (a legend says
+    which), the heatmaps one per value, on one colour scale. Counts tick at whole numbers.
+    Failed runs (NaN) are gaps. Saved to `path` when given (written whole); the Figure is
+    returned."""
     import pandas as pd
 
     if not isinstance(table, pd.DataFrame):
@@ -735,26 +840,22 @@ def sweep(table, x, y=None, value=("t_rest",), path=None, *, dpi=100, figure_fac
     for name in [x, y] + values:
         if name is not None and name not in table.columns:
             raise ValueError(f"no column {name!r} in the table (columns: {', '.join(table.columns)})")
-    fig = (figure_factory or Figure)(figsize=(7, 5))
-    ax = fig.add_subplot(1, 1, 1)
+    if y is not None and len(values) != 1:
+        raise ValueError("a heatmap shows one value column")
+    fields, groups = _groups(table, x, y)
     if y is None:
-        ordered = table.sort_values(x)
-        for name in values:
-            ax.plot(ordered[x], ordered[name], marker=".", label=name)
-        ax.set_xlabel(x)
-        ax.set_ylabel(values[0] if len(values) == 1 else "value")
-        if len(values) > 1:
-            ax.legend()
+        size = (7.0 + (1.8 if fields else 0.0), max(5.0, 1.2 + 2.4 * len(values)))
     else:
-        if len(values) != 1:
-            raise ValueError("a heatmap shows one value column")
-        grid = table.pivot_table(index=y, columns=x, values=values[0], aggfunc="mean", dropna=False)
-        mesh = ax.pcolormesh(grid.columns.to_numpy(float), grid.index.to_numpy(float),
-                             grid.to_numpy(float), shading="nearest")
-        fig.colorbar(mesh, ax=ax, label=values[0])
-        ax.set_xlabel(x)
-        ax.set_ylabel(y)
-    ax.set_title(f"{', '.join(values)} over {x}" + (f" and {y}" if y else ""))
+        columns = min(len(groups), 3)
+        size = (2.0 + 5.0 * columns, 0.8 + 4.2 * -(-len(groups) // columns))
+    fig = (figure_factory or Figure)(figsize=size, layout="constrained")
+    if y is None:
+        _sweep_lines(fig, table, x, values, fields, groups)
+    else:
+        _sweep_maps(fig, table, x, y, values[0], groups)
+    over = f"{x} and {y}" if y else x
+    each = f", {'a line' if y is None else 'a map'} per {', '.join(fields)}" if fields else ""
+    fig.suptitle(f"{', '.join(values)} over {over}{each}")
     if path is not None:
         _write(fig, path, dpi)
     return fig
