@@ -440,7 +440,9 @@ def _overlap(a, b):
     return a.x0 < b.x1 and b.x0 < a.x1 and a.y0 < b.y1 and b.y0 < a.y1
 
 
-@pytest.mark.parametrize("make", [case5_like, case3_like])
+@pytest.mark.parametrize("make", [case5_like, case3_like, lambda: simulated("case6"),
+                                  lambda: simulated("stick_slip")],
+                         ids=["case5_like", "case3_like", "case6 (forces)", "stick_slip (pe)"])
 def test_layout_nothing_overlaps(make):
     fig = plot.figure(make())
     canvas = FigureCanvasAgg(fig)  # what save() renders through

@@ -29,7 +29,8 @@ def _parser():
         description="Plot an impact1d output file: positions with walls and slot, "
         "velocities, applied forces, kinetic and potential energy, impacts per constraint, "
         "energy ledger.",
-        epilog="exit status: 0 done; 1 the output could not be read or the image written; "
+        epilog="exit status: 0 done; 1 the output could not be read or drawn (a time window "
+        "that misses the run, a --scene it was not run from) or the image written; "
         "2 a bad command line.",
     )
     p.add_argument("output", metavar="OUTPUT.dat", help="output file written by impact1d "
