@@ -245,3 +245,12 @@ def test_t_rest_without_a_stopping_event(case5):
     # Batch (numbers only) and per-run (a text field) paths give the same rule.
     batch = impact1d.sweep(case5.__class__(**{**vars(case5), "method": "vissim"}), [{"dt": 1e-3}])
     assert batch.loc[0, "t_rest"] == first_still
+
+
+def test_plot_legend_writes_whole_numbers_whole(case5):
+    """A varied work limit is a count: max_rows = 10000000 in the legend, not 1e+07."""
+    from impact1d import plot
+
+    table = impact1d.sweep(case5, {"r_left": [0.2, 0.8], "max_rows": [1e4, 1e7]})
+    labels = [line.get_label() for line in plot.sweep(table, "r_left").axes[0].lines]
+    assert labels == ["max_rows = 10000", "max_rows = 10000000"]

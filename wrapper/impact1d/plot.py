@@ -748,7 +748,13 @@ def _is_count(name):
 
 
 def _number(value):
-    return f"{value:g}" if isinstance(value, (int, float, np.number)) else str(value)
+    """A varied field's value for a legend: whole numbers whole (max_rows = 10000000, not
+    1e+07), others as %g, text as it is."""
+    if not isinstance(value, (int, float, np.number)):
+        return str(value)
+    if float(value).is_integer() and abs(value) < 1e15:
+        return str(int(value))
+    return f"{value:g}"
 
 
 def _groups(table, x, y):
