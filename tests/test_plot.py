@@ -41,6 +41,9 @@ TIGHT = dict(rtol=0.0, atol=1e-12)
 # rather than skipping the tests that need it.
 IMPACT1D = importlib.import_module("impact1d")
 plot = importlib.import_module("impact1d.plot")
+# The panels every run has (a constant-force scene without springs: no force panel by
+# default, no potential energy).
+BASE_PANELS = [p for p in plot.PANELS if p not in ("forces", "potential_energy")]
 
 
 # ----------------------------------------------------------------------------
@@ -68,6 +71,9 @@ class FakeScene:
     v2: float = 0.0
     f1: float | None = 0.0
     f2: float | None = 0.0
+    f1_amp: float | None = None
+    f1_period: float | None = None
+    f1_phase: float | None = None
     t_end: float = 1.0
     dt: float = 1e-3
     dt_out: float | None = 1e-3
@@ -342,7 +348,7 @@ def test_object_api_only():
     figs = plot.figure(case3_like(), separate=True)
     assert plt.get_fignums() == before
     assert fig.__class__.__name__ == "Figure"
-    assert [f.get_label() for f in figs] == list(plot.PANELS)
+    assert [f.get_label() for f in figs] == BASE_PANELS
 
 
 def test_rest_bar_stays_to_the_end():
@@ -434,7 +440,9 @@ def _overlap(a, b):
     return a.x0 < b.x1 and b.x0 < a.x1 and a.y0 < b.y1 and b.y0 < a.y1
 
 
-@pytest.mark.parametrize("make", [case5_like, case3_like])
+@pytest.mark.parametrize("make", [case5_like, case3_like, lambda: simulated("case6"),
+                                  lambda: simulated("stick_slip")],
+                         ids=["case5_like", "case3_like", "case6 (forces)", "stick_slip (pe)"])
 def test_layout_nothing_overlaps(make):
     fig = plot.figure(make())
     canvas = FigureCanvasAgg(fig)  # what save() renders through
@@ -483,7 +491,7 @@ def test_save_png(tmp_path):
 
 def test_save_separate(tmp_path):
     paths = plot.save(case3_like(), tmp_path / "sub" / "run.png", separate=True)
-    assert [Path(p).name for p in paths] == [f"run_{p}.png" for p in plot.PANELS]
+    assert [Path(p).name for p in paths] == [f"run_{p}.png" for p in BASE_PANELS]
     for p in paths:
         assert is_png(p)
     assert not (tmp_path / "sub" / "run.png").exists()
@@ -580,7 +588,7 @@ def test_cli_options(tmp_path, cli):
     out = tmp_path / "run.dat"
     write_cli_output(res, out, with_events=False)
     assert cli.main([str(out), "-o", str(tmp_path / "pics" / "x.png"), "--separate"]) == 0
-    for p in plot.PANELS:
+    for p in BASE_PANELS:
         assert is_png(tmp_path / "pics" / f"x_{p}.png")
 
 
@@ -653,3 +661,223 @@ def test_slot_limit_beyond_the_walls_is_not_drawn():
     assert maybe_artist(pos, "slot_band") is None and maybe_artist(pos, "slot:max") is None
     np.testing.assert_allclose(artist(pos, "slot:min").get_ydata(),
                                np.clip(res.x1 + res.scene.d_min, 0.0, 10.0))
+
+
+# ----------------------------------------------------------------------------
+# messages
+
+
+class FullDiskFigure(matplotlib.figure.Figure):
+    """A figure whose save meets a full disk, reported as the OS reports it: naming the file
+    being written (the temporary one save() writes first)."""
+
+    def savefig(self, fname, *args, **kwargs):
+        import errno
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), os.fspath(fname))
+
+
+def test_write_error_names_the_file_asked_for(tmp_path):
+    target = tmp_path / "run.png"
+    with pytest.raises(OSError) as caught:
+        plot.save(case5_like(), target, figure_factory=FullDiskFigure)
+    assert caught.value.filename == str(target) and ".part" not in str(caught.value)
+    assert "No space left" in str(caught.value)
+    assert list(tmp_path.iterdir()) == []        # no temporary left behind
+
+
+@pytest.mark.skipif(not os.path.isdir("/proc/self"), reason="needs Linux /proc")
+def test_cli_write_error_names_the_png(tmp_path, cli, capsys):
+    """/proc takes no new file, even from root: making the temporary fails there."""
+    out = tmp_path / "run.dat"
+    write_cli_output(case3_like(), out)
+    assert cli.main([str(out), "-o", "/proc/impact1d_test.png"]) == 1
+    err = capsys.readouterr().err
+    assert err == "impact1d-plot: error: cannot write /proc/impact1d_test.png: No such file or directory\n"
+    table = tmp_path / "table.csv"
+    table.write_text("r_left,n_impacts,t_rest,error\n0,1,0.5,\n1,2,0.7,\n")
+    assert cli.main([str(table), "--x", "r_left", "-o", "/proc/impact1d_test.png"]) == 1
+    err = capsys.readouterr().err
+    assert ".part" not in err and "cannot write /proc/impact1d_test.png" in err
+
+
+# ----------------------------------------------------------------------------
+# the applied-force panel, the time window, kinetic and potential energy apart
+
+
+def simulated(name, **overrides):
+    return IMPACT1D.simulate(IMPACT1D.load_scene(str(ROOT / "input" / f"{name}.nml")), **overrides)
+
+
+def work_of(res, force):
+    """The work of `force` on body 1 along the samples (trapezoids)."""
+    power = force * res.v1
+    return np.concatenate([[0.0], np.cumsum(0.5 * (power[1:] + power[:-1]) * np.diff(res.t))])
+
+
+# Work integrated from the samples (dt_out = 1e-3) against the engine's ledger: 2.4e-7 of
+# it for the forces the engine applied; a force off by 1 % of its sine's amplitude misses
+# by 7e-5.
+WORK_RTOL = 2e-6
+
+
+def test_applied_forces_do_the_runs_work():
+    """The forces the panel draws are the engine's: their work along the motion is the
+    run's `work` column (a constant, a table, and a sine with a phase, on one free body)."""
+    res = IMPACT1D.simulate(IMPACT1D.Scene(
+        m1=1.0, x1=0.0, f1=0.5, f1_table=str(ROOT / "input" / "triangle.dat"), f1_amp=3.0,
+        f1_period=0.7, f1_phase=0.5, t_end=5.0, dt=1e-3))
+    forces = plot.applied_forces(res)
+    assert list(forces) == ["f1"]
+    np.testing.assert_allclose(work_of(res, forces["f1"]), res.work,
+                               rtol=0, atol=WORK_RTOL * np.max(np.abs(res.work)))
+
+
+def test_case6_force_panel_shows_the_triangle():
+    res = simulated("case6")
+    ax = axes_by_label(plot.figure(res))
+    f1, f2 = artist(ax["forces"], "f1"), artist(ax["forces"], "f2")
+    t = np.asarray(f1.get_xdata())
+    # the corners are drawn exactly (a triangle stays sharp whatever dt_out is)
+    for corner, value in ((1.0, 30.0), (2.0, 0.0), (3.0, -30.0), (4.0, 0.0)):
+        assert f1.get_ydata()[np.flatnonzero(t == corner)[0]] == value
+    np.testing.assert_array_equal(f1.get_ydata(), np.interp(t, [0, 1, 2, 3, 4], [0, 30, 0, -30, 0]))
+    assert np.all(np.asarray(f2.get_ydata()) == 0.0)
+    assert "(N)" in ax["forces"].get_ylabel()
+    assert list(ax).index("forces") == list(ax).index("velocities") + 1
+
+
+def test_sine_force_drawn_finer_than_the_samples():
+    scene = FakeScene(f1_amp=5.0, f1_period=0.1, f1_phase=0.3, x_right=None, r_right=None)
+    res = exact_run(scene)      # the sine is not in the motion: the panel reads the scene only
+    res.t = res.t[::50]         # samples 0.05 s apart: two a period
+    for name in ("x1", "v1", "x2", "v2", "ke", "work", "friction_loss", "impact_loss", "residual"):
+        setattr(res, name, getattr(res, name)[::50])
+    line = artist(axes_by_label(plot.figure(res))["forces"], "f1")
+    t = np.asarray(line.get_xdata())
+    assert np.max(np.diff(t)) <= 0.1 / 40
+    np.testing.assert_allclose(line.get_ydata(), 5.0 * np.sin(2 * np.pi * t / 0.1 + 0.3), atol=1e-12)
+
+
+def test_force_panel_by_default_only_when_a_force_varies():
+    res = case5_like()          # constant forces
+    assert "forces" not in axes_by_label(plot.figure(res))
+    ax = axes_by_label(plot.figure(res, forces=True))["forces"]
+    assert np.all(np.asarray(artist(ax, "f1").get_ydata()) == -2.0)
+    assert np.all(np.asarray(artist(ax, "f2").get_ydata()) == 4.0)
+    assert "forces" not in axes_by_label(plot.figure(simulated("case6"), forces=False))
+    assert [f.get_label() for f in plot.figure(res, separate=True, forces=True)][:3] == \
+        ["positions", "velocities", "forces"]
+
+
+def test_file_read_back_knows_its_forces_only_with_its_scene(tmp_path):
+    """The output's header names no force table: read back alone, the forces are unknown (no
+    panel; asked for, a warning says why); with its scene, the panel is the run's."""
+    out = tmp_path / "case6.dat"
+    done = subprocess.run([find_tool("impact1d"), str(ROOT / "input" / "case6.nml"), "-o", str(out)],
+                          capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    alone = IMPACT1D.read_output(out)
+    assert alone.forces_known is False and alone.scene.f1_table is None
+    assert "forces" not in axes_by_label(plot.figure(alone))
+    with pytest.warns(UserWarning, match="does not record its force tables"):
+        assert "forces" not in axes_by_label(plot.figure(alone, forces=True))
+    with pytest.raises(ValueError, match="force tables"):
+        plot.applied_forces(alone)
+    whole = IMPACT1D.read_output(out, scene=ROOT / "input" / "case6.nml")
+    assert whole.forces_known is True
+    np.testing.assert_array_equal(plot.applied_forces(whole)["f1"],
+                                  plot.applied_forces(simulated("case6"))["f1"])
+    with pytest.raises(IMPACT1D.InputError, match="f1 = 0.0.*f1 = -2.0"):
+        IMPACT1D.read_output(out, scene=ROOT / "input" / "case5.nml")
+
+
+def test_cli_takes_the_force_tables_from_the_scene(tmp_path, cli, capsys, monkeypatch):
+    """From the scene file the header names (relative to where impact1d ran), or --scene;
+    when neither can be had, a note on stderr says why there is no force panel."""
+    monkeypatch.chdir(ROOT)
+    out = tmp_path / "case6.dat"
+    done = subprocess.run([find_tool("impact1d"), "input/case6.nml", "-o", str(out)],
+                          capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert cli.main([str(out), "--separate", "-o", str(tmp_path / "a.png")]) == 0
+    assert is_png(tmp_path / "a_forces.png") and capsys.readouterr().err == ""
+    monkeypatch.chdir(tmp_path)         # the header's input/case6.nml is not here
+    assert cli.main([str(out), "--separate", "-o", str(tmp_path / "b.png")]) == 0
+    err = capsys.readouterr().err
+    assert not (tmp_path / "b_forces.png").exists() and is_png(tmp_path / "b_positions.png")
+    assert err.startswith("impact1d-plot: note: no force panel:") and "--scene" in err
+    assert err.count("\n") == 1
+    assert cli.main([str(out), "--separate", "-o", str(tmp_path / "c.png"),
+                     "--scene", str(ROOT / "input" / "case6.nml")]) == 0
+    assert is_png(tmp_path / "c_forces.png")
+    assert cli.main([str(out), "--separate", "-o", str(tmp_path / "d.png"), "--no-forces",
+                     "--scene", str(ROOT / "input" / "case6.nml")]) == 0
+    assert not (tmp_path / "d_forces.png").exists() and capsys.readouterr().err == ""
+    assert cli.main([str(out), "--scene", str(ROOT / "input" / "case5.nml")]) == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "f1" in err
+
+
+def test_kinetic_and_potential_energy_on_their_own_axes():
+    """Stick-slip: about 0.5 J of kinetic energy beside 5,000 J in the spring; each gets an
+    axis scaled to it."""
+    res = simulated("stick_slip")
+    ax = axes_by_label(plot.figure(res))
+    ke, pe = ax["kinetic_energy"], ax["potential_energy"]
+    assert [line.get_gid() for line in ke.get_lines()] == ["ke"]
+    np.testing.assert_array_equal(artist(pe, "pe").get_ydata(), res.pe)
+    assert ke.get_ylim() == (0.0, 1.1 * res.ke.max()) and res.ke.max() < 1.0
+    assert pe.get_ylim() == (0.0, 1.1 * res.pe.max()) and res.pe.max() > 4000.0
+    assert "kinetic energy (J)" == ke.get_ylabel() and "potential energy (J)" == pe.get_ylabel()
+    assert [f.get_label() for f in plot.figure(res, separate=True)] == list(plot.PANELS)
+
+
+def test_time_window():
+    res = simulated("case6")
+    lo, hi = 2.5005, 3.9995                 # between samples (dt_out = 1e-3)
+    fig = plot.figure(res, t_from=lo, t_to=hi)
+    ax = axes_by_label(fig)
+    for a in ax.values():
+        assert a.get_xlim() == (lo, hi)
+    inside = (res.t >= lo - 1e-3) & (res.t <= hi + 1e-3)        # and the sample either side
+    assert res.t[inside][0] < lo and res.t[inside][-1] > hi
+    x1 = artist(ax["positions"], "x1")
+    np.testing.assert_array_equal(x1.get_xdata(), res.t[inside])
+    np.testing.assert_array_equal(x1.get_ydata(), res.x1[inside])
+    # the ledger still counts from t = 0
+    np.testing.assert_array_equal(artist(ax["ledger"], "ke_change").get_ydata(),
+                                  res.ke[inside] - res.ke[0])
+    impacts = [t for t, kind in zip(res.events["t"], res.events["kind"])
+               if kind in CONTACTS and lo <= t <= hi]
+    assert f"{len(impacts)} impacts in t = {lo:g} to {hi:g} s" in ax["positions"].get_title(loc="left")
+    np.testing.assert_array_equal(artist(ax["impacts"], "tick:left").get_xdata(),
+                                  [t for t in impacts if t in impact_times(res, "left")])
+    drawn = np.asarray(artist(ax["forces"], "f1").get_xdata())
+    assert drawn[0] == lo and drawn[-1] == hi
+
+
+def test_time_window_keeps_a_rest_that_began_before_it():
+    res = case5_like()                      # both bodies rest from t = 3
+    ax = axes_by_label(plot.figure(res, t_from=3.1))["impacts"]
+    np.testing.assert_allclose(rest_bars(ax, "left"), [(impact_times(res, "rest_left")[0], 3.2)],
+                               atol=1e-12)
+    assert ax.get_xlim() == (3.1, 3.2)
+
+
+@pytest.mark.parametrize("window, message", [
+    (dict(t_from=3.0, t_to=2.0), "empty"), (dict(t_from=7.0), "misses the run"),
+    (dict(t_to=-1.0), "misses the run"), (dict(t_from=float("nan")), "finite")])
+def test_bad_time_window(window, message):
+    with pytest.raises(ValueError, match=message):
+        plot.figure(case5_like(), **window)
+
+
+def test_cli_time_window(tmp_path, cli, capsys):
+    out = tmp_path / "run.dat"
+    write_cli_output(case5_like(), out)
+    assert cli.main([str(out), "--t-from", "2", "--t-to", "3", "--separate"]) == 0
+    assert is_png(tmp_path / "run_positions.png")
+    capsys.readouterr()
+    assert cli.main([str(out), "--t-from", "7"]) == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "misses the run" in err

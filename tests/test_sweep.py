@@ -150,7 +150,64 @@ def test_plot_axes(case5):
     assert (ax.get_xlabel(), ax.get_ylabel()) == ("r_left", "r_right")
     fig = plot.sweep(impact1d.sweep(case5, {"r_left": [0.1, 0.5, 0.9]}), "r_left",
                      value=["t_rest", "impact_loss"])
-    assert [line.get_label() for line in fig.axes[0].lines] == ["t_rest", "impact_loss"]
+    # quantities of different units on axes of their own, each labelled with its name
+    axes = {ax.get_label(): ax for ax in fig.axes}
+    assert list(axes) == ["t_rest", "impact_loss"]
+    assert [axes[n].get_ylabel() for n in axes] == ["t_rest (s)", "impact_loss (J)"]
+    assert all(len(ax.lines) == 1 for ax in fig.axes)
+
+
+# A third varied field: r_right (three values) beside x = r_left; t_end has one value (as in
+# make study), so it is no group.
+THREE_FIELDS = {"r_left": [0.9, 0.0, 0.3, 0.6], "r_right": [0.2, 0.5, 0.8], "t_end": [4.0]}
+
+
+def test_plot_lines_grouped_by_the_other_field(case5):
+    """A line per r_right, each along r_left in order (it was one line zig-zagging through
+    every row), and an axes per quantity; counts tick at whole numbers."""
+    from impact1d import plot
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    table = impact1d.sweep(case5, THREE_FIELDS)
+    fig = plot.sweep(table, "r_left", value=["n_impacts", "impact_loss"])
+    FigureCanvasAgg(fig).draw()
+    axes = {ax.get_label(): ax for ax in fig.axes}
+    assert list(axes) == ["n_impacts", "impact_loss"]
+    assert axes["n_impacts"].get_ylabel() == "n_impacts"
+    for name, ax in axes.items():
+        assert [line.get_label() for line in ax.lines] == [f"r_right = {r:g}" for r in (0.2, 0.5, 0.8)]
+        for line, r in zip(ax.lines, (0.2, 0.5, 0.8)):
+            rows = table[table["r_right"] == r].sort_values("r_left")
+            np.testing.assert_array_equal(line.get_xdata(), [0.0, 0.3, 0.6, 0.9])
+            np.testing.assert_array_equal(line.get_ydata(), rows[name].to_numpy(float))
+    ticks = axes["n_impacts"].get_yticks()
+    assert np.all(ticks == np.round(ticks))
+    assert "a line per r_right" in fig._suptitle.get_text()
+
+
+def test_plot_maps_one_per_value_of_the_other_field(case5):
+    from impact1d import plot
+
+    table = impact1d.sweep(case5, {"r_left": [0.0, 0.5], "r_right": [0.25, 0.75], "t_end": [2.0, 4.0]})
+    fig = plot.sweep(table, "r_left", "r_right", "impact_loss")
+    maps = [ax for ax in fig.axes if ax.collections and ax.get_label() != "<colorbar>"]
+    assert [ax.get_title() for ax in maps] == ["t_end = 2", "t_end = 4"]
+    limits = {ax.collections[0].get_clim() for ax in maps}
+    assert len(limits) == 1          # one colour scale
+    for ax, t_end in zip(maps, (2.0, 4.0)):
+        rows = table[table["t_end"] == t_end].sort_values(["r_right", "r_left"])
+        np.testing.assert_array_equal(np.asarray(ax.collections[0].get_array()).ravel(),
+                                      rows["impact_loss"].to_numpy(float))
+
+
+def test_plot_failed_runs_are_gaps(case5):
+    from impact1d import plot
+
+    table = impact1d.sweep(case5, {"r_left": [0.2, 1.5, 0.8]})      # r_left = 1.5 is refused
+    assert table["n_impacts"].isna().sum() == 1
+    line = plot.sweep(table, "r_left", value="n_impacts").axes[0].lines[0]
+    np.testing.assert_array_equal(line.get_xdata(), [0.2, 0.8, 1.5])
+    assert np.isnan(line.get_ydata()[2]) and not np.isnan(line.get_ydata()[:2]).any()
 
 
 def test_rest_time_map_matches_the_closed_form(case5):
@@ -188,3 +245,12 @@ def test_t_rest_without_a_stopping_event(case5):
     # Batch (numbers only) and per-run (a text field) paths give the same rule.
     batch = impact1d.sweep(case5.__class__(**{**vars(case5), "method": "vissim"}), [{"dt": 1e-3}])
     assert batch.loc[0, "t_rest"] == first_still
+
+
+def test_plot_legend_writes_whole_numbers_whole(case5):
+    """A varied work limit is a count: max_rows = 10000000 in the legend, not 1e+07."""
+    from impact1d import plot
+
+    table = impact1d.sweep(case5, {"r_left": [0.2, 0.8], "max_rows": [1e4, 1e7]})
+    labels = [line.get_label() for line in plot.sweep(table, "r_left").axes[0].lines]
+    assert labels == ["max_rows = 10000", "max_rows = 10000000"]

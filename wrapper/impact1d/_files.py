@@ -74,16 +74,29 @@ def _create_temporary(target) -> str:
 
 def write_whole(path, write) -> None:
     """Call write(temporary_path), then put that file in place as `path` (through a
-    symbolic link at `path`: output_target)."""
+    symbolic link at `path`: output_target). An OSError about the temporary file is
+    raised as the same error about `path`: the temporary is ours, the user named `path`."""
     target = output_target(path)
-    temporary = _create_temporary(target)
+    temporary = None
     try:
+        temporary = _create_temporary(target)
         write(temporary)
         os.replace(temporary, target)
-    except BaseException:
-        if os.path.lexists(temporary):
+    except BaseException as error:
+        if temporary is not None and os.path.lexists(temporary):
             os.remove(temporary)
+        if isinstance(error, OSError) and _is_temporary(error.filename, target):
+            # OSError(errno, ...) is the matching subclass again (FileNotFoundError, ...).
+            raise OSError(error.errno, error.strerror, os.fspath(path)) from None
         raise
+
+
+def _is_temporary(name, target) -> bool:
+    """Whether `name` is one of _create_temporary's names for target."""
+    if not isinstance(name, str):
+        return False
+    root, ext = os.path.splitext(target)
+    return name.startswith(f"{root}.{os.getpid()}-") and name.endswith(f".part{ext}")
 
 
 def print_line(text) -> None:

@@ -2,16 +2,21 @@
 
 from __future__ import annotations
 
+import dataclasses
 import os
 
 import numpy as np
 
-from ._scene import REAL_FIELDS, TEXT_FIELDS, Scene, InputError
+from ._scene import REAL_FIELDS, TEXT_FIELDS, Scene, InputError, load_scene
 from ._files import check_input
 from ._simulate import (COLUMNS, OPTIONAL_COLUMNS, EVENT_DTYPE, ONE_BODY_EVENT_DTYPE, Result,
                         result_from_columns)
 
 __all__ = ["read_output", "events_path"]
+
+# The scene fields that make the applied forces, besides the tables (which the output's
+# header does not name).
+FORCE_FIELDS = ("f1", "f2", "f1_amp", "f1_period", "f1_phase", "f2_amp", "f2_period", "f2_phase")
 
 
 def events_path(path) -> str:
@@ -54,10 +59,15 @@ def _read_events(path, one_body=False) -> np.ndarray:
     return np.array(rows, dtype=dtype)
 
 
-def read_output(path) -> Result:
+def read_output(path, scene=None) -> Result:
     """Load `impact1d` CLI output: the samples of OUT.dat, the events of OUT.events.dat
     when it exists, and the scene recorded in the header (`source` = the scene file).
-    `steps` is None (the file does not record it); energy_residual is max |residual|."""
+    `steps` is None (the file does not record it); energy_residual is max |residual|.
+
+    The header records every value of the scene but not the force tables' names, so the
+    Result's `forces_known` is False, unless `scene` (a Scene or a scene file: the one
+    the output was run from) is given: its force tables then complete the Result's scene
+    (InputError if its force values differ from the header's)."""
     path = os.fspath(path)
     check_input(path, "output file")
     header, columns = _read_header(path)
@@ -82,7 +92,7 @@ def read_output(path) -> Result:
     for name in TEXT_FIELDS:
         if name in header:
             kwargs[name] = header[name]
-    scene = Scene(**kwargs, source=header.get("scene"))
+    header_scene = Scene(**kwargs, source=header.get("scene"))
 
     events_file = events_path(path)
     one_body = "x2" not in names
@@ -93,5 +103,22 @@ def read_output(path) -> Result:
         events = np.empty(0, dtype=ONE_BODY_EVENT_DTYPE if one_body else EVENT_DTYPE)
     residual = samples[:, names.index("residual")]
     energy_residual = float(np.max(np.abs(residual))) if residual.size else 0.0
-    return result_from_columns(samples, events, names, energy_residual=energy_residual,
-                               steps=None, scene=scene)
+    result = result_from_columns(samples, events, names, energy_residual=energy_residual,
+                                 steps=None, scene=header_scene, forces_known=False)
+    return result if scene is None else with_forces_of(result, scene, path)
+
+
+def with_forces_of(result: Result, scene, path) -> Result:
+    """`result` (read from the output file `path`) with the force tables of `scene` (a Scene
+    or a scene file), whose force values must be the header's."""
+    if not isinstance(scene, Scene):
+        scene = load_scene(scene)
+    for name in FORCE_FIELDS:
+        mine, theirs = getattr(result.scene, name), getattr(scene, name)
+        if mine != theirs:
+            where = f"the scene {scene.source}" if scene.source else "the scene"
+            raise InputError(f"{path} was not run from {where}: its header has "
+                             f"{name} = {mine}, the scene {name} = {theirs}")
+    tables = {"f1_table": scene.f1_table, "f2_table": scene.f2_table}
+    return dataclasses.replace(result, scene=dataclasses.replace(result.scene, **tables),
+                               forces_known=True)

@@ -140,6 +140,10 @@ class Result:
     # What the run should know but did not stop it, one sentence each (a step that is
     # coarse for the springs' fastest mode, with the error RK4 makes on it).
     warnings: tuple = ()
+    # Whether `scene` holds the run's applied forces whole: False for an output file read
+    # back without its scene (its header records every force value but not the force
+    # tables' names); read_output(path, scene=...) makes it True.
+    forces_known: bool = True
 
     @property
     def columns(self) -> tuple:
@@ -150,6 +154,21 @@ class Result:
     def samples(self) -> np.ndarray:
         """The run's sample columns as one (n, len(columns)) array, in `columns` order."""
         return np.column_stack([getattr(self, name) for name in self.columns])
+
+    def to_dataframe(self):
+        """The samples as a pandas DataFrame: one column per name in `columns`, in that
+        order, one row per sample (the same float64 values)."""
+        import pandas as pd
+
+        return pd.DataFrame({name: getattr(self, name) for name in self.columns},
+                            columns=list(self.columns))
+
+    def events_frame(self):
+        """The event log as a pandas DataFrame: one row per event, in order, with the
+        columns of `events` (t, kind, v1_before, [v2_before,] v1_after[, v2_after])."""
+        import pandas as pd
+
+        return pd.DataFrame(self.events, columns=list(self.events.dtype.names))
 
     def __repr__(self) -> str:
         title = self.scene.title if self.scene is not None else None

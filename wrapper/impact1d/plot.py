@@ -1,44 +1,53 @@
-"""Plots of one impact1d run: positions, velocities, kinetic energy, impacts, energy ledger.
+"""Plots of one impact1d run: positions, velocities, applied forces, kinetic and potential
+energy, impacts, energy ledger; and of a sweep's table.
 
 The panels follow the VisSim tutorial's result figures (positions: Figures 19
 and 21; kinetic energy: Figures 20 and 22; impact indicator: Figure 23) and add
 the energy ledger that every run reports.
 
 A *result* is anything with the attributes of :class:`impact1d.Result`:
-``t x1 v1 x2 v2 ke work friction_loss impact_loss residual`` (1-D arrays),
-``events`` (structured array with fields ``t kind v1_before v2_before v1_after
-v2_after``, or None) and ``scene`` (an object with the scene's fields, absent
-ones None or missing; may itself be None).  Both ``impact1d.simulate`` and
-``impact1d.read_output`` return such objects.
+``t x1 v1 x2 v2 ke work friction_loss impact_loss residual`` (1-D arrays; ``pe``
+and ``damping_loss`` too when present), ``events`` (structured array with fields
+``t kind v1_before v2_before v1_after v2_after``, or None) and ``scene`` (an
+object with the scene's fields, absent ones None or missing; may itself be
+None).  Both ``impact1d.simulate`` and ``impact1d.read_output`` return such
+objects; one read back without its scene has ``forces_known = False`` (the file
+does not record its force tables), and then no force panel is drawn.
 
 Only the object API of matplotlib is used (``matplotlib.figure.Figure``), so
 this module never touches pyplot's global state or picks a backend:
 ``save`` renders PNGs through Agg on any machine.
 
 Artists carry a ``gid`` so tests and scripts can find them: lines ``x1 x2 v1 v2
-ke work friction_loss impact_loss ke_change residual``, walls ``wall:left``,
+f1 f2 ke pe work friction_loss impact_loss damping_loss ke_change residual``, walls ``wall:left``,
 ``wall:right``, the slot band ``slot_band`` (or ``slot:min``/``slot:max`` when
 only one limit exists), impact markers on the position panel
 ``impact:<contact>``, impact ticks ``tick:<contact>`` and persistent-contact
 bars ``rest:<contact>`` on the impact panel, friction events ``stick1`` etc. on
 the velocity panel.  Axes are labelled (``Axes.get_label()``) ``positions
-velocities kinetic_energy impacts ledger residual``.
+velocities forces kinetic_energy potential_energy impacts ledger residual``.
 """
 
 from __future__ import annotations
 
+import math
 import os
+import warnings
 
 import numpy as np
 from matplotlib.figure import Figure
-from matplotlib.ticker import ScalarFormatter
+from matplotlib import colormaps
+from matplotlib.ticker import MaxNLocator, ScalarFormatter
 
 from ._files import check_input, write_whole
 
-__all__ = ["figure", "save", "PANELS", "CONTACTS"]
+__all__ = ["figure", "save", "sweep", "applied_forces", "PANELS", "CONTACTS"]
 
 #: Panel names, in drawing order; ``save(..., separate=True)`` appends them to the file stem.
-PANELS = ("positions", "velocities", "kinetic_energy", "impacts", "energy")
+#: A run has those of its content: ``forces`` when drawn (see :func:`figure`),
+#: ``potential_energy`` with springs (a ``pe`` column), the others always.
+PANELS = ("positions", "velocities", "forces", "kinetic_energy", "potential_energy", "impacts",
+          "energy")
 
 #: The four unilateral constraints, in the order of the impact panel's rows (top to bottom).
 CONTACTS = ("left", "right", "slot_min", "slot_max")
@@ -64,7 +73,9 @@ _CONTACT_BODIES = {"left": (1,), "right": (2,), "slot_min": (1, 2), "slot_max": 
 _HEIGHT = {  # relative panel heights in the combined figure
     "positions": 3.0,
     "velocities": 2.0,
+    "forces": 1.6,
     "kinetic_energy": 1.8,
+    "potential_energy": 1.6,
     "impacts": 0.45,  # per row of the impact indicator, plus a base below
     "ledger": 2.0,
     "residual": 1.1,
@@ -167,29 +178,171 @@ def _title(result):
     return "impact1d run"
 
 
-def _subtitle(result, events):
+def _subtitle(window, events):
     parts = []
-    method = _scene_value(result, "method")
+    method = _scene_value(window, "method")
     if method:
         parts.append(f"method {method}")
-    dt = _float_or_none(_scene_value(result, "dt"))
+    dt = _float_or_none(_scene_value(window, "dt"))
     if dt is not None:
         parts.append(f"dt = {dt:g} s")
     n_impacts = sum(1 for _, k in events if k in CONTACTS)
-    parts.append(f"{n_impacts} impact{'s' if n_impacts != 1 else ''}")
-    residual = np.asarray(result.residual, dtype=float)
+    where = f" in t = {window.span[0]:g} to {window.span[1]:g} s" if window.span != window.run else ""
+    parts.append(f"{n_impacts} impact{'s' if n_impacts != 1 else ''}{where}")
+    residual = np.asarray(window.result.residual, dtype=float)
     if residual.size:
         parts.append(f"max |energy residual| = {np.max(np.abs(residual)):.1e} J")
     return "  \u00b7  ".join(parts)
 
 
 # ----------------------------------------------------------------------------
+# what the panels draw: a time window of the run, its applied forces
+
+# Every sample column a result may have (impact1d.COLUMNS, without importing the core).
+_SAMPLES = ("t", "x1", "v1", "x2", "v2", "ke", "pe", "work", "friction_loss", "impact_loss",
+            "damping_loss", "residual")
+
+
+class _Window:
+    """The result as the panels see it: its samples from t_from to t_to (with the sample on
+    each side, so that lines reach the window's edges; all of them by default), its events
+    (`events`: all, in time order) and what counts from the run's start (`run`: its first
+    and last times; `energy0`: KE + PE at the first sample, which the ledger counts from)."""
+
+    def __init__(self, result, t_from=None, t_to=None):
+        t = np.asarray(result.t, dtype=float)
+        self.result, self.scene = result, getattr(result, "scene", None)
+        self.run = (float(t[0]), float(t[-1])) if t.size else (0.0, 0.0)
+        self.span = _span(self.run, t_from, t_to)
+        first = max(int(np.searchsorted(t, self.span[0], side="right")) - 1, 0)
+        last = min(int(np.searchsorted(t, self.span[1], side="left")) + 1, t.size)
+        for name in _SAMPLES:
+            column = getattr(result, name, None)
+            setattr(self, name, None if column is None else np.asarray(column, dtype=float)[first:last])
+        self.energy0 = 0.0
+        for name in ("ke", "pe"):
+            column = getattr(result, name, None)
+            if column is not None and len(column):
+                self.energy0 += float(column[0])
+        self.events = _events(result)
+        self.forces = None      # (times, {"f1": ..., "f2": ...}) when the panel is drawn
+
+    def within(self, events):
+        """The (t, kind) pairs inside the window."""
+        lo, hi = self.span
+        return [(t, kind) for t, kind in events if lo <= t <= hi]
+
+
+def _span(run, t_from, t_to):
+    """The window (t_from, t_to) within the run's times; ValueError if it is empty."""
+    lo = run[0] if t_from is None else float(t_from)
+    hi = run[1] if t_to is None else float(t_to)
+    if not (math.isfinite(lo) and math.isfinite(hi)):
+        raise ValueError(f"the time window must be finite, got t_from = {lo:g}, t_to = {hi:g}")
+    if t_from is not None and t_to is not None and lo >= hi:
+        raise ValueError(f"the time window is empty: t_from = {lo:g} s is not below t_to = {hi:g} s")
+    if (t_from is not None or t_to is not None) and (hi <= run[0] or lo >= run[1]):
+        raise ValueError(f"the time window t = {lo:g} to {hi:g} s misses the run "
+                         f"(t = {run[0]:g} to {run[1]:g} s)")
+    return max(lo, run[0]), min(hi, run[1])
+
+
+def _force_terms(result):
+    """Each body's force terms from the result's scene: {"f1": (constant, table or None,
+    (amp, period, phase) or None), ...} (table: its corner times and values), "f2" only with
+    a second body. ValueError saying why when the result does not know its forces."""
+    scene = getattr(result, "scene", None)
+    if scene is None:
+        raise ValueError("the result has no scene to take its forces from")
+    if not getattr(result, "forces_known", True):
+        raise ValueError("the output file does not record its force tables (read it with "
+                         "read_output(path, scene=...), or impact1d-plot --scene SCENE)")
+    bodies = (1, 2) if getattr(result, "x2", None) is not None else (1,)
+    terms = {}
+    for body in bodies:
+        constant = _float_or_none(_scene_value(result, f"f{body}")) or 0.0
+        table = _scene_value(result, f"f{body}_table")
+        if table is not None:
+            table = _force_table(os.fspath(table))
+        amp = _float_or_none(_scene_value(result, f"f{body}_amp"))
+        period = _float_or_none(_scene_value(result, f"f{body}_period"))
+        phase = _float_or_none(_scene_value(result, f"f{body}_phase")) or 0.0
+        sine = (amp, period, phase) if amp and period else None
+        terms[f"f{body}"] = (constant, table, sine)
+    return terms
+
+
+def _force_table(path):
+    """A force table's (times, values): two columns, '#' comments (the core has checked it
+    when it ran the scene)."""
+    try:
+        check_input(path, "force table")
+        data = np.loadtxt(path, comments="#", ndmin=2)
+    except (OSError, ValueError) as error:
+        raise ValueError(f"the force table cannot be read: {error}") from None
+    if data.shape[1] != 2 or data.shape[0] == 0:
+        raise ValueError(f"the force table {path} is not two columns t f")
+    return data[:, 0], data[:, 1]
+
+
+def _force_values(terms, t):
+    """f_i(t) = f_i + table_i(t) + amp sin(2 pi t / period + phase), each term when named
+    (a table held at its end values outside its times, as the core does)."""
+    out = {}
+    for name, (constant, table, sine) in terms.items():
+        f = np.full(t.shape, constant)
+        if table is not None:
+            f = f + np.interp(t, *table)
+        if sine is not None:
+            amp, period, phase = sine
+            f = f + amp * np.sin(2.0 * np.pi * t / period + phase)
+        out[name] = f
+    return out
+
+
+# A sine drawn with at least this many points per period (samples may be coarser), and
+# never more than this many points in all.
+_SINE_POINTS, _MAX_FORCE_POINTS = 48, 200_000
+
+
+def _force_times(terms, window):
+    """Where to draw the forces: the window's samples, its edges, the tables' corners in it
+    (a triangle stays sharp whatever dt_out is), and a fine grid under a sine."""
+    lo, hi = window.span
+    t = window.t[(window.t >= lo) & (window.t <= hi)]
+    parts = [t, np.array([lo, hi])]
+    for _, table, sine in terms.values():
+        if table is not None:
+            parts.append(table[0][(table[0] > lo) & (table[0] < hi)])
+        if sine is not None:
+            count = min(int(_SINE_POINTS * (hi - lo) / abs(sine[1])) + 2, _MAX_FORCE_POINTS)
+            parts.append(np.linspace(lo, hi, count))
+    return np.unique(np.concatenate(parts))
+
+
+def applied_forces(result, t=None) -> dict:
+    """The applied forces of the result's scene, f_i(t) = f_i + table_i(t) + f_i_amp
+    sin(2 pi t / f_i_period + f_i_phase), at the times `t` (default: the result's samples):
+    {"f1": array, "f2": array} ("f2" only with a second body). Springs, dampers, friction
+    and contacts are not applied forces. ValueError saying why when the result does not
+    know its forces: no scene, a file read back without its scene (the header does not
+    record force tables), a force table that cannot be read."""
+    times = np.asarray(result.t if t is None else t, dtype=float)
+    return _force_values(_force_terms(result), times)
+
+
+def _forces_vary(terms) -> bool:
+    """Whether some force changes in time (a table or a sine): a constant one is flat."""
+    return any(table is not None or sine is not None for _, table, sine in terms.values())
+
+
+# ----------------------------------------------------------------------------
 # panels
 
 
-def _finish_time_axis(ax, t):
-    if len(t) > 1 and t[-1] > t[0]:
-        ax.set_xlim(t[0], t[-1])
+def _finish_time_axis(ax, window):
+    if window.span[1] > window.span[0]:
+        ax.set_xlim(*window.span)
     ax.grid(True, alpha=0.3)
 
 
@@ -279,7 +432,7 @@ def _draw_positions(ax, result, events):
 
     ax.set_ylim(*ylim)
     ax.set_ylabel("position (m)")
-    _finish_time_axis(ax, t)
+    _finish_time_axis(ax, result)
     _legend(ax)
 
 
@@ -303,37 +456,54 @@ def _draw_velocities(ax, result, events):
                     markersize=4, color=_BODY_COLOR[body], gid=f"{what}{body}",
                     label=f"body {body} {text}")
     ax.set_ylabel("velocity (m/s)")
-    _finish_time_axis(ax, t)
+    _finish_time_axis(ax, result)
+    _legend(ax)
+
+
+def _draw_energy(ax, result, name, label, color, ylabel):
+    """An energy from zero up: a constant one (case 3's KE) then reads as a flat line, not
+    as rounding noise blown up by autoscaling. KE and PE each have their own axes: one
+    can be a thousand times the other (stick-slip: 5,000 J of spring energy, KE ~ 0.5 J)."""
+    t = np.asarray(result.t, dtype=float)
+    energy = np.asarray(getattr(result, name), dtype=float)
+    ax.plot(t, energy, color=color, linewidth=1.3, gid=name, label=label)
+    top = float(np.max(energy)) if energy.size else 1.0
+    ax.set_ylim(0.0, 1.1 * top if top > 0 else 1.0)
+    ax.set_ylabel(ylabel)
+    _finish_time_axis(ax, result)
     _legend(ax)
 
 
 def _draw_kinetic_energy(ax, result, events):
-    t = np.asarray(result.t, dtype=float)
-    ke = np.asarray(result.ke, dtype=float)
-    ax.plot(t, ke, color="black", linewidth=1.3, gid="ke",
-            label="KE = m1 v1\u00b2/2" + (" + m2 v2\u00b2/2" if result.v2 is not None else ""))
-    top = float(np.max(ke)) if ke.size else 1.0
-    if getattr(result, "pe", None) is not None:
-        pe = np.asarray(result.pe, dtype=float)
-        ax.plot(t, pe, color="tab:purple", linewidth=1.1, gid="pe", label="PE of the springs")
-        top = max(top, float(np.max(pe)) if pe.size else 0.0)
-    # From zero up: a constant energy (case 3) then reads as a flat line, not as
-    # rounding noise blown up by autoscaling.
-    ax.set_ylim(0.0, 1.1 * top if top > 0 else 1.0)
-    ax.set_ylabel("kinetic energy (J)" if getattr(result, "pe", None) is None else "energy (J)")
-    _finish_time_axis(ax, t)
+    label = "KE = m1 v1\u00b2/2" + (" + m2 v2\u00b2/2" if result.v2 is not None else "")
+    _draw_energy(ax, result, "ke", label, "black", "kinetic energy (J)")
+
+
+def _draw_potential_energy(ax, result, events):
+    _draw_energy(ax, result, "pe", "PE of the springs", "tab:purple", "potential energy (J)")
+
+
+def _draw_forces(ax, result, events):
+    times, forces = result.forces
+    ax.axhline(0.0, color="0.5", linewidth=0.8)
+    for body in (1, 2):
+        name = f"f{body}"
+        if name in forces:
+            ax.plot(times, forces[name], color=_BODY_COLOR[body], linewidth=1.3, gid=name,
+                    label=f"{name}(t) on body {body}")
+    ax.set_ylabel("applied force (N)")
+    _finish_time_axis(ax, result)
     _legend(ax)
 
 
 def _draw_impacts(ax, result, events):
-    t = np.asarray(result.t, dtype=float)
-    t_start, t_end = (float(t[0]), float(t[-1])) if t.size else (0.0, 0.0)
-    contacts = _contacts_present(result, events)
+    contacts = _contacts_present(result, result.events)
     n = len(contacts)
     for row, contact in enumerate(contacts):
         y = n - 1 - row  # first contact on top
         color = _CONTACT_COLOR[contact]
-        bars = _rest_intervals(events, contact, t_start, t_end)
+        # A rest that began before the window still shows in it: bars from every event.
+        bars = _rest_intervals(result.events, contact, *result.run)
         if bars:
             ax.broken_barh([(a, b - a) for a, b in bars], (y - 0.3, 0.6), facecolors=color,
                            alpha=0.45, gid=f"rest:{contact}")
@@ -351,7 +521,7 @@ def _draw_impacts(ax, result, events):
     ax.set_yticklabels([_CONTACT_LABEL[c] for c in reversed(contacts)])
     ax.set_ylim(-0.6, n - 0.4 if n else 0.6)
     ax.set_ylabel("impacts")
-    _finish_time_axis(ax, t)
+    _finish_time_axis(ax, result)
     ax.grid(False, axis="y")
     from matplotlib.patches import Patch
     from matplotlib.lines import Line2D
@@ -382,12 +552,12 @@ def _draw_ledger(ax, result, events):
     if getattr(result, "pe", None) is not None:
         energy, what = ke + np.asarray(result.pe, dtype=float), "(KE + PE)"
     if ke.size:
-        ax.plot(t, energy - energy[0], color="black", linewidth=1.0, linestyle="--", gid="ke_change",
+        ax.plot(t, energy - result.energy0, color="black", linewidth=1.0, linestyle="--", gid="ke_change",
                 label=f"{what} \u2212 {what}(0) = W \u2212 {losses}")
     # On the scale of the run's energy: a ledger that stays at rounding level
     # (no forces, no losses: case 3) reads as flat zero lines, not as noise.
     series = [np.asarray(getattr(result, n), dtype=float)
-              for n in names] + [energy - energy[0] if ke.size else ke]
+              for n in names] + [energy - result.energy0 if ke.size else ke]
     values = np.concatenate([s[np.isfinite(s)] for s in series] + [np.zeros(1)])
     scale = max(float(np.max(np.abs(values))), float(np.max(ke)) if ke.size else 0.0)
     lo, hi = float(values.min()), float(values.max())
@@ -395,7 +565,7 @@ def _draw_ledger(ax, result, events):
         mid = 0.5 * (lo + hi)
         ax.set_ylim(mid - 0.1 * scale, mid + 0.1 * scale)
     ax.set_ylabel("energy (J)")
-    _finish_time_axis(ax, t)
+    _finish_time_axis(ax, result)
     _legend(ax)
 
 
@@ -416,14 +586,16 @@ def _draw_residual(ax, result, events):
     ax.yaxis.set_major_formatter(fmt)
     ax.locator_params(axis="y", nbins=3)
     ax.set_ylabel("residual (J)")
-    _finish_time_axis(ax, t)
+    _finish_time_axis(ax, result)
     _legend(ax)
 
 
 _DRAW = {
     "positions": _draw_positions,
     "velocities": _draw_velocities,
+    "forces": _draw_forces,
     "kinetic_energy": _draw_kinetic_energy,
+    "potential_energy": _draw_potential_energy,
     "impacts": _draw_impacts,
     "ledger": _draw_ledger,
     "residual": _draw_residual,
@@ -432,7 +604,9 @@ _DRAW = {
 _PANEL_AXES = {
     "positions": ("positions",),
     "velocities": ("velocities",),
+    "forces": ("forces",),
     "kinetic_energy": ("kinetic_energy",),
+    "potential_energy": ("potential_energy",),
     "impacts": ("impacts",),
     "energy": ("ledger", "residual"),
 }
@@ -447,8 +621,8 @@ def _heights(names, n_contacts):
             for n in names]
 
 
-def _build(result, names, events, factory, label):
-    n_contacts = len(_contacts_present(result, events))
+def _build(window, names, factory, label):
+    n_contacts = len(_contacts_present(window, window.events))
     heights = _heights(names, n_contacts)
     # A lone panel gets some height of its own, so it does not read as a strip.
     height = max(0.9 + 1.25 * sum(heights), 4.5)
@@ -456,66 +630,213 @@ def _build(result, names, events, factory, label):
     fig.set_label(label)
     axes = fig.subplots(len(names), 1, sharex=True, squeeze=False,
                         gridspec_kw={"height_ratios": heights})[:, 0]
+    events = window.within(window.events)
     for ax, name in zip(axes, names):
         ax.set_label(name)
-        _DRAW[name](ax, result, events)
+        _DRAW[name](ax, window, events)
     for ax in axes[:-1]:
         ax.tick_params(labelbottom=False)
     axes[-1].set_xlabel("time t (s)")
-    fig.suptitle(_title(result), fontsize="large", fontweight="bold")
-    axes[0].set_title(_subtitle(result, events), fontsize="small", loc="left", color="0.3")
+    fig.suptitle(_title(window), fontsize="large", fontweight="bold")
+    axes[0].set_title(_subtitle(window, events), fontsize="small", loc="left", color="0.3")
     fig.align_ylabels(axes)
     return fig
 
 
-def figure(result, separate=False, *, figure_factory=None):
+def _panels(window, forces):
+    """The panels this run has, in PANELS order; sets window.forces when they are drawn."""
+    drawn = set(PANELS) - {"forces", "potential_energy"}
+    if window.pe is not None:
+        drawn.add("potential_energy")
+    if forces is not False:
+        try:
+            terms = _force_terms(window.result)
+        except ValueError as error:
+            if forces:
+                warnings.warn(f"no force panel: {error}", stacklevel=3)
+        else:
+            if forces or _forces_vary(terms):
+                times = _force_times(terms, window)
+                window.forces = (times, _force_values(terms, times))
+                drawn.add("forces")
+    return [p for p in PANELS if p in drawn]
+
+
+def figure(result, separate=False, *, forces=None, t_from=None, t_to=None, figure_factory=None):
     """Draw a run.
 
-    Returns one :class:`matplotlib.figure.Figure` with all panels stacked on a
+    Returns one :class:`matplotlib.figure.Figure` with the run's panels stacked on a
     shared time axis, or with ``separate=True`` a list of figures, one per
-    panel of :data:`PANELS` (each figure's ``get_label()`` is the panel name).
+    panel (in :data:`PANELS` order; each figure's ``get_label()`` is the panel name).
+
+    ``forces``: the applied-force panel (:func:`applied_forces`). None (default) draws it
+    when a force changes in time (a table or a sine); True also for constant forces; False
+    never. A result that does not know its forces (a file read back without its scene)
+    gets no panel; with ``forces=True`` a warning says why.
+
+    ``t_from``, ``t_to``: the time window drawn (default the whole run); ValueError when it
+    is empty or misses the run. The ledger still counts from t = 0 and the subtitle counts
+    the impacts in the window.
 
     ``figure_factory`` makes the figures (default ``matplotlib.figure.Figure``;
     pass ``matplotlib.pyplot.figure`` to get figures that ``pyplot.show``
     displays).  It is called with ``figsize=`` and ``layout=``.
     """
     factory = Figure if figure_factory is None else figure_factory
-    events = _events(result)
+    window = _Window(result, t_from, t_to)
+    panels = _panels(window, forces)
     if not separate:
-        names = [n for p in PANELS for n in _PANEL_AXES[p]]
-        return _build(result, names, events, factory, "impact1d")
-    return [_build(result, _PANEL_AXES[p], events, factory, p) for p in PANELS]
+        names = [n for p in panels for n in _PANEL_AXES[p]]
+        return _build(window, names, factory, "impact1d")
+    return [_build(window, _PANEL_AXES[p], factory, p) for p in panels]
 
 
-def save(result, path, separate=False, *, dpi=100, figure_factory=None):
+def save(result, path, separate=False, *, forces=None, t_from=None, t_to=None, dpi=100,
+         figure_factory=None):
     """Write the run's plot as PNG; return the list of paths written.
 
     With ``separate=True`` one file per panel: ``STEM_<panel>.png`` next to ``path``.
-    ``figure_factory`` is passed to :func:`figure`.
+    ``forces``, ``t_from``, ``t_to`` and ``figure_factory`` are passed to :func:`figure`.
     """
+    figs = figure(result, separate=separate, forces=forces, t_from=t_from, t_to=t_to,
+                  figure_factory=figure_factory)
+    paths = _paths(path, figs)
+    for fig, p in zip(figs if separate else [figs], paths):
+        _write(fig, p, dpi)
+    return paths
+
+
+def _paths(path, figs):
+    """Where save() writes `figs` (a Figure, or a list of one per panel) for `path`."""
     path = os.fspath(path)
     stem, ext = os.path.splitext(path)
-    if not ext:
-        ext = ".png"
-        path = stem + ext
-    figs = figure(result, separate=separate, figure_factory=figure_factory)
-    if not separate:
-        figs = [figs]
-        paths = [path]
-    else:
-        paths = [f"{stem}_{fig.get_label()}{ext}" for fig in figs]
-    folder = os.path.dirname(os.path.abspath(path))
-    os.makedirs(folder, exist_ok=True)
-    for fig, p in zip(figs, paths):
-        write_whole(p, lambda temporary: fig.savefig(temporary, dpi=dpi))
-    return paths
+    ext = ext or ".png"
+    if not isinstance(figs, list):
+        return [stem + ext]
+    return [f"{stem}_{fig.get_label()}{ext}" for fig in figs]
+
+
+def _write(fig, path, dpi=100):
+    """Save `fig` to `path` whole (missing folders made; an error names `path`)."""
+    os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
+    write_whole(path, lambda temporary: fig.savefig(temporary, dpi=dpi))
+
+
+# Units of the sweep table's columns (summaries and the scene fields a sweep varies), for
+# the axis labels; a name not here is shown bare (a restitution, a count).
+_UNITS = {
+    "x1_end": "m", "x2_end": "m", "v1_end": "m/s", "v2_end": "m/s", "ke_end": "J",
+    "pe_end": "J", "t_rest": "s", "impact_loss": "J", "friction_loss": "J",
+    "damping_loss": "J", "energy_residual": "J",
+    "m1": "kg", "m2": "kg", "g": "m/s\u00b2", "x_left": "m", "x_right": "m", "d_min": "m",
+    "d_max": "m", "x1": "m", "x2": "m", "v1": "m/s", "v2": "m/s", "f1": "N", "f2": "N",
+    "f1_amp": "N", "f2_amp": "N", "f1_period": "s", "f2_period": "s", "f1_phase": "rad",
+    "f2_phase": "rad", "t_end": "s", "dt": "s", "dt_out": "s", "zero_vel": "m/s",
+    "k1": "N/m", "k2": "N/m", "k12": "N/m", "x1_rest": "m", "x2_rest": "m", "d_rest": "m",
+    "c1": "N s/m", "c2": "N s/m", "c12": "N s/m",
+}
+
+
+def _axis_label(name):
+    unit = _UNITS.get(name)
+    return f"{name} ({unit})" if unit else name
+
+
+def _is_count(name):
+    """Counts (n_impacts, steps, ...): whole numbers, so their axes tick at whole numbers."""
+    return name.startswith("n_") or name == "steps"
+
+
+def _number(value):
+    """A varied field's value for a legend: whole numbers whole (max_rows = 10000000, not
+    1e+07), others as %g, text as it is."""
+    if not isinstance(value, (int, float, np.number)):
+        return str(value)
+    if float(value).is_integer() and abs(value) < 1e15:
+        return str(int(value))
+    return f"{value:g}"
+
+
+def _groups(table, x, y):
+    """The table split by its other varied fields: [(label, rows)], one item (label None)
+    when x (and y) are all that varies. A varied field is a column named as a scene field
+    with more than one value in the table (one value, as make study's t_end, is no group)."""
+    from ._scene import REAL_FIELDS, TEXT_FIELDS
+
+    fields = [name for name in table.columns if name in REAL_FIELDS + TEXT_FIELDS
+              and name not in (x, y) and table[name].nunique(dropna=False) > 1]
+    if not fields:
+        return fields, [(None, table)]
+    groups = table.groupby(fields, sort=True, dropna=False)
+    return fields, [(", ".join(f"{f} = {_number(v)}" for f, v in
+                               zip(fields, key if isinstance(key, tuple) else (key,))), rows)
+                    for key, rows in groups]
+
+
+def _column(rows, name):
+    """A column as float64, missing values (a failed run's, pandas' NA) as NaN: a gap."""
+    return rows[name].to_numpy(dtype=float, na_value=np.nan)
+
+
+def _sweep_lines(fig, table, x, values, fields, groups):
+    """One axes per summary column (quantities of different units and scales never share
+    one), a line per group of the other varied fields, each ordered along x."""
+    axes = fig.subplots(len(values), 1, sharex=True, squeeze=False)[:, 0]
+    cmap = colormaps["viridis"]
+    colors = ([cmap(v) for v in np.linspace(0.0, 0.85, len(groups))] if len(groups) > 1
+              else ["tab:blue"])
+    for ax, name in zip(axes, values):
+        for (label, rows), color in zip(groups, colors):
+            ordered = rows.sort_values(x, kind="stable")
+            ax.plot(ordered[x].to_numpy(), _column(ordered, name), marker=".", color=color,
+                    label=label, gid=f"{name}:{label}" if label else name)
+        ax.set_label(name)
+        ax.set_ylabel(_axis_label(name))
+        if _is_count(name):
+            ax.yaxis.set_major_locator(MaxNLocator(integer=True))
+        ax.grid(True, alpha=0.3)
+    for ax in axes[:-1]:
+        ax.tick_params(labelbottom=False)
+    axes[-1].set_xlabel(_axis_label(x))
+    if fields:
+        axes[0].legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0,
+                       fontsize="small", frameon=False, ncol=1 if len(groups) <= 16 else 2)
+
+
+def _sweep_maps(fig, table, x, y, value, groups):
+    """A heatmap of `value` over x and y per group of the other varied fields, on one
+    colour scale."""
+    grids = [(label, rows.pivot_table(index=y, columns=x, values=value, aggfunc="mean",
+                                      dropna=False)) for label, rows in groups]
+    numbers = np.concatenate([g.to_numpy(float).ravel() for _, g in grids])
+    finite = numbers[np.isfinite(numbers)]
+    low, high = (float(finite.min()), float(finite.max())) if finite.size else (0.0, 1.0)
+    columns = min(len(grids), 3)
+    axes = fig.subplots(-(-len(grids) // columns), columns, squeeze=False).ravel()
+    for ax, (label, grid) in zip(axes, grids):
+        mesh = ax.pcolormesh(grid.columns.to_numpy(float), grid.index.to_numpy(float),
+                             grid.to_numpy(float), shading="nearest", vmin=low, vmax=high)
+        ax.set_label(label or value)
+        ax.set_xlabel(_axis_label(x))
+        ax.set_ylabel(_axis_label(y))
+        if label:
+            ax.set_title(label, fontsize="medium")
+    for ax in axes[len(grids):]:
+        ax.set_visible(False)
+    bar = fig.colorbar(mesh, ax=list(axes[:len(grids)]), label=_axis_label(value))
+    if _is_count(value):
+        bar.locator = MaxNLocator(integer=True)
+        bar.update_ticks()
 
 
 def sweep(table, x, y=None, value=("t_rest",), path=None, *, dpi=100, figure_factory=None):
     """A figure of a sweep's table (impact1d.sweep or impact1d-sweep's CSV): with one varied
-    field `x`, a line per summary column in `value` against it; with two (`x`, `y`), a
-    heatmap of the one column `value`. Failed runs (NaN) are gaps. Saved to `path` when
-    given (written whole); the Figure is returned."""
+    field `x`, each summary column in `value` against it, on axes of its own (labelled with
+    its name and unit); with two (`x`, `y`), a heatmap of the one column `value`. When the
+    table varies other fields too, the lines are a line per value of them (a legend says
+    which), the heatmaps one per value, on one colour scale. Counts tick at whole numbers.
+    Failed runs (NaN) are gaps. Saved to `path` when given (written whole); the Figure is
+    returned."""
     import pandas as pd
 
     if not isinstance(table, pd.DataFrame):
@@ -525,27 +846,22 @@ def sweep(table, x, y=None, value=("t_rest",), path=None, *, dpi=100, figure_fac
     for name in [x, y] + values:
         if name is not None and name not in table.columns:
             raise ValueError(f"no column {name!r} in the table (columns: {', '.join(table.columns)})")
-    fig = (figure_factory or Figure)(figsize=(7, 5))
-    ax = fig.add_subplot(1, 1, 1)
+    if y is not None and len(values) != 1:
+        raise ValueError("a heatmap shows one value column")
+    fields, groups = _groups(table, x, y)
     if y is None:
-        ordered = table.sort_values(x)
-        for name in values:
-            ax.plot(ordered[x], ordered[name], marker=".", label=name)
-        ax.set_xlabel(x)
-        ax.set_ylabel(values[0] if len(values) == 1 else "value")
-        if len(values) > 1:
-            ax.legend()
+        size = (7.0 + (1.8 if fields else 0.0), max(5.0, 1.2 + 2.4 * len(values)))
     else:
-        if len(values) != 1:
-            raise ValueError("a heatmap shows one value column")
-        grid = table.pivot_table(index=y, columns=x, values=values[0], aggfunc="mean", dropna=False)
-        mesh = ax.pcolormesh(grid.columns.to_numpy(float), grid.index.to_numpy(float),
-                             grid.to_numpy(float), shading="nearest")
-        fig.colorbar(mesh, ax=ax, label=values[0])
-        ax.set_xlabel(x)
-        ax.set_ylabel(y)
-    ax.set_title(f"{', '.join(values)} over {x}" + (f" and {y}" if y else ""))
+        columns = min(len(groups), 3)
+        size = (2.0 + 5.0 * columns, 0.8 + 4.2 * -(-len(groups) // columns))
+    fig = (figure_factory or Figure)(figsize=size, layout="constrained")
+    if y is None:
+        _sweep_lines(fig, table, x, values, fields, groups)
+    else:
+        _sweep_maps(fig, table, x, y, values[0], groups)
+    over = f"{x} and {y}" if y else x
+    each = f", {'a line' if y is None else 'a map'} per {', '.join(fields)}" if fields else ""
+    fig.suptitle(f"{', '.join(values)} over {over}{each}")
     if path is not None:
-        os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
-        write_whole(path, lambda temporary: fig.savefig(temporary, dpi=dpi))
+        _write(fig, path, dpi)
     return fig

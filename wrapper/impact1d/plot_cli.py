@@ -1,10 +1,15 @@
-"""``impact1d-plot OUTPUT.dat [-o PNG] [--separate] [--show]``: plot a run written by the CLI.
+"""``impact1d-plot OUTPUT.dat [-o PNG] [--separate] [--show] [--forces | --no-forces]
+[--scene SCENE] [--t-from T] [--t-to T]``: plot a run written by the CLI.
 ``impact1d-plot TABLE.csv --x NAME [--y NAME] [--value COLUMN ...]``: plot a sweep's table
 (impact1d-sweep): lines over one varied field, a heatmap over two.
 
 Reads OUTPUT.dat (and OUTPUT.events.dat next to it, if present: the output's
 extension replaced by .events.dat) and writes OUTPUT.png next to it, or one PNG per panel with ``--separate``
 (OUTPUT_positions.png, ...).  ``--show`` also opens the figures in a window.
+The force panel needs the scene's force tables, which the output's header does not name:
+they come from --scene, else from the scene file the header names (`# scene = ...`, as
+given to impact1d: relative to the folder impact1d ran in) when its force values are the
+header's; else a note on stderr says why there is no force panel.
 Any error (one that writing the report on stdout meets too) gives a one-line message on
 stderr and exit status 1. Only regular files are read (a FIFO or a device is refused).
 """
@@ -22,8 +27,10 @@ def _parser():
     p = argparse.ArgumentParser(
         prog=PROG,
         description="Plot an impact1d output file: positions with walls and slot, "
-        "velocities, kinetic energy, impacts per constraint, energy ledger.",
-        epilog="exit status: 0 done; 1 the output could not be read or the image written; "
+        "velocities, applied forces, kinetic and potential energy, impacts per constraint, "
+        "energy ledger.",
+        epilog="exit status: 0 done; 1 the output could not be read or drawn (a time window "
+        "that misses the run, a --scene it was not run from) or the image written; "
         "2 a bad command line.",
     )
     p.add_argument("output", metavar="OUTPUT.dat", help="output file written by impact1d "
@@ -33,6 +40,12 @@ def _parser():
     p.add_argument("--separate", action="store_true",
                    help="one PNG per panel: PNG stem + _positions, _velocities, ...")
     p.add_argument("--show", action="store_true", help="also open the figures in a window")
+    p.add_argument("--forces", action=argparse.BooleanOptionalAction, default=None,
+                   help="the applied-force panel (default: when a force changes in time)")
+    p.add_argument("--scene", metavar="SCENE", help="the scene OUTPUT was run from, for its "
+                   "force tables (default: the scene file named in OUTPUT's header)")
+    p.add_argument("--t-from", type=float, metavar="T", help="draw from time T (s)")
+    p.add_argument("--t-to", type=float, metavar="T", help="draw up to time T (s)")
     p.add_argument("--x", help="a sweep table's varied field for the x axis")
     p.add_argument("--y", help="a second varied field: a heatmap of --value")
     p.add_argument("--value", action="append", default=None,
@@ -70,7 +83,31 @@ def _fail(message):
     return 1
 
 
+def _note(message):
+    print(f"{PROG}: note: {message}", file=sys.stderr)
+
+
+def _with_forces(result, output, scene):
+    """(the result with its force tables, None), or (the result, why they are unknown). From
+    `scene` when given (its errors raised), else from the scene file the header names."""
+    from impact1d import InputError
+    from impact1d._output import with_forces_of
+
+    if scene is not None:
+        return with_forces_of(result, scene, output), None
+    source = result.scene.source if result.scene is not None else None
+    if not source:
+        return result, f"{output} names neither its force tables nor its scene (give --scene SCENE)"
+    try:
+        return with_forces_of(result, source, output), None
+    except InputError as error:
+        return result, (f"the header of {output} does not name force tables, and its scene "
+                        f"file is of no use ({_one_line(error)}): give --scene SCENE")
+
+
 def _one_line(exc):
+    if isinstance(exc, OSError) and exc.strerror:
+        return exc.strerror         # the caller names the file
     text = " ".join(str(exc).split())
     return text or type(exc).__name__
 
@@ -118,13 +155,29 @@ def main(argv=None):
         import matplotlib.pyplot as plt
 
         factory = plt.figure
-    png = args.png or _default_png(output)
+    forces, why_not = args.forces, None
+    if forces is not False:
+        try:
+            result, why_not = _with_forces(result, output, args.scene)
+        except Exception as exc:  # noqa: BLE001 - --scene unreadable or not this output's
+            return _fail(_one_line(exc))
+        if why_not:
+            forces = False
     try:
-        paths = plot.save(result, png, separate=args.separate, figure_factory=factory)
+        figs = plot.figure(result, separate=args.separate, forces=forces, t_from=args.t_from,
+                           t_to=args.t_to, figure_factory=factory)
     except Exception as exc:  # noqa: BLE001
-        return _fail(f"cannot write {png}: {_one_line(exc)}")
-    if not all(_say(f"wrote {p}") for p in paths):
-        return 1
+        return _fail(f"cannot plot {output}: {_one_line(exc)}")
+    paths = plot._paths(args.png or _default_png(output), figs)
+    for fig, path in zip(figs if args.separate else [figs], paths):
+        try:
+            plot._write(fig, path)
+        except Exception as exc:  # noqa: BLE001
+            return _fail(f"cannot write {path}: {_one_line(exc)}")
+        if not _say(f"wrote {path}"):
+            return 1
+    if why_not:         # after the figure: a failure is then one line, as every error
+        _note(f"no force panel: {why_not}")
     if args.show:
         plt.show()
     return 0
@@ -143,9 +196,16 @@ def _plot_table(args):
     png = args.png or _default_png(args.output)
     try:
         table = (pd.read_parquet if args.output.endswith(".parquet") else pd.read_csv)(args.output)
-        plot.sweep(table, args.x, args.y, args.value or ["t_rest"], png)
     except Exception as exc:  # noqa: BLE001 - one line, whatever went wrong
+        return _fail(f"cannot read {args.output}: {_one_line(exc)}")
+    try:
+        figure = plot.sweep(table, args.x, args.y, args.value or ["t_rest"])
+    except Exception as exc:  # noqa: BLE001
         return _fail(f"cannot plot {args.output}: {_one_line(exc)}")
+    try:
+        plot._write(figure, png)
+    except Exception as exc:  # noqa: BLE001
+        return _fail(f"cannot write {png}: {_one_line(exc)}")
     return 0 if _say(f"wrote {png}") else 1
 
 
