@@ -464,7 +464,8 @@ contains
     do k = 1, n_contacts
       scene%has_contact(k) = has_limit(input, k)
       if (.not. scene%has_contact(k)) cycle
-      scene%offset(k) = offset_sign(k) * limit_value(input, k)
+      ! (A limit of -0 enters as +0: snap puts a body at -offset / normal, which is then +0.)
+      scene%offset(k) = offset_sign(k) * (limit_value(input, k) + 0.0_wp)
       if (input%given(limit_index(k) + 1)) scene%restitution(k) = input%value(limit_index(k) + 1)
     end do
     do k = 1, n_elements
@@ -477,11 +478,14 @@ contains
     scene%springs%has_spring = any(input%given(spring_index))
     scene%springs%has_damper = any(input%given(spring_index + 2))
     scene%springs%present = scene%springs%has_spring .or. scene%springs%has_damper
-    scene%x0 = input%value([i_x1, i_x2])
+    ! Inputs of -0 enter as +0 (the limits too, above): sums over bodies and contacts drop
+    ! absent terms exactly only when nothing they meet is -0, and a root formula takes the
+    ! sign of a zero (docs/architecture.md, "Signed zeros").
+    scene%x0 = input%value([i_x1, i_x2]) + 0.0_wp
     if (scene%n_bodies == 1) scene%x0(2) = 0.0_wp
     scene%v0 = 0.0_wp
-    if (input%given(i_v1)) scene%v0(1) = input%value(i_v1)
-    if (input%given(i_v2)) scene%v0(2) = input%value(i_v2)
+    if (input%given(i_v1)) scene%v0(1) = input%value(i_v1) + 0.0_wp
+    if (input%given(i_v2)) scene%v0(2) = input%value(i_v2) + 0.0_wp
 
     do i = 1, 2
       if (input%given(i_f1 + i - 1)) scene%forcing%constant(i) = input%value(i_f1 + i - 1)
