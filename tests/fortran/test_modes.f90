@@ -4,7 +4,7 @@ program test_modes
   use impact1d_kinds, only: wp
   use impact1d_scene, only: scene_type, i_left, i_slot_min
   use impact1d_modes, only: mode_type, solve_mode
-  use testing, only: check, finish
+  use testing, only: check, finish, two_body
   implicit none
   ! Accelerations here are ratios of small integers: exact to a few ulps.
   real(wp), parameter :: tol = 1.0e-13_wp
@@ -14,10 +14,8 @@ program test_modes
   real(wp) :: a(2), h(4)
   real(wp), parameter :: no_rate(2) = 0.0_wp
 
-  scene%mass = [1.0_wp, 2.0_wp]
-  scene%friction = [10.0_wp, 20.0_wp]      ! mu = 1, g = 10
-  scene%static_friction = scene%friction
-  scene%has_contact = .true.
+  ! Friction bounds 10 and 20 N; walls either side and a slot between the bodies.
+  call two_body('m2 = 2, mu1 = 1, mu2 = 1, g = 10, x_left = -1, x_right = 5, d_min = 0.5, d_max = 2', scene)
 
   ! Test case 1: forces 6 and -10 below the bounds 10 and 20: both stick.
   call solve_mode(scene, [6.0_wp, -10.0_wp], no_rate, [.false., .false., .false., .false.], &
@@ -54,8 +52,7 @@ program test_modes
     'pulled off a wall: the contact releases, a = 40')
 
   ! Frictionless bodies locked by a closed slot_min and pushed together: they move as one.
-  scene%friction = 0.0_wp
-  scene%static_friction = scene%friction
+  call two_body('m2 = 2, x_left = -1, x_right = 5, d_min = 0.5, d_max = 2', scene)
   call solve_mode(scene, [6.0_wp, -3.0_wp], no_rate, [.false., .false., .true., .false.], &
     [.false., .false.], [0.0_wp, 0.0_wp], mode, found)
   a = mode%acceleration([6.0_wp, -3.0_wp])
