@@ -4,7 +4,8 @@
 !> arrays that the compiler keeps in registers, two bodies in one SIMD register. On arrays of
 !> run-time size the steps of the sine and spring bench scenes took 1.5 and 2 times as long
 !> and an event point twice as long (descriptors, calls not inlined, copies through memcpy).
-!> A one-body scene leaves its second lane idle at 0 (docs/architecture.md, "Lanes").
+!> A one-body scene leaves its second lane idle at 0 (docs/architecture.md, "Model, state
+!> and lanes").
 !> Scenes have at most max_lanes bodies until the cluster solver (issue 19, stage 4).
 module impact1d_lanes
   use impact1d_kinds, only: wp
