@@ -4,29 +4,32 @@ module impact1d_contacts
   use impact1d_kinds, only: wp
   use impact1d_scene, only: scene_type, n_contacts, i_slot_min, i_slot_max
   use impact1d_impacts, only: normal_velocity
-  use impact1d_state, only: state_type, add_compensated
+  use impact1d_state, only: lane_state_type, add_compensated
   use impact1d_yardsticks, only: gap_rounding, time_rounding, velocity_rounding
   use impact1d_modes, only: mode_type
   use impact1d_loads, only: state_force
+  use impact1d_lanes, only: max_lanes
   implicit none
   private
-  public :: gap, gap_tolerance, gap_tolerance_along, displacement, snap, rigid_pair, u_tolerance
+  public :: gap, gap_tolerance, gap_tolerance_along, displacement, snap, rigid_pair, u_tolerance, u_tolerances
 
 contains
 
-  !> Gap k of a state, exact to its own size: x2 - x1 is formed without rounding (two-sum),
-  !> and subtracting a limit it is close to is exact, so the slot is resolved like a wall.
-  pure real(wp) function gap(scene, k, state)
+  !> Gap k of a state (in lanes), exact to its own size: x2 - x1 is formed without rounding
+  !> (two-sum), and subtracting a limit it is close to is exact, so the slot is resolved like
+  !> a wall. On the pair's normals (the mode kernel's view): the same arithmetic for one body
+  !> and two, and no branch per end in the location loop.
+  pure real(wp) function gap(scene, k, m)
     type(scene_type), intent(in) :: scene
     integer, intent(in) :: k
-    type(state_type), intent(in) :: state
+    type(lane_state_type), intent(in) :: m
     real(wp) :: a, b, total, rounded
-    a = scene%normal(1, k) * state%x(1)
-    b = scene%normal(2, k) * state%x(2)
+    a = scene%pair%normal(1, k) * m%x(1)
+    b = scene%pair%normal(2, k) * m%x(2)
     total = a + b
     rounded = total - a
-    gap = (total + scene%offset(k)) + (((a - (total - rounded)) + (b - rounded)) + &
-      dot_product(scene%normal(:, k), state%x_lo))
+    gap = (total + scene%row_offset(k)) + (((a - (total - rounded)) + (b - rounded)) + &
+      dot_product(scene%pair%normal(:, k), m%x_lo))
   end function gap
 
   !> Rounding level of gap k. A gap is exact to its own size (compensated positions, exact
@@ -34,13 +37,13 @@ contains
   !> it by count. A gap closing within the clock's
   !> resolution is closed now: this is what makes contacts hit at the same instant one
   !> event, while a tiny flight elsewhere keeps its own time.
-  pure real(wp) function gap_tolerance(scene, k, state, moved)
+  pure real(wp) function gap_tolerance(scene, k, m, moved)
     type(scene_type), intent(in) :: scene
     integer, intent(in) :: k
-    type(state_type), intent(in) :: state
+    type(lane_state_type), intent(in) :: m
     real(wp), intent(in) :: moved
-    gap_tolerance = gap_rounding * (moved + dot_product(abs(scene%normal(:, k)), abs(state%x_lo))) + &
-      time_rounding * max(abs(state%t), scene%dt) * max(0.0_wp, -normal_velocity(scene, k, state%v))
+    gap_tolerance = gap_rounding * (moved + dot_product(abs(scene%pair%normal(:, k)), abs(m%x_lo))) + &
+      time_rounding * max(abs(m%t), scene%dt) * max(0.0_wp, -normal_velocity(scene, k, m%v))
   end function gap_tolerance
 
   !> gap_tolerance along a step from state a with dense output c, as a polynomial in theta:
@@ -52,20 +55,20 @@ contains
   pure function gap_tolerance_along(scene, k, a, c, acc_rounding) result(q)
     type(scene_type), intent(in) :: scene
     integer, intent(in) :: k
-    type(state_type), intent(in) :: a
-    real(wp), intent(in) :: c(3, 2), acc_rounding(2)
+    type(lane_state_type), intent(in) :: a
+    real(wp), intent(in) :: c(3, max_lanes), acc_rounding(max_lanes)
     real(wp) :: q(0:3)
     q(0) = gap_tolerance(scene, k, a, 0.0_wp)
-    q(1:3) = gap_rounding * (abs(scene%normal(1, k)) * abs(c(:, 1)) + abs(scene%normal(2, k)) * abs(c(:, 2)))
-    q(2) = q(2) + 0.5_wp * dot_product(abs(scene%normal(:, k)), acc_rounding)
+    q(1:3) = gap_rounding * (abs(scene%pair%normal(1, k)) * abs(c(:, 1)) + abs(scene%pair%normal(2, k)) * abs(c(:, 2)))
+    q(2) = q(2) + 0.5_wp * dot_product(abs(scene%pair%normal(:, k)), acc_rounding)
   end function gap_tolerance_along
 
   !> How far a step from a to b moved gap k (through either body).
   pure real(wp) function displacement(scene, k, a, b)
     type(scene_type), intent(in) :: scene
     integer, intent(in) :: k
-    type(state_type), intent(in) :: a, b
-    displacement = dot_product(abs(scene%normal(:, k)), abs((b%x - a%x) + (b%x_lo - a%x_lo)))
+    type(lane_state_type), intent(in) :: a, b
+    displacement = dot_product(abs(scene%pair%normal(:, k)), abs((b%x - a%x) + (b%x_lo - a%x_lo)))
   end function displacement
 
   !> Put a closed contact exactly on its constraint (gap = 0, no roundoff penetration).
@@ -73,19 +76,19 @@ contains
     type(scene_type), intent(in) :: scene
     integer, intent(in) :: k
     logical, intent(in) :: closed(n_contacts)
-    type(state_type), intent(inout) :: s
+    type(lane_state_type), intent(inout) :: s
     real(wp) :: limit
     integer :: i
     select case (k)
     case (1, 2)
       ! A wall holds one body: normal . x + offset = 0 for the body it faces.
-      i = merge(1, 2, scene%normal(1, k) /= 0.0_wp)
-      s%x(i) = -scene%offset(k) / scene%normal(i, k)
+      i = merge(1, 2, scene%pair%normal(1, k) /= 0.0_wp)
+      s%x(i) = -scene%row_offset(k) / scene%pair%normal(i, k)
       s%x_lo(i) = 0.0_wp
     case (3, 4)
       ! Move the body that no wall holds.
       ! x2 = x1 + d exactly, the sum's rounding kept in the low part.
-      limit = merge(-scene%offset(3), scene%offset(4), k == 3)
+      limit = merge(-scene%row_offset(3), scene%row_offset(4), k == 3)
       if (closed(2)) then
         s%x(1) = s%x(2)
         s%x_lo(1) = s%x_lo(2)
@@ -110,12 +113,29 @@ contains
   pure real(wp) function u_tolerance(scene, mode, s, k, entry_scale)
     type(scene_type), intent(in) :: scene
     type(mode_type), intent(in) :: mode
-    type(state_type), intent(in) :: s
+    type(lane_state_type), intent(in) :: s
     integer, intent(in) :: k
-    real(wp), intent(in) :: entry_scale(2)
-    real(wp) :: acc(2)
-    acc = mode%acceleration(state_force(scene, s))
-    u_tolerance = velocity_rounding * dot_product(abs(scene%normal(:, k)), &
+    real(wp), intent(in) :: entry_scale(max_lanes)
+    real(wp) :: f(max_lanes), acc(max_lanes)
+    call state_force(scene, s, f)
+    call mode%acceleration(f, acc)
+    u_tolerance = velocity_rounding * dot_product(abs(scene%pair%normal(:, k)), &
       max(abs(s%v) + abs(acc) * scene%dt, entry_scale))
   end function u_tolerance
+
+  !> u_tolerance of every contact (the accelerations worked out once).
+  pure function u_tolerances(scene, mode, s, entry_scale) result(tol)
+    type(scene_type), intent(in) :: scene
+    type(mode_type), intent(in) :: mode
+    type(lane_state_type), intent(in) :: s
+    real(wp), intent(in) :: entry_scale(max_lanes)
+    real(wp) :: tol(n_contacts), f(max_lanes), acc(max_lanes), speed(max_lanes)
+    integer :: k
+    call state_force(scene, s, f)
+    call mode%acceleration(f, acc)
+    speed = max(abs(s%v) + abs(acc) * scene%dt, entry_scale)
+    do k = 1, n_contacts
+      tol(k) = velocity_rounding * dot_product(abs(scene%pair%normal(:, k)), speed)
+    end do
+  end function u_tolerances
 end module impact1d_contacts

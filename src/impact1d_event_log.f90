@@ -4,30 +4,34 @@
 !> opened), and the velocity scale of the instant's impulses.
 module impact1d_event_log
   use impact1d_kinds, only: wp
+  use impact1d_lanes, only: max_lanes
   use impact1d_scene, only: scene_type, n_contacts
   use impact1d_output, only: sink_type, run_stats, event_rest, event_release
   use impact1d_yardsticks, only: same_instant
   implicit none
   private
-  public :: event_log_type, log_event
+  public :: event_log_type, log_event, reported_pair
 
-  !> The log's bookkeeping between event points.
+  !> The log's bookkeeping between event points; the per-body arrays (N) allocated by
+  !> allocate_bodies.
   type :: event_log_type
     logical :: in_contact(n_contacts) = .false.    !< contact k has been logged resting
-    logical :: at_rest(2) = .false.                !< body i has been logged at rest (stick)
+    logical, allocatable :: at_rest(:)             !< (N) body i has been logged at rest (stick)
     !> A rest after an accumulation of impacts, logged when its time comes.
     real(wp) :: pending_rest(n_contacts) = huge(1.0_wp)
-    !> A release waiting for time to move on (see begin_rest), with its velocities.
+    !> A release waiting for time to move on (see begin_rest), with the velocities it reports
+    !> (reported_pair).
     real(wp) :: release_time(n_contacts) = huge(1.0_wp)
     real(wp) :: release_v(2, n_contacts) = 0.0_wp
-    !> When impulses last moved each body off its rest (see the stick log at the event point).
-    real(wp) :: rest_lost_time(2) = -huge(1.0_wp)
-    !> The last event point's instant and the velocity scale its impulses came from: a
+    !> (N) When impulses last moved each body off its rest (see the stick log at the event point).
+    real(wp), allocatable :: rest_lost_time(:)
+    !> The last event point's instant and the velocity scale its impulses came from (lanes): a
     !> further event point at the same instant keeps that scale (impulses redistribute
     !> velocity but cannot create precision, however many event points they take).
     real(wp) :: scale_time = -huge(1.0_wp)
-    real(wp) :: scale(2) = 0.0_wp
+    real(wp) :: scale(max_lanes) = 0.0_wp
   contains
+    procedure :: allocate_bodies
     procedure :: flush_pending_rest
     procedure :: flush_releases
     procedure :: begin_rest
@@ -35,21 +39,40 @@ module impact1d_event_log
 
 contains
 
-  !> An event of `kind` at t, counted and sent to the sink.
+  !> Nothing logged yet, for n bodies.
+  pure subroutine allocate_bodies(self, n)
+    class(event_log_type), intent(inout) :: self
+    integer, intent(in) :: n
+    allocate(self%at_rest(n), self%rest_lost_time(n))
+    self%at_rest = .false.
+    self%rest_lost_time = -huge(1.0_wp)
+  end subroutine allocate_bodies
+
+  !> The velocities an event reports, of bodies 1 and 2 (v2 = 0 with one body, a
+  !> column the sinks leave out).
+  pure function reported_pair(v) result(pair)
+    real(wp), intent(in) :: v(:)
+    real(wp) :: pair(2)
+    pair = 0.0_wp
+    pair(:size(v)) = v
+  end function reported_pair
+
+  !> An event of `kind` at t (velocities of the N bodies before and after), counted and sent
+  !> to the sink.
   subroutine log_event(sink, stats, t, kind, v_before, v_after)
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
     real(wp), intent(in) :: t
     integer, intent(in) :: kind
-    real(wp), intent(in) :: v_before(2), v_after(2)
+    real(wp), intent(in) :: v_before(:), v_after(:)
     stats%events(kind) = stats%events(kind) + 1
-    call sink%put_event(t, kind, v_before, v_after)
+    call sink%put_event(t, kind, reported_pair(v_before), reported_pair(v_after))
   end subroutine log_event
 
   !> Rest after an accumulation of impacts is logged at the accumulation time (t, velocities v).
   subroutine flush_pending_rest(self, t, v, sink, stats)
     class(event_log_type), intent(inout) :: self
-    real(wp), intent(in) :: t, v(2)
+    real(wp), intent(in) :: t, v(:)
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
     integer :: k
@@ -86,7 +109,7 @@ contains
     class(event_log_type), intent(inout) :: self
     type(scene_type), intent(in) :: scene
     integer, intent(in) :: k
-    real(wp), intent(in) :: t, when, v(2)
+    real(wp), intent(in) :: t, when, v(:)
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
     if (self%in_contact(k)) return

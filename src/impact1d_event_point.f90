@@ -2,18 +2,21 @@
 !> impacts resolved (one joint inelastic impact, then sequential impulses), bounce series
 !> whose rest is below the clock's resolution put to rest (Zeno), stopped bodies zeroed,
 !> the new mode from the complementarity problem, and the log of what changed.
+!> On the state in lanes (impact1d_lanes) and the pair's masses, friction bounds and normals
+!> (scene%pair, the mode kernel's view): one body is the pair with an idle second lane.
 module impact1d_event_point
   use impact1d_kinds, only: wp, eps_wp
   use impact1d_error, only: error_type, raise, status_simulation, fmt
+  use impact1d_lanes, only: max_lanes
   use impact1d_scene, only: scene_type, n_contacts, i_slot_min, i_slot_max
   use impact1d_modes, only: mode_type, solve_mode
   use impact1d_impacts, only: normal_velocity, impulse, most_approaching, restitution_of, &
     kinetic_energy, joint_inelastic, inelastic_projection
   use impact1d_output, only: sink_type, run_stats, event_impact, event_rest, event_stick, event_slip
-  use impact1d_state, only: state_type, add_compensated
+  use impact1d_state, only: state_type, lane_state_type, load_lanes, store_lanes, add_compensated
   use impact1d_yardsticks, only: gap_rounding, velocity_rounding, time_rounding, energy_rounding, force_scale, &
     same_instant
-  use impact1d_contacts, only: gap, gap_tolerance, snap, rigid_pair, u_tolerance
+  use impact1d_contacts, only: gap, gap_tolerance, snap, rigid_pair, u_tolerance, u_tolerances
   use impact1d_stepping, only: rk4_type
   use impact1d_location, only: watch_type
   use impact1d_loads, only: state_force, applied_rate
@@ -28,11 +31,11 @@ contains
   !> The event point at s%t. which: what the location found (contact k, 100 + body i, -1 a
   !> mode condition) or 0; initial: the start of the run (no mode yet). Leaves the new mode,
   !> what it needs watched and the integrator's constant acceleration set.
-  subroutine event_point(scene, initial, which, s, mode, event_log, watch, rk, sink, stats, error)
+  subroutine event_point(scene, initial, which, state, mode, event_log, watch, rk, sink, stats, error)
     type(scene_type), intent(in) :: scene
     logical, intent(in) :: initial
     integer, intent(in) :: which
-    type(state_type), intent(inout) :: s
+    type(state_type), intent(inout) :: state
     type(mode_type), intent(inout) :: mode
     type(event_log_type), intent(inout) :: event_log
     type(watch_type), intent(inout) :: watch
@@ -40,28 +43,47 @@ contains
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
     type(error_type), allocatable, intent(inout) :: error
-    logical :: closed(n_contacts), candidate(n_contacts), resting(2), found
+    type(lane_state_type) :: s
+    call load_lanes(state, s)
+    call pair_event_point(scene, initial, which, s, mode, event_log, watch, rk, sink, stats, error)
+    call store_lanes(s, state)
+  end subroutine event_point
+
+  !> event_point on the state in lanes.
+  subroutine pair_event_point(scene, initial, which, s, mode, event_log, watch, rk, sink, stats, error)
+    type(scene_type), intent(in) :: scene
+    logical, intent(in) :: initial
+    integer, intent(in) :: which
+    type(lane_state_type), intent(inout) :: s
+    type(mode_type), intent(inout) :: mode
+    type(event_log_type), intent(inout) :: event_log
+    type(watch_type), intent(inout) :: watch
+    type(rk4_type), intent(inout) :: rk
+    class(sink_type), intent(inout) :: sink
+    type(run_stats), intent(inout) :: stats
+    type(error_type), allocatable, intent(inout) :: error
+    logical :: closed(n_contacts), candidate(n_contacts), resting(max_lanes), found
     logical :: pushed(n_contacts)
-    real(wp) :: f(2), df(2), v_before(2), v_after(2), moving_sign(2), acc(2)
+    real(wp), dimension(max_lanes) :: f, df, v_before, v_after, moving_sign, acc
     ! Velocity scale of each body entering this event point: impulses redistribute
     ! velocity but cannot create precision, so what is below its rounding is zero.
-    real(wp) :: entry_scale(2)
+    real(wp) :: entry_scale(max_lanes)
     integer :: k, i, n_impulses
     type(mode_type) :: new_mode
 
-    f = state_force(scene, s)
-    df = applied_rate(scene, s%t, s%v)
+    call state_force(scene, s, f)
+    call applied_rate(scene, s%t, s%v, df)
     do k = 1, n_contacts
-      closed(k) = scene%has_contact(k)
+      closed(k) = scene%row_present(k)
       if (closed(k)) closed(k) = k == which .or. gap(scene, k, s) <= gap_tolerance(scene, k, s, 0.0_wp)
       ! The user's numbers carry their decimal rounding (7.553 - 7.122 is not 0.431): at the
       ! start, a gap within it is contact, as the validator accepted it.
-      if (initial .and. scene%has_contact(k)) closed(k) = closed(k) .or. gap(scene, k, s) <= &
-        gap_rounding * max(maxval(abs(scene%normal(:, k) * s%x)), abs(scene%offset(k)))
+      if (initial .and. scene%row_present(k)) closed(k) = closed(k) .or. gap(scene, k, s) <= &
+        gap_rounding * max(maxval(abs(scene%pair%normal(:, k) * s%x)), abs(scene%row_offset(k)))
     end do
     ! A rigid link (d_min = d_max) is one constraint seen from both sides.
-    if (scene%has_contact(i_slot_min) .and. scene%has_contact(i_slot_max)) then
-      if (scene%offset(i_slot_min) == -scene%offset(i_slot_max)) then
+    if (scene%row_present(i_slot_min) .and. scene%row_present(i_slot_max)) then
+      if (scene%row_offset(i_slot_min) == -scene%row_offset(i_slot_max)) then
         closed(i_slot_min) = closed(i_slot_min) .or. closed(i_slot_max)
         closed(i_slot_max) = closed(i_slot_min)
       end if
@@ -71,12 +93,12 @@ contains
     end do
     ! A sliding body whose stop was located, or that stopped within rounding (its velocity
     ! change over a step is the scale), is at rest.
-    acc = mode%acceleration(f)
-    if (initial) acc = f / scene%mass     ! no mode yet: the free accelerations set the scale
+    call mode%acceleration(f, acc)
+    if (initial) acc = f / scene%pair%mass     ! no mode yet: the free accelerations set the scale
     entry_scale = abs(s%v) + abs(acc) * scene%dt
     if (same_instant(scene, s%t, event_log%scale_time)) entry_scale = max(entry_scale, event_log%scale)
     do i = 1, 2
-      if (scene%static_friction(i) == 0.0_wp) cycle
+      if (scene%pair%static_friction(i) == 0.0_wp) cycle
       if (i == which - 100 .or. abs(s%v(i)) <= velocity_rounding * abs(acc(i)) * scene%dt) &
         call zero_velocity(scene, s, i)
     end do
@@ -85,8 +107,7 @@ contains
     ! impulses would only approach it geometrically (a body pinned by a heavier one).
     if (joint_inelastic(scene, closed)) then
       v_before = s%v
-      call inelastic_projection(scene, closed, s%v, u_tolerances(scene, mode, s, entry_scale), &
-        v_after, pushed)
+      call inelastic_projection(scene, closed, s%v, u_tolerances(scene, mode, s, entry_scale), v_after, pushed)
       if (any(pushed)) then
         call check_dissipative(scene, s%t, v_before, v_after, error)
         if (allocated(error)) return
@@ -110,11 +131,11 @@ contains
         return
       end if
       v_before = s%v
-      v_after = impulse(scene, k, restitution_of(scene, k, closed), s%v, rigid_pair(closed))
+      call impulse(scene, k, restitution_of(scene, k, closed), s%v, v_after, rigid_pair(closed))
       call check_dissipative(scene, s%t, v_before, v_after, error)
       if (allocated(error)) return
       call apply(scene, s, v_after)
-      if (all(scene%normal(:, k) /= 0.0_wp)) entry_scale = maxval(entry_scale)
+      if (all(scene%pair%normal(:, k) /= 0.0_wp)) entry_scale = maxval(entry_scale)
       call log_event(sink, stats, s%t, event_impact + k, v_before, v_after)
     end do
 
@@ -133,8 +154,10 @@ contains
     do k = 1, n_contacts
       if (.not. closed(k)) cycle
       if (abs(normal_velocity(scene, k, s%v)) <= u_tolerance(scene, mode, s, k, entry_scale) .and. &
-          normal_velocity(scene, k, s%v) /= 0.0_wp) &
-        call apply(scene, s, impulse(scene, k, 0.0_wp, s%v, rigid_pair(closed)))
+          normal_velocity(scene, k, s%v) /= 0.0_wp) then
+        call impulse(scene, k, 0.0_wp, s%v, v_after, rigid_pair(closed))
+        call apply(scene, s, v_after)
+      end if
     end do
 
     ! Zeno: a bounce series whose remaining time is below the clock's resolution ends in
@@ -149,7 +172,7 @@ contains
     ! A body still against the other one (a closed slot limit) that has stopped has stopped
     ! too: its velocity is the contact's rounding-level normal velocity.
     do k = 1, n_contacts
-      if (.not. closed(k) .or. any(scene%normal(:, k) == 0.0_wp)) cycle
+      if (.not. closed(k) .or. any(scene%pair%normal(:, k) == 0.0_wp)) cycle
       if (abs(normal_velocity(scene, k, s%v)) > u_tolerance(scene, mode, s, k, entry_scale)) cycle
       do i = 1, 2
         if (s%v(i) == 0.0_wp) call zero_velocity(scene, s, 3 - i)
@@ -158,11 +181,11 @@ contains
 
     ! Dampers pull with the velocities the impacts left.
     if (scene%springs%has_damper) then
-      f = state_force(scene, s)
-      df = applied_rate(scene, s%t, s%v)
+      call state_force(scene, s, f)
+      call applied_rate(scene, s%t, s%v, df)
     end if
     call candidates(scene, mode, s, entry_scale, closed, candidate, resting, moving_sign)
-    call solve_mode(scene, f, df, candidate, resting, moving_sign, new_mode, found, force_scale(scene, f, df))
+    call solve_mode(scene%pair, f, df, candidate, resting, moving_sign, new_mode, found, force_scale(scene, f, df))
     if (.not. found) then
       call raise(error, status_simulation, 'at t = ' // trim(fmt(s%t)) // &
         ': no consistent contact and friction state (complementarity problem has no solution)')
@@ -171,41 +194,41 @@ contains
 
     call log_mode_change(scene, initial, f, df, candidate, new_mode, s, event_log, sink, stats)
     mode = new_mode
-    watch%quiet_until = -huge(1.0_wp)
+    call watch%forget_quiet_times()
     if (rk%constant_forcing) then
-      rk%constant_acceleration = mode%acceleration(scene%forcing%constant)
+      call mode%acceleration(scene%forcing%constant_lanes, rk%constant_acceleration)
       call watch%find_quiet_times(scene, mode, s, rk%constant_acceleration)
     end if
-    watch%watching = mode%n_hold > 0 .or. any(scene%has_contact .and. .not. mode%active) .or. &
-      any(scene%static_friction > 0.0_wp .and. mode%sgn /= 0.0_wp)
-  end subroutine event_point
+    watch%watching = mode%n_hold > 0 .or. any(scene%row_present .and. .not. mode%active) .or. &
+      any(scene%pair%static_friction > 0.0_wp .and. mode%sgn /= 0.0_wp)
+  end subroutine pair_event_point
 
   !> Log what a user can see change between the old mode and new_mode: contacts that start
   !> or stop holding, bodies that come to rest or break away.
   subroutine log_mode_change(scene, initial, f, df, candidate, new_mode, s, event_log, sink, stats)
     type(scene_type), intent(in) :: scene
     logical, intent(in) :: initial, candidate(n_contacts)
-    real(wp), intent(in) :: f(2), df(2)
+    real(wp), intent(in) :: f(max_lanes), df(max_lanes)
     type(mode_type), intent(in) :: new_mode
-    type(state_type), intent(in) :: s
+    type(lane_state_type), intent(in) :: s
     type(event_log_type), intent(inout) :: event_log
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
-    real(wp) :: acc(2), tol_a(2), acc_rate(2)
+    real(wp), dimension(max_lanes) :: acc, tol_a, acc_rate
     logical :: leaving, resting_now
     integer :: k, i
 
-    acc = new_mode%acceleration(f)
-    tol_a = 1.0e3_wp * eps_wp * force_scale(scene, f, df) / scene%mass
+    call new_mode%acceleration(f, acc)
+    tol_a = 1.0e3_wp * eps_wp * force_scale(scene, f, df) / scene%pair%mass
     do k = 1, n_contacts
       if (new_mode%active(k) .and. .not. event_log%in_contact(k)) then
         call event_log%begin_rest(scene, k, s%t, s%t, s%v, sink, stats)
       else if (event_log%in_contact(k) .and. .not. new_mode%active(k)) then
         if (.not. candidate(k) .or. &
-            dot_product(scene%normal(:, k), acc) > dot_product(abs(scene%normal(:, k)), tol_a) .or. &
-            (dot_product(scene%normal(:, k), acc) >= -dot_product(abs(scene%normal(:, k)), tol_a) .and. &
-            dot_product(scene%normal(:, k), matmul(new_mode%gain, df)) > 1.0e3_wp * eps_wp * sum(abs(df)) / &
-            minval(scene%mass))) then
+            dot_product(scene%pair%normal(:, k), acc) > dot_product(abs(scene%pair%normal(:, k)), tol_a) .or. &
+            (dot_product(scene%pair%normal(:, k), acc) >= -dot_product(abs(scene%pair%normal(:, k)), tol_a) &
+            .and. dot_product(scene%pair%normal(:, k), matmul(new_mode%gain, df)) > &
+            1.0e3_wp * eps_wp * sum(abs(df)) / minval(scene%pair%mass))) then
           if (event_log%pending_rest(k) < huge(1.0_wp)) then
             call log_event(sink, stats, s%t, event_rest + k, s%v, s%v)
             event_log%pending_rest(k) = huge(1.0_wp)
@@ -221,10 +244,10 @@ contains
     ! A body at rest leaves it when its acceleration, or at a break-away instant (force
     ! exactly at the bound) the acceleration's rate, points along its sliding direction.
     acc_rate = matmul(new_mode%gain, df)
-    do i = 1, 2
-      if (scene%static_friction(i) == 0.0_wp) cycle
+    do i = 1, scene%n_bodies
+      if (scene%pair%static_friction(i) == 0.0_wp) cycle
       leaving = new_mode%sgn(i) * acc(i) > tol_a(i) .or. (new_mode%sgn(i) * acc(i) >= -tol_a(i) .and. &
-        new_mode%sgn(i) * acc_rate(i) > 1.0e3_wp * eps_wp * sum(abs(df)) / scene%mass(i))
+        new_mode%sgn(i) * acc_rate(i) > 1.0e3_wp * eps_wp * sum(abs(df)) / scene%pair%mass(i))
       resting_now = s%v(i) == 0.0_wp .and. .not. leaving
       ! A body that impulses moved off its rest and that stops again at that same instant
       ! (a chain of impacts ending there) never left rest: no stick (its leaving was not
@@ -252,24 +275,25 @@ contains
     type(scene_type), intent(in) :: scene
     type(mode_type), intent(in) :: mode
     integer, intent(in) :: k
-    real(wp), intent(in) :: f(2), df(2), entry_scale(2)
+    real(wp), dimension(max_lanes), intent(in) :: f, df, entry_scale
     logical, intent(in) :: closed(n_contacts)
-    type(state_type), intent(inout) :: s
+    type(lane_state_type), intent(inout) :: s
     type(event_log_type), intent(inout) :: event_log
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
-    real(wp) :: u, a_up, a_down, remaining
+    real(wp) :: u, a_up, a_down, remaining, v_bounce(max_lanes)
     u = normal_velocity(scene, k, s%v)
     if (u <= u_tolerance(scene, mode, s, k, entry_scale)) return
     a_up = free_gap_acceleration(scene, mode, k, s, s%v, f, df, closed, entry_scale)
     if (a_up >= 0.0_wp) return
-    a_down = free_gap_acceleration(scene, mode, k, s, impulse(scene, k, 1.0_wp, s%v, rigid_pair(closed)), &
-      f, df, closed, entry_scale)
+    call impulse(scene, k, 1.0_wp, s%v, v_bounce, rigid_pair(closed))
+    a_down = free_gap_acceleration(scene, mode, k, s, v_bounce, f, df, closed, entry_scale)
     remaining = bounce_series_time(u, a_up, a_down, restitution_of(scene, k, closed))
     ! Gaps are exact to their own size, so the series is followed until what remains of it
     ! is below the clock's resolution.
     if (remaining > time_rounding * max(abs(s%t), scene%dt)) return
-    call apply(scene, s, impulse(scene, k, 0.0_wp, s%v, rigid_pair(closed)))
+    call impulse(scene, k, 0.0_wp, s%v, v_bounce, rigid_pair(closed))
+    call apply(scene, s, v_bounce)
     if (remaining < huge(1.0_wp)) then
       call event_log%begin_rest(scene, k, s%t, s%t + remaining, s%v, sink, stats)
     else
@@ -299,28 +323,30 @@ contains
     type(scene_type), intent(in) :: scene
     type(mode_type), intent(in) :: mode
     integer, intent(in) :: k
-    type(state_type), intent(in) :: s
-    real(wp), intent(in) :: v(2), f(2), df(2), entry_scale(2)
+    type(lane_state_type), intent(in) :: s
+    real(wp), dimension(max_lanes), intent(in) :: v, f, df, entry_scale
     logical, intent(in) :: closed(n_contacts)
     type(mode_type) :: free_mode
-    type(state_type) :: probe
-    logical :: candidate(n_contacts), resting(2), found
-    real(wp) :: moving_sign(2)
+    type(lane_state_type) :: probe
+    logical :: candidate(n_contacts), resting(max_lanes), found
+    real(wp) :: moving_sign(max_lanes), acc(max_lanes)
     probe = s
     probe%v = v
     call candidates(scene, mode, probe, entry_scale, closed, candidate, resting, moving_sign)
     candidate(k) = .false.
-    call solve_mode(scene, f, df, candidate, resting, moving_sign, free_mode, found, force_scale(scene, f, df))
+    call solve_mode(scene%pair, f, df, candidate, resting, moving_sign, free_mode, found, force_scale(scene, f, df))
     a_gap = 0.0_wp
-    if (found) a_gap = dot_product(scene%normal(:, k), free_mode%acceleration(f))
+    if (.not. found) return
+    call free_mode%acceleration(f, acc)
+    a_gap = dot_product(scene%pair%normal(:, k), acc)
   end function free_gap_acceleration
 
   !> Bodies whose velocity is below the rounding of what a step changes it by, or of the
   !> velocities this event point started from, are at rest.
   pure subroutine zero_stopped(scene, s, acc, entry_scale)
     type(scene_type), intent(in) :: scene
-    type(state_type), intent(inout) :: s
-    real(wp), intent(in) :: acc(2), entry_scale(2)
+    type(lane_state_type), intent(inout) :: s
+    real(wp), intent(in) :: acc(max_lanes), entry_scale(max_lanes)
     integer :: i
     do i = 1, 2
       if (s%v(i) /= 0.0_wp .and. abs(s%v(i)) <= velocity_rounding * max(abs(acc(i)) * scene%dt, &
@@ -332,12 +358,12 @@ contains
   !> where friction stopped it (a run with no impact reports no impact loss), else to impacts.
   pure subroutine zero_velocity(scene, s, i)
     type(scene_type), intent(in) :: scene
-    type(state_type), intent(inout) :: s
+    type(lane_state_type), intent(inout) :: s
     integer, intent(in) :: i
-    if (scene%static_friction(i) > 0.0_wp) then
-      call add_compensated(s%friction_loss, s%friction_lo, 0.5_wp * scene%mass(i) * s%v(i)**2)
+    if (scene%pair%static_friction(i) > 0.0_wp) then
+      call add_compensated(s%friction_loss, s%friction_lo, 0.5_wp * scene%pair%mass(i) * s%v(i)**2)
     else
-      s%impact_loss = s%impact_loss + 0.5_wp * scene%mass(i) * s%v(i)**2
+      s%impact_loss = s%impact_loss + 0.5_wp * scene%pair%mass(i) * s%v(i)**2
     end if
     s%v(i) = 0.0_wp
     s%v_lo(i) = 0.0_wp
@@ -348,7 +374,7 @@ contains
   !> return numbers booked as a negative impact loss.
   subroutine check_dissipative(scene, t, v_before, v_after, error)
     type(scene_type), intent(in) :: scene
-    real(wp), intent(in) :: t, v_before(2), v_after(2)
+    real(wp), intent(in) :: t, v_before(max_lanes), v_after(max_lanes)
     type(error_type), allocatable, intent(inout) :: error
     real(wp) :: ke_before, ke_after
     ke_before = kinetic_energy(scene, v_before)
@@ -363,8 +389,8 @@ contains
   !> Set new velocities at an instant, booking the kinetic energy they remove as impact loss.
   pure subroutine apply(scene, s, v_new)
     type(scene_type), intent(in) :: scene
-    type(state_type), intent(inout) :: s
-    real(wp), intent(in) :: v_new(2)
+    type(lane_state_type), intent(inout) :: s
+    real(wp), intent(in) :: v_new(max_lanes)
     s%impact_loss = s%impact_loss + kinetic_energy(scene, s%v) - kinetic_energy(scene, v_new)
     s%v = v_new
     s%v_lo = 0.0_wp
@@ -374,28 +400,19 @@ contains
   pure subroutine candidates(scene, mode, s, entry_scale, closed, candidate, resting, moving_sign)
     type(scene_type), intent(in) :: scene
     type(mode_type), intent(in) :: mode
-    type(state_type), intent(in) :: s
-    real(wp), intent(in) :: entry_scale(2)
+    type(lane_state_type), intent(in) :: s
+    real(wp), intent(in) :: entry_scale(max_lanes)
     logical, intent(in) :: closed(n_contacts)
-    logical, intent(out) :: candidate(n_contacts), resting(2)
-    real(wp), intent(out) :: moving_sign(2)
+    logical, intent(out) :: candidate(n_contacts), resting(max_lanes)
+    real(wp), intent(out) :: moving_sign(max_lanes)
     integer :: k
     do k = 1, n_contacts
       candidate(k) = closed(k)
       if (candidate(k)) candidate(k) = abs(normal_velocity(scene, k, s%v)) <= u_tolerance(scene, mode, s, k, entry_scale)
     end do
-    resting = scene%static_friction > 0.0_wp .and. s%v == 0.0_wp
+    resting = scene%pair%static_friction > 0.0_wp .and. s%v == 0.0_wp
     moving_sign = 0.0_wp
-    where (scene%static_friction > 0.0_wp .and. s%v /= 0.0_wp) moving_sign = sign(1.0_wp, s%v)
+    where (scene%pair%static_friction > 0.0_wp .and. s%v /= 0.0_wp) moving_sign = sign(1.0_wp, s%v)
   end subroutine candidates
 
-  pure function u_tolerances(scene, mode, s, entry_scale) result(tol)
-    type(scene_type), intent(in) :: scene
-    type(mode_type), intent(in) :: mode
-    type(state_type), intent(in) :: s
-    real(wp), intent(in) :: entry_scale(2)
-    real(wp) :: tol(n_contacts)
-    integer :: k
-    tol = [(u_tolerance(scene, mode, s, k, entry_scale), k = 1, n_contacts)]
-  end function u_tolerances
 end module impact1d_event_point

@@ -33,12 +33,16 @@ contains
   !> from counting, while the reported time is the true zero, not the -tol crossing; it is a
   !> polynomial in theta (coefficients >= 0) because rounding grows with what the step has
   !> moved by then: a crossing early in a long step is judged by the rounding there.
-  pure real(wp) function earliest_crossing(p, h, tol) result(theta)
-    real(wp), intent(in) :: p(0:3), h, tol(0:3)
-    real(wp) :: nodes(5), crit(2)
+  pure real(wp) function earliest_crossing(p_given, h, tol) result(theta)
+    real(wp), intent(in) :: p_given(0:3), h, tol(0:3)
+    real(wp) :: p(0:3), nodes(5), crit(2)
     integer :: n_nodes, n_crit, j
     real(wp) :: a, b
 
+    ! A -0 coefficient becomes +0: the stable root formula takes its sign (sign(.., qb) in
+    ! stationary_points), so the roots found must not depend on which zero a sum of terms
+    ! of absent bodies or contacts happened to give.
+    p = p_given + 0.0_wp
     theta = 2.0_wp * h + 1.0_wp
     ! Cheap rejection, the common case: p cannot reach zero on [0, h].
     if (p(0) - h * (abs(p(1)) + h * (abs(p(2)) + h * abs(p(3)))) > 0.0_wp) return

@@ -2,6 +2,7 @@
 !> only when the scene names it, so an absent term costs nothing in the stepping loop.
 module impact1d_forcing
   use impact1d_kinds, only: wp
+  use impact1d_lanes, only: max_lanes, to_lanes
   implicit none
   private
   public :: table_type, forcing_type
@@ -11,13 +12,18 @@ module impact1d_forcing
     real(wp), allocatable :: t(:), f(:)
   end type table_type
 
+  !> Each body's force f_i(t), by term; arrays (N), allocated by allocate_bodies.
   type :: forcing_type
-    real(wp) :: constant(2) = 0.0_wp
-    logical :: has_table(2) = .false.
-    logical :: has_sine(2) = .false.
-    type(table_type) :: table(2)
-    real(wp) :: amp(2) = 0.0_wp, omega(2) = 0.0_wp, phase(2) = 0.0_wp
+    real(wp), allocatable :: constant(:)        !< (N) constant term, N
+    logical, allocatable :: has_table(:)        !< (N) body i has a force table
+    logical, allocatable :: has_sine(:)         !< (N) body i has a sine term
+    type(table_type), allocatable :: table(:)   !< (N) its table (when has_table)
+    real(wp), allocatable :: amp(:), omega(:), phase(:)   !< (N) amp sin(omega t + phase): N, rad/s, rad
+    logical :: varies = .false.                 !< some body has a table or a sine (set_varies)
+    real(wp) :: constant_lanes(max_lanes) = 0.0_wp  !< (lanes) constant, for force (set_varies)
   contains
+    procedure :: allocate_bodies
+    procedure :: set_varies
     procedure :: force
     procedure :: rate
     procedure :: next_breakpoint
@@ -26,27 +32,60 @@ module impact1d_forcing
 
 contains
 
-  !> Forces on both bodies at time t.
-  pure function force(self, t) result(f)
+  !> No force on n bodies: every term absent.
+  pure subroutine allocate_bodies(self, n)
+    class(forcing_type), intent(inout) :: self
+    integer, intent(in) :: n
+    allocate(self%constant(n), self%has_table(n), self%has_sine(n), self%table(n), self%amp(n), &
+      self%omega(n), self%phase(n))
+    self%constant = 0.0_wp
+    self%has_table = .false.
+    self%has_sine = .false.
+    self%amp = 0.0_wp
+    self%omega = 0.0_wp
+    self%phase = 0.0_wp
+  end subroutine allocate_bodies
+
+  !> varies: whether the forces change with time, and the constants in lanes (once the
+  !> terms are set).
+  pure subroutine set_varies(self)
+    class(forcing_type), intent(inout) :: self
+    self%varies = any(self%has_table) .or. any(self%has_sine)
+    call to_lanes(self%constant, self%constant_lanes)
+  end subroutine set_varies
+
+  !> Forces on the bodies at time t, in lanes (impact1d_lanes: an idle lane 0). Small, so
+  !> that the stepping loop inlines it; tables and sines apart (add_varying).
+  pure subroutine force(self, t, f)
     class(forcing_type), intent(in) :: self
     real(wp), intent(in) :: t
-    real(wp) :: f(2)
+    real(wp), intent(out) :: f(max_lanes)
+    f = self%constant_lanes
+    if (self%varies) call add_varying(self, t, f)
+  end subroutine force
+
+  !> f += the tables' and sines' terms at t.
+  pure subroutine add_varying(self, t, f)
+    class(forcing_type), intent(in) :: self
+    real(wp), intent(in) :: t
+    real(wp), intent(inout) :: f(max_lanes)
     integer :: i
-    f = self%constant
-    do i = 1, 2
+    do i = 1, max_lanes      ! (a loop of max_lanes trips the compiler unrolls: N <= max_lanes)
+      if (i > size(self%constant)) exit
       if (self%has_table(i)) f(i) = f(i) + table_value(self%table(i), t)
       if (self%has_sine(i)) f(i) = f(i) + self%amp(i) * sin(self%omega(i) * t + self%phase(i))
     end do
-  end function force
+  end subroutine add_varying
 
-  !> Right derivative df/dt at t: tells which way a force that is exactly at a bound will go.
-  pure function rate(self, t) result(df)
+  !> Right derivative df/dt at t, in lanes: tells which way a force that is exactly at a
+  !> bound will go.
+  pure subroutine rate(self, t, df)
     class(forcing_type), intent(in) :: self
     real(wp), intent(in) :: t
-    real(wp) :: df(2)
+    real(wp), intent(out) :: df(max_lanes)
     integer :: i, k
-    df = 0.0_wp
-    do i = 1, 2
+    df = 0.0_wp      ! (and an idle lane)
+    do i = 1, size(self%constant)
       if (self%has_table(i)) then
         k = segment(self%table(i)%t, t)
         if (k >= 1 .and. k < size(self%table(i)%t)) df(i) = &
@@ -54,7 +93,7 @@ contains
       end if
       if (self%has_sine(i)) df(i) = df(i) + self%amp(i) * self%omega(i) * cos(self%omega(i) * t + self%phase(i))
     end do
-  end function rate
+  end subroutine rate
 
   !> First table corner strictly after t (huge if none): steps end there exactly, because
   !> RK4 is exact for polynomial forcing only between corners.
@@ -64,7 +103,7 @@ contains
     real(wp) :: t_next
     integer :: i, k
     t_next = huge(1.0_wp)
-    do i = 1, 2
+    do i = 1, size(self%has_table)
       if (.not. self%has_table(i)) cycle
       k = segment(self%table(i)%t, t) + 1
       if (k <= size(self%table(i)%t)) t_next = min(t_next, self%table(i)%t(k))
@@ -96,7 +135,7 @@ contains
 
   !> Index k with times(k) <= t < times(k+1); 0 before the first time, n at or after the last.
   pure integer function segment(times, t) result(k)
-    real(wp), intent(in) :: times(:)
+    real(wp), contiguous, intent(in) :: times(:)
     real(wp), intent(in) :: t
     integer :: lo, hi, mid
     lo = 0

@@ -1,7 +1,11 @@
 !> Impact laws: Newton restitution on one contact, applied as an impulse along M^-1 n so
 !> that momentum is kept by slot impacts and a wall only reverses its body's velocity.
+!> A kernel of the pair (impact1d_lanes): velocities in lanes, the pair's masses and
+!> normals (scene%pair, the mode kernel's view: a one-body scene's idle lane has unit mass
+!> and no normal, so it keeps its velocity 0).
 module impact1d_impacts
   use impact1d_kinds, only: wp
+  use impact1d_lanes, only: max_lanes
   use impact1d_scene, only: scene_type, n_contacts, i_left, i_right, i_slot_min, i_slot_max
   implicit none
   private
@@ -14,8 +18,8 @@ contains
   pure real(wp) function normal_velocity(scene, k, v)
     type(scene_type), intent(in) :: scene
     integer, intent(in) :: k
-    real(wp), intent(in) :: v(2)
-    normal_velocity = dot_product(scene%normal(:, k), v)
+    real(wp), intent(in) :: v(max_lanes)
+    normal_velocity = dot_product(scene%pair%normal(:, k), v)
   end function normal_velocity
 
   !> Velocities after an impulse on contact k that leaves the normal velocity at -r times
@@ -24,31 +28,32 @@ contains
   !> body of mass m1 + m2, the link carrying the impulse: the pair's velocity is its centre of
   !> mass's (a relative velocity the link cannot have is absorbed, as by a plastic link
   !> impact), and the wall reverses that: v' = v_cm - (1 + r) u_cm n_i for both.
-  pure function impulse(scene, k, r, v, rigid) result(v_after)
+  pure subroutine impulse(scene, k, r, v, v_after, rigid)
     type(scene_type), intent(in) :: scene
     integer, intent(in) :: k
-    real(wp), intent(in) :: r, v(2)
+    real(wp), intent(in) :: r, v(max_lanes)
+    real(wp), intent(out) :: v_after(max_lanes)
     logical, intent(in), optional :: rigid
-    real(wp) :: v_after(2), p, v_pair
+    real(wp) :: p, v_pair
     if (present(rigid)) then
       if (rigid .and. (k == i_left .or. k == i_right)) then
         ! Written so that it is v(1) to the bit when the bodies already move together.
-        v_pair = v(1) + scene%mass(2) * (v(2) - v(1)) / sum(scene%mass)
-        v_after = v_pair - (1.0_wp + r) * normal_velocity(scene, k, [v_pair, v_pair]) * sum(scene%normal(:, k))
+        v_pair = v(1) + scene%pair%mass(2) * (v(2) - v(1)) / sum(scene%pair%mass)
+        v_after = v_pair - (1.0_wp + r) * normal_velocity(scene, k, [v_pair, v_pair]) * sum(scene%pair%normal(:, k))
         return
       end if
     end if
-    p = -(1.0_wp + r) * normal_velocity(scene, k, v) / dot_product(scene%normal(:, k)**2, 1.0_wp / scene%mass)
-    v_after = v + scene%normal(:, k) * p / scene%mass
+    p = -(1.0_wp + r) * normal_velocity(scene, k, v) / dot_product(scene%pair%normal(:, k)**2, 1.0_wp / scene%pair%mass)
+    v_after = v + scene%pair%normal(:, k) * p / scene%pair%mass
     ! A wall acts on its own body only: keep the other velocity bit for bit.
-    where (scene%normal(:, k) == 0.0_wp) v_after = v
-  end function impulse
+    where (scene%pair%normal(:, k) == 0.0_wp) v_after = v
+  end subroutine impulse
 
   !> The closed contact approaching fastest (0 if none approaches faster than its tol).
   pure integer function most_approaching(scene, closed, v, tol) result(k_best)
     type(scene_type), intent(in) :: scene
     logical, intent(in) :: closed(n_contacts)
-    real(wp), intent(in) :: v(2), tol(n_contacts)
+    real(wp), intent(in) :: v(max_lanes), tol(n_contacts)
     integer :: k
     real(wp) :: u_best
     k_best = 0
@@ -69,7 +74,7 @@ contains
     type(scene_type), intent(in) :: scene
     integer, intent(in) :: k
     logical, intent(in) :: closed(n_contacts)
-    restitution_of = scene%restitution(k)
+    restitution_of = scene%row_restitution(k)
     if ((k == i_slot_min .or. k == i_slot_max) .and. closed(i_slot_min) .and. closed(i_slot_max)) &
       restitution_of = 0.0_wp
   end function restitution_of
@@ -101,10 +106,10 @@ contains
   pure subroutine inelastic_projection(scene, closed, v, tol, v_after, pushed)
     type(scene_type), intent(in) :: scene
     logical, intent(in) :: closed(n_contacts)
-    real(wp), intent(in) :: v(2), tol(n_contacts)
-    real(wp), intent(out) :: v_after(2)
+    real(wp), intent(in) :: v(max_lanes), tol(n_contacts)
+    real(wp), intent(out) :: v_after(max_lanes)
     logical, intent(out) :: pushed(n_contacts)
-    real(wp) :: candidate(2), distance, best_distance
+    real(wp) :: candidate(max_lanes), distance, best_distance
     integer :: j, k
 
     v_after = v
@@ -117,14 +122,16 @@ contains
         if (.not. closed(j)) cycle
         if (j == k) then
           ! The single-face projection is the r = 0 impulse (exact for a wall: its body stops).
-          candidate = impulse(scene, k, 0.0_wp, v)
+          call impulse(scene, k, 0.0_wp, v, candidate)
         else
           ! Opposite normals (a rigid link's two limits) span one line only: no vertex.
-          if (scene%normal(1, j) * scene%normal(2, k) - scene%normal(2, j) * scene%normal(1, k) == 0.0_wp) cycle
+          associate (n => scene%pair%normal)
+            if (n(1, j) * n(2, k) - n(2, j) * n(1, k) == 0.0_wp) cycle
+          end associate
           candidate = 0.0_wp
         end if
         if (most_approaching(scene, closed, candidate, tol) /= 0) cycle
-        distance = dot_product(scene%mass, (candidate - v)**2)
+        distance = dot_product(scene%pair%mass, (candidate - v)**2)
         if (distance >= best_distance) cycle
         best_distance = distance
         v_after = candidate
@@ -135,9 +142,15 @@ contains
     end do
   end subroutine inelastic_projection
 
+  !> Kinetic energy of the bodies at velocities v: N of them, or lanes (an idle lane adds +0).
   pure real(wp) function kinetic_energy(scene, v)
     type(scene_type), intent(in) :: scene
-    real(wp), intent(in) :: v(2)
-    kinetic_energy = 0.5_wp * dot_product(scene%mass, v**2)
+    real(wp), intent(in) :: v(:)
+    integer :: i
+    kinetic_energy = 0.0_wp
+    do i = 1, size(v)
+      kinetic_energy = kinetic_energy + scene%pair%mass(i) * v(i)**2
+    end do
+    kinetic_energy = 0.5_wp * kinetic_energy
   end function kinetic_energy
 end module impact1d_impacts

@@ -7,27 +7,45 @@ module impact1d_location
   use impact1d_modes, only: mode_type, max_holds
   use impact1d_events, only: earliest_crossing
   use impact1d_impacts, only: normal_velocity
-  use impact1d_state, only: state_type
+  use impact1d_state, only: lane_state_type
+  use impact1d_lanes, only: max_lanes
   use impact1d_yardsticks, only: velocity_rounding, force_scale
   use impact1d_contacts, only: gap, gap_tolerance, gap_tolerance_along, displacement
   use impact1d_stepping, only: rk4_type, dense_output
-  use impact1d_loads, only: applied_force, state_force, applied_rate
+  use impact1d_loads, only: applied_force, applied_rate, state_force
   implicit none
   private
   public :: watch_type, hold_crossing, refine, constraints_hold, first_negative
 
   !> What the current mode needs watched.
   type :: watch_type
-    !> Until when each open gap (1..4) and each sliding body (5, 6) needs no location.
-    real(wp) :: quiet_until(n_contacts + 2) = -huge(1.0_wp)
+    !> Until when each open gap (row) and each sliding body (N, allocated in run) needs no
+    !> location.
+    real(wp) :: quiet_row(n_contacts) = -huge(1.0_wp)
+    real(wp), allocatable :: quiet_body(:)
     !> Something in the mode can end it (else its steps need no location at all).
     logical :: watching = .true.
   contains
     procedure :: locate
     procedure :: find_quiet_times
+    procedure :: forget_quiet_times
+    procedure :: quiet_time
   end type watch_type
 
 contains
+
+  !> Nothing is known quiet (until find_quiet_times).
+  pure subroutine forget_quiet_times(self)
+    class(watch_type), intent(inout) :: self
+    self%quiet_row = -huge(1.0_wp)
+    self%quiet_body(:) = -huge(1.0_wp)
+  end subroutine forget_quiet_times
+
+  !> The first of the quiet times: steps ending before it need no location.
+  pure real(wp) function quiet_time(self)
+    class(watch_type), intent(in) :: self
+    quiet_time = min(minval(self%quiet_row), minval(self%quiet_body))
+  end function quiet_time
 
   !> Earliest event in (0, step]: a gap closing, a sliding body stopping, a mode condition
   !> failing. which = k for contact k, 100 + i for body i, -1 for a mode condition.
@@ -38,11 +56,12 @@ contains
     logical, intent(in) :: constant_forcing
     !> The dense output is exact (the motion is a cubic): else its own error counts too.
     logical, intent(in) :: polynomial_forcing
-    type(state_type), intent(in) :: a, b
+    type(lane_state_type), intent(in) :: a, b
     real(wp), intent(in) :: step
     real(wp), intent(out) :: theta
     integer, intent(out) :: which
-    real(wp) :: c(3, 2), p(0:3), q(0:3), candidate, scale, acc_rounding(2), acc0(2)
+    real(wp) :: p(0:3), q(0:3), candidate, scale, c(3, max_lanes), f(max_lanes), df(max_lanes)
+    real(wp) :: acc_rounding(max_lanes), acc0(max_lanes)
     integer :: k, i
     logical :: have_dense, have_acc_rounding, have_acc0
 
@@ -52,20 +71,21 @@ contains
     have_acc_rounding = .false.
     have_acc0 = .false.
     do k = 1, n_contacts
-      if (.not. scene%has_contact(k) .or. mode%active(k)) cycle
-      if (a%t + step < self%quiet_until(k)) cycle
-      if (.not. have_dense) c = dense_output(a, b, step)
+      if (.not. scene%row_present(k) .or. mode%active(k)) cycle
+      if (a%t + step < self%quiet_row(k)) cycle
+      if (.not. have_dense) call dense_output(a, b, step, c)
       have_dense = .true.
       p(0) = gap(scene, k, a)
-      p(1:3) = scene%normal(1, k) * c(:, 1) + scene%normal(2, k) * c(:, 2)
+      p(1:3) = scene%pair%normal(1, k) * c(:, 1) + scene%pair%normal(2, k) * c(:, 2)
       ! The common case first: the gap cannot reach zero within the step.
       if (p(0) - step * (abs(p(1)) + step * (abs(p(2)) + step * abs(p(3)))) > 0.0_wp) cycle
       ! Only a gap that may close needs the forces' rounding (a sine costs two evaluations).
       if (.not. have_acc_rounding) then
-        acc_rounding = 1.0e3_wp * eps_wp * &
-          force_scale(scene, state_force(scene, a), applied_rate(scene, a%t, a%v)) / scene%mass
+        call state_force(scene, a, f)
+        call applied_rate(scene, a%t, a%v, df)
+        acc_rounding = 1.0e3_wp * eps_wp * force_scale(scene, f, df) / scene%pair%mass
         if (.not. polynomial_forcing) then
-          acc0 = mode%acceleration(state_force(scene, a))
+          call mode%acceleration(f, acc0)
           have_acc0 = .true.
         end if
       end if
@@ -78,17 +98,17 @@ contains
       ! leaving a wall as the sine force turns: located again and again at theta = 0).
       ! The dips the cubic cannot resolve do not count; a real crossing still does, and
       ! the step's end is checked on the integrator's own state (constraints_hold).
-      if (.not. polynomial_forcing) q(2) = q(2) + abs(p(2) - 0.5_wp * dot_product(scene%normal(:, k), acc0))
+      if (.not. polynomial_forcing) q(2) = q(2) + abs(p(2) - 0.5_wp * dot_product(scene%pair%normal(:, k), acc0))
       candidate = earliest_crossing(p, step, q)
       if (candidate < theta) then
         theta = candidate
         which = k
       end if
     end do
-    do i = 1, 2
-      if (scene%static_friction(i) == 0.0_wp .or. mode%sgn(i) == 0.0_wp) cycle
-      if (a%t + step < self%quiet_until(n_contacts + i)) cycle
-      if (.not. have_dense) c = dense_output(a, b, step)
+    do i = 1, scene%n_bodies
+      if (scene%body_static(i) == 0.0_wp .or. mode%sgn(i) == 0.0_wp) cycle
+      if (a%t + step < self%quiet_body(i)) cycle
+      if (.not. have_dense) call dense_output(a, b, step, c)
       have_dense = .true.
       ! Sliding velocity in its own direction: the derivative of the Hermite cubic.
       p = mode%sgn(i) * [c(1, i), 2.0_wp * c(2, i), 3.0_wp * c(3, i), 0.0_wp]
@@ -100,7 +120,10 @@ contains
       ! step's ends) would dip its velocity below zero at once, a stop located at theta = 0
       ! again and again. The dip the cubic cannot resolve does not count.
       if (.not. polynomial_forcing) then
-        if (.not. have_acc0) acc0 = mode%acceleration(state_force(scene, a))
+        if (.not. have_acc0) then
+          call state_force(scene, a, f)
+          call mode%acceleration(f, acc0)
+        end if
         have_acc0 = .true.
         q(1) = q(1) + abs(p(1) - mode%sgn(i) * acc0(i))
       end if
@@ -112,7 +135,7 @@ contains
     end do
     ! Under constant forces the mode's conditions are constant: they held when it began.
     if (mode%n_hold > 0 .and. .not. constant_forcing) then
-      if (scene%springs%present .and. .not. have_dense) c = dense_output(a, b, step)
+      if (scene%springs%present .and. .not. have_dense) call dense_output(a, b, step, c)
       candidate = hold_crossing(scene, mode, a, c, step)
       if (candidate < theta) then
         theta = candidate
@@ -129,8 +152,8 @@ contains
   real(wp) function hold_crossing(scene, mode, a, c, step) result(theta)
     type(scene_type), intent(in) :: scene
     type(mode_type), intent(in) :: mode
-    type(state_type), intent(in) :: a
-    real(wp), intent(in) :: c(3, 2), step
+    type(lane_state_type), intent(in) :: a
+    real(wp), intent(in) :: c(3, max_lanes), step
     real(wp) :: lo, hi, mid, tol, t0
     integer :: n_sub, j
     real(wp), parameter :: two_pi = 2.0_wp * acos(-1.0_wp)
@@ -138,12 +161,12 @@ contains
     t0 = a%t
     tol = hold_tolerance(scene, a)
     n_sub = 1
-    do j = 1, 2
+    do j = 1, scene%n_bodies
       if (scene%forcing%has_sine(j)) n_sub = max(n_sub, &
         ceiling(16.0_wp * step * scene%forcing%omega(j) / two_pi))
     end do
     if (scene%springs%present) n_sub = max(n_sub, &
-      ceiling(16.0_wp * step * scene%springs%frequency(scene%mass) / two_pi))
+      ceiling(16.0_wp * step * scene%springs%omega / two_pi))
     lo = 0.0_wp
     do j = 1, n_sub
       hi = step * real(j, wp) / real(n_sub, wp)
@@ -171,15 +194,15 @@ contains
   real(wp) function worst_hold(scene, mode, a, c, theta)
     type(scene_type), intent(in) :: scene
     type(mode_type), intent(in) :: mode
-    type(state_type), intent(in) :: a
-    real(wp), intent(in) :: c(3, 2), theta
-    real(wp) :: values(max_holds), f(2), dx(2), v(2)
+    type(lane_state_type), intent(in) :: a
+    real(wp), intent(in) :: c(3, max_lanes), theta
+    real(wp) :: values(max_holds), f(max_lanes), dx(max_lanes), v(max_lanes)
     if (scene%springs%present) then
       dx = a%x_lo + theta * (c(1, :) + theta * (c(2, :) + theta * c(3, :)))
       v = c(1, :) + theta * (2.0_wp * c(2, :) + 3.0_wp * theta * c(3, :))
-      f = applied_force(scene, a%t + theta, a%x, dx, v)
+      call applied_force(scene, a%t + theta, a%x, dx, v, f)
     else
-      f = scene%forcing%force(a%t + theta)
+      call scene%forcing%force(a%t + theta, f)
     end if
     values = mode%holds(f)
     worst_hold = minval(values(1:mode%n_hold))
@@ -187,10 +210,11 @@ contains
 
   real(wp) function hold_tolerance(scene, a)
     type(scene_type), intent(in) :: scene
-    type(state_type), intent(in) :: a
-    hold_tolerance = 1.0e3_wp * eps_wp * &
-      force_scale(scene, state_force(scene, a), applied_rate(scene, a%t, a%v)) &
-      + tiny(1.0_wp)
+    type(lane_state_type), intent(in) :: a
+    real(wp) :: f(max_lanes), df(max_lanes)
+    call state_force(scene, a, f)
+    call applied_rate(scene, a%t, a%v, df)
+    hold_tolerance = 1.0e3_wp * eps_wp * force_scale(scene, f, df) + tiny(1.0_wp)
   end function hold_tolerance
 
   !> Re-take the step to the located time and polish it by Newton's method on the watched
@@ -200,11 +224,11 @@ contains
     type(rk4_type), intent(inout) :: rk
     type(scene_type), intent(in) :: scene
     type(mode_type), intent(in) :: mode
-    type(state_type), intent(in) :: a
+    type(lane_state_type), intent(in) :: a
     real(wp), intent(inout) :: step
     integer, intent(in) :: which
-    type(state_type), intent(inout) :: b
-    real(wp) :: value, slope, tol, acc(2), located_step
+    type(lane_state_type), intent(inout) :: b
+    real(wp) :: value, slope, tol, located_step, f(max_lanes), acc(max_lanes)
     integer :: iteration
     located_step = step
     call rk%step(scene, mode, a, step, b)
@@ -212,7 +236,8 @@ contains
     do iteration = 1, 8
       if (which > 100) then
         value = b%v(which - 100)
-        acc = mode%acceleration(state_force(scene, b))
+        call state_force(scene, b, f)
+        call mode%acceleration(f, acc)
         slope = acc(which - 100)
         tol = velocity_rounding * max(abs(a%v(which - 100)), abs(value))
       else
@@ -234,16 +259,16 @@ contains
   pure logical function constraints_hold(scene, mode, s, b, located_contact)
     type(scene_type), intent(in) :: scene
     type(mode_type), intent(in) :: mode
-    type(state_type), intent(in) :: s, b
+    type(lane_state_type), intent(in) :: s, b
     integer, intent(in) :: located_contact
     integer :: k, i
     constraints_hold = .true.
     do k = 1, n_contacts
-      if (.not. scene%has_contact(k) .or. mode%active(k) .or. k == located_contact) cycle
+      if (.not. scene%row_present(k) .or. mode%active(k) .or. k == located_contact) cycle
       if (gap(scene, k, b) < -gap_tolerance(scene, k, b, displacement(scene, k, s, b))) constraints_hold = .false.
     end do
-    do i = 1, 2
-      if (scene%static_friction(i) == 0.0_wp .or. mode%sgn(i) == 0.0_wp) cycle
+    do i = 1, scene%n_bodies
+      if (scene%body_static(i) == 0.0_wp .or. mode%sgn(i) == 0.0_wp) cycle
       if (mode%sgn(i) * b%v(i) < -velocity_rounding * max(abs(s%v(i)), abs(b%v(i)), &
           abs(b%v(i) - s%v(i)))) constraints_hold = .false.
     end do
@@ -257,18 +282,20 @@ contains
     class(watch_type), intent(inout) :: self
     type(scene_type), intent(in) :: scene
     type(mode_type), intent(in) :: mode
-    type(state_type), intent(in) :: s
-    real(wp), intent(in) :: constant_acceleration(2)
+    type(lane_state_type), intent(in) :: s
+    real(wp), intent(in) :: constant_acceleration(max_lanes)
     integer :: k, i
-    self%quiet_until = huge(1.0_wp)     ! what is not watched needs no location
+    ! What is not watched needs no location.
+    self%quiet_row = huge(1.0_wp)
+    self%quiet_body(:) = huge(1.0_wp)
     do k = 1, n_contacts
-      if (.not. scene%has_contact(k) .or. mode%active(k)) cycle
-      self%quiet_until(k) = s%t + 0.99_wp * first_negative(gap(scene, k, s), normal_velocity(scene, k, s%v), &
-        dot_product(scene%normal(:, k), constant_acceleration))
+      if (.not. scene%row_present(k) .or. mode%active(k)) cycle
+      self%quiet_row(k) = s%t + 0.99_wp * first_negative(gap(scene, k, s), normal_velocity(scene, k, s%v), &
+        dot_product(scene%pair%normal(:, k), constant_acceleration))
     end do
-    do i = 1, 2
-      if (scene%static_friction(i) == 0.0_wp .or. mode%sgn(i) == 0.0_wp) cycle
-      self%quiet_until(n_contacts + i) = s%t + 0.99_wp * first_negative(mode%sgn(i) * s%v(i), &
+    do i = 1, scene%n_bodies
+      if (scene%body_static(i) == 0.0_wp .or. mode%sgn(i) == 0.0_wp) cycle
+      self%quiet_body(i) = s%t + 0.99_wp * first_negative(mode%sgn(i) * s%v(i), &
         mode%sgn(i) * constant_acceleration(i), 0.0_wp)
     end do
   end subroutine find_quiet_times

@@ -2,19 +2,35 @@
 !> static friction, and which way sliding friction acts. Within a mode the accelerations are
 !> a linear function of the external forces only, a = gain (f(t) + f_slide), so the stepping
 !> loop pays two multiply-adds per stage for them.
+!> The solver here is a kernel for two bodies: it sees a unit of one or two bodies through a
+!> pair_type (their masses, friction bounds and the rows' normals as 2-vectors). A one-body
+!> unit is padded with a phantom body (unit mass, at rest, no friction, on no row) that
+!> exists only here, so that one-body results stay those of the two-body solver bit for bit.
 module impact1d_modes
   use impact1d_kinds, only: wp, eps_wp
-  use impact1d_scene, only: scene_type, n_contacts
   implicit none
   private
-  public :: mode_type, solve_mode, max_holds
+  public :: mode_type, pair_type, solve_mode, max_holds, pair_rows
 
   !> Conditions a mode needs (contact force >= 0, |static friction| <= bound): at most two
   !> locked rows, two conditions for a stuck body.
   integer, parameter :: max_holds = 4
+  !> Rows a unit of two bodies can have: a wall each side and the link's two limits.
+  integer, parameter :: pair_rows = 4
 
+  !> What the kernel sees of a unit of n bodies (n = 1: body 2 is the phantom).
+  type :: pair_type
+    integer :: n = 2                                !< bodies in the unit: 1 or 2
+    real(wp) :: mass(2) = 1.0_wp                    !< (2) kg; the phantom's 1
+    real(wp) :: friction(2) = 0.0_wp                !< (2) sliding friction bounds c_i, N
+    real(wp) :: static_friction(2) = 0.0_wp        !< (2) static friction bounds s_i >= c_i, N
+    !> (2, pair_rows) row k's coefficients on the two bodies: gap_k = normal(:, k) . x + offset_k
+    real(wp) :: normal(2, pair_rows) = 0.0_wp
+  end type pair_type
+
+  !> A mode of the pair's two bodies; its forces and accelerations are over the unit's n.
   type :: mode_type
-    logical :: active(n_contacts) = .false.   !< contacts held closed (persistent)
+    logical :: active(pair_rows) = .false.    !< rows held closed (persistent)
     logical :: stuck(2) = .false.             !< bodies held by static friction
     real(wp) :: sgn(2) = 0.0_wp               !< sliding direction: friction is -c_i sgn_i
     real(wp) :: f_slide(2) = 0.0_wp           !< the sliding friction forces -c_i sgn_i
@@ -29,15 +45,21 @@ module impact1d_modes
 
 contains
 
-  !> Accelerations of both bodies under forces f in this mode.
-  pure function acceleration(self, f) result(a)
+  !> Accelerations a of the pair's two bodies (lanes) under forces f in this mode: a = gain
+  !> (f + f_slide), matmul's sums (from +0, in column order) written out, small enough to be
+  !> inlined into the stepping loop (a subroutine: an array-valued function result's
+  !> temporary may go to the heap).
+  pure subroutine acceleration(self, f, a)
     class(mode_type), intent(in) :: self
     real(wp), intent(in) :: f(2)
-    real(wp) :: a(2)
-    a = matmul(self%gain, f + self%f_slide)
-  end function acceleration
+    real(wp), intent(out) :: a(2)
+    real(wp) :: load(2)
+    load = f + self%f_slide
+    a(1) = (0.0_wp + self%gain(1, 1) * load(1)) + self%gain(1, 2) * load(2)
+    a(2) = (0.0_wp + self%gain(2, 1) * load(1)) + self%gain(2, 2) * load(2)
+  end subroutine acceleration
 
-  !> Values of the mode's conditions under forces f: the mode ends when one turns negative.
+  !> Values of the mode's conditions under forces f (lanes): the mode ends when one turns negative.
   pure function holds(self, f) result(h)
     class(mode_type), intent(in) :: self
     real(wp), intent(in) :: f(2)
@@ -59,10 +81,11 @@ contains
   !> reaction set has independent rows, the other reactions sitting at a bound).
   !> force_scale: the size of the forces around this instant (what a step can change them
   !> by included), the yardstick of rounding; without it, the forces now.
-  subroutine solve_mode(scene, f, df, candidate, resting, moving_sign, mode, found, force_scale)
-    type(scene_type), intent(in) :: scene
+  !> f, df, resting and moving_sign are the pair's (lanes).
+  subroutine solve_mode(pair, f, df, candidate, resting, moving_sign, mode, found, force_scale)
+    type(pair_type), intent(in) :: pair
     real(wp), intent(in) :: f(2), df(2)
-    logical, intent(in) :: candidate(n_contacts), resting(2)
+    logical, intent(in) :: candidate(pair_rows), resting(2)
     real(wp), intent(in) :: moving_sign(2)
     type(mode_type), intent(out) :: mode
     logical, intent(out) :: found
@@ -70,10 +93,10 @@ contains
     real(wp) :: scale
     integer :: target_stuck, o1, o2, mask, n_active, target_active, k
     integer :: option(2)
-    logical :: active(n_contacts)
+    logical :: active(pair_rows)
 
     found = .false.
-    scale = sum(abs(f)) + 2.0_wp * sum(scene%static_friction)
+    scale = sum(abs(f)) + 2.0_wp * sum(pair%static_friction)
     if (present(force_scale)) scale = max(scale, force_scale)
     do target_stuck = 2, 0, -1
       do o1 = 0, 2
@@ -83,12 +106,12 @@ contains
           if ((.not. resting(1) .and. o1 /= 0) .or. (.not. resting(2) .and. o2 /= 0)) cycle
           if (count(option == 0 .and. resting) /= target_stuck) cycle
           do target_active = count(candidate), 0, -1
-            do mask = 0, 2**n_contacts - 1
-              active = [(btest(mask, k - 1), k = 1, n_contacts)]
+            do mask = 0, 2**pair_rows - 1
+              active = [(btest(mask, k - 1), k = 1, pair_rows)]
               if (any(active .and. .not. candidate)) cycle
               n_active = count(active)
               if (n_active /= target_active) cycle
-              call try_mode(scene, f, df, scale, candidate, resting, moving_sign, option, active, mode, found)
+              call try_mode(pair, f, df, scale, candidate, resting, moving_sign, option, active, mode, found)
               if (found) return
             end do
           end do
@@ -97,10 +120,10 @@ contains
     end do
   end subroutine solve_mode
 
-  subroutine try_mode(scene, f, df, scale, candidate, resting, moving_sign, option, active, mode, found)
-    type(scene_type), intent(in) :: scene
+  subroutine try_mode(pair, f, df, scale, candidate, resting, moving_sign, option, active, mode, found)
+    type(pair_type), intent(in) :: pair
     real(wp), intent(in) :: f(2), df(2), scale, moving_sign(2)
-    logical, intent(in) :: candidate(n_contacts), resting(2), active(n_contacts)
+    logical, intent(in) :: candidate(pair_rows), resting(2), active(pair_rows)
     integer, intent(in) :: option(2)
     type(mode_type), intent(inout) :: mode
     logical, intent(out) :: found
@@ -109,7 +132,7 @@ contains
     integer :: m, i, k, p, row_body(2), row_contact(2)
 
     found = .false.
-    minv = 1.0_wp / scene%mass
+    minv = 1.0_wp / pair%mass
     mode%active = active
     mode%stuck = resting .and. option == 0
     mode%sgn = moving_sign
@@ -117,7 +140,7 @@ contains
       if (resting(i) .and. option(i) == 1) mode%sgn(i) = 1.0_wp
       if (resting(i) .and. option(i) == 2) mode%sgn(i) = -1.0_wp
     end do
-    mode%f_slide = -scene%friction * mode%sgn
+    mode%f_slide = -pair%friction * mode%sgn
 
     load = f + mode%f_slide
     tol = 1.0e3_wp * eps_wp * scale + tiny(1.0_wp)
@@ -131,17 +154,17 @@ contains
     ! Only where the link must carry load: a rigid link or bodies merely touching log no rest.
     if (all(mode%stuck) .and. count(active) == 1) then
       k = findloc(active, .true., dim=1)
-      if (all(scene%normal(:, k) /= 0.0_wp)) then
-        if (admissible([-1.0_wp, 0.0_wp], scene%static_friction(1)) .and. &
-            admissible([1.0_wp, 0.0_wp], scene%static_friction(1)) .and. &
-            admissible([0.0_wp, -1.0_wp], scene%static_friction(2)) .and. &
-            admissible([0.0_wp, 1.0_wp], scene%static_friction(2))) return
+      if (all(pair%normal(:, k) /= 0.0_wp)) then
+        if (admissible([-1.0_wp, 0.0_wp], pair%static_friction(1)) .and. &
+            admissible([1.0_wp, 0.0_wp], pair%static_friction(1)) .and. &
+            admissible([0.0_wp, -1.0_wp], pair%static_friction(2)) .and. &
+            admissible([0.0_wp, 1.0_wp], pair%static_friction(2))) return
         mode%gain = 0.0_wp
         mode%n_hold = 0
-        call add_hold([-scene%normal(1, k), 0.0_wp], scene%static_friction(1))
-        call add_hold([0.0_wp, -scene%normal(2, k)], scene%static_friction(2))
-        call add_hold([scene%normal(1, k), -scene%normal(2, k)], sum(scene%static_friction))
-        call add_hold([-scene%normal(1, k), scene%normal(2, k)], sum(scene%static_friction))
+        call add_hold([-pair%normal(1, k), 0.0_wp], pair%static_friction(1))
+        call add_hold([0.0_wp, -pair%normal(2, k)], pair%static_friction(2))
+        call add_hold([pair%normal(1, k), -pair%normal(2, k)], sum(pair%static_friction))
+        call add_hold([-pair%normal(1, k), pair%normal(2, k)], sum(pair%static_friction))
         found = all([(admissible(mode%hold_w(:, p), mode%hold_c(p)), p = 1, mode%n_hold)])
         return
       end if
@@ -151,11 +174,11 @@ contains
     m = 0
     row_body = 0
     row_contact = 0
-    do k = 1, n_contacts
+    do k = 1, pair_rows
       if (.not. active(k)) cycle
       m = m + 1
       if (m > 2) return
-      rows(m, :) = scene%normal(:, k)
+      rows(m, :) = pair%normal(:, k)
       row_contact(m) = k
     end do
     do i = 1, 2
@@ -209,8 +232,8 @@ contains
         call add_hold(k_gain(p, :), 0.0_wp)                       ! contact force >= 0
       else
         i = row_body(p)
-        call add_hold(-k_gain(p, :), scene%static_friction(i))    ! static friction <= mus_i m_i g
-        call add_hold(k_gain(p, :), scene%static_friction(i))     ! static friction >= -mus_i m_i g
+        call add_hold(-k_gain(p, :), pair%static_friction(i))    ! static friction <= mus_i m_i g
+        call add_hold(k_gain(p, :), pair%static_friction(i))     ! static friction >= -mus_i m_i g
       end if
     end do
     do p = 1, mode%n_hold
@@ -218,15 +241,15 @@ contains
     end do
     ! A closed contact left free must not close further; a body leaving rest must move the
     ! way its friction assumes. Both are written in force units so one tolerance serves.
-    do k = 1, n_contacts
+    do k = 1, pair_rows
       if (.not. candidate(k) .or. active(k)) cycle
-      meff = 1.0_wp / dot_product(scene%normal(:, k)**2, minv)
-      w = meff * matmul(scene%normal(:, k), mode%gain)
+      meff = 1.0_wp / dot_product(pair%normal(:, k)**2, minv)
+      w = meff * matmul(pair%normal(:, k), mode%gain)
       if (.not. admissible(w, 0.0_wp)) return
     end do
     do i = 1, 2
       if (.not. resting(i) .or. mode%stuck(i)) cycle
-      w = scene%mass(i) * mode%sgn(i) * mode%gain(i, :)
+      w = pair%mass(i) * mode%sgn(i) * mode%gain(i, :)
       if (.not. admissible(w, 0.0_wp)) return
     end do
     found = .true.

@@ -7,11 +7,12 @@ module impact1d_scene
   use impact1d_error, only: error_type, raise, status_input, fmt, fmt_width
   use impact1d_forcing, only: forcing_type, table_type
   use impact1d_springs, only: springs_type, n_elements
+  use impact1d_modes, only: pair_type
   use impact1d_stability, only: linear_modes, stable_step, mode_error, coarse_rate
   implicit none
   private
   public :: n_real, n_text, real_names, text_names, scene_input, scene_type, build_scene, validate
-  public :: n_contacts, two_body_normal, i_left, i_right, i_slot_min, i_slot_max
+  public :: n_contacts, i_left, i_right, i_slot_min, i_slot_max
   public :: i_m1, i_m2, i_mu1, i_mu2, i_g, i_x_left, i_r_left, i_x_right, i_r_right, i_d_min, &
     i_r_min, i_d_max, i_r_max, i_x1, i_v1, i_x2, i_v2, i_f1, i_f2, i_f1_amp, i_f1_period, &
     i_f1_phase, i_f2_amp, i_f2_period, i_f2_phase, i_t_end, i_dt, i_dt_out, i_mus1, i_mus2, &
@@ -49,7 +50,7 @@ module impact1d_scene
   character(len=*), parameter :: contact_names(n_contacts) = [character(len=8) :: &
     'left', 'right', 'slot_min', 'slot_max']
   !> Their normals with two bodies: the left wall holds body 1, the right wall body 2. With
-  !> one body both walls hold body 1 (scene_type's normal).
+  !> one body both walls hold body 1 (the pair's normal: scene_type's pair%normal).
   real(wp), parameter :: two_body_normal(2, n_contacts) = reshape( &
     [1.0_wp, 0.0_wp, 0.0_wp, -1.0_wp, -1.0_wp, 1.0_wp, 1.0_wp, -1.0_wp], [2, n_contacts])
   real(wp), parameter :: one_body_normal(2, n_contacts) = reshape( &
@@ -86,22 +87,31 @@ module impact1d_scene
     character(len=:), allocatable :: source
   end type scene_input
 
-  !> The checked model. Friction bounds: sliding c_i = mu_i m_i g, static mus_i m_i g >= c_i.
+  !> The checked model: the constant part of a run (what changes is impact1d_state's), as
+  !> counts and one array per attribute (MuJoCo's mjModel).
   type :: scene_type
     character(len=:), allocatable :: title, method
     !> What the run should know but does not stop it (a coarse step), one per line; '' if none.
     character(len=:), allocatable :: warnings
-    real(wp) :: mass(2), friction(2), static_friction(2)
-    type(springs_type) :: springs
-    !> Bodies in the scene: 1 (m2 not given) or 2. A one-body scene keeps a body 2 at rest
-    !> at 0 that nothing acts on and no contact involves, so the solver's arrays stay 2-long.
-    integer :: n_bodies = 2
-    !> gap_k = normal(:, k) . x + offset_k
-    real(wp) :: normal(2, n_contacts) = two_body_normal
-    logical :: has_contact(n_contacts) = .false.
-    real(wp) :: offset(n_contacts) = 0.0_wp, restitution(n_contacts) = 1.0_wp
-    real(wp) :: x0(2), v0(2)
-    type(forcing_type) :: forcing
+    ! bodies ------------------------------------------------------------------------------
+    integer :: n_bodies = 2                          !< N: 1 (m2 not given) or 2
+    real(wp), allocatable :: body_mass(:)            !< (N) kg
+    real(wp), allocatable :: body_friction(:)        !< (N) sliding friction bound c_i = (mu_i m_i) g, N
+    real(wp), allocatable :: body_static(:)          !< (N) static friction bound (mus_i m_i) g >= c_i, N
+    real(wp), allocatable :: body_x0(:), body_v0(:)  !< (N) initial position (m) and velocity (m/s)
+    type(forcing_type) :: forcing                    !< the external forces f_i(t), per body (N)
+    type(springs_type) :: springs                    !< springs and dampers: k1, k2, k12 as elements
+    ! rows: the four optional unilateral constraints, in the order left, right, slot_min, slot_max;
+    ! gap_k = pair%normal(:, k) . x + row_offset(k) >= 0 (their normals on the two bodies are
+    ! the kernels' view, pair%normal)
+    logical :: row_present(n_contacts) = .false.     !< (4) the scene has row k
+    real(wp) :: row_offset(n_contacts) = 0.0_wp      !< (4) its offset: -x_left, +x_right, -d_min, +d_max
+    real(wp) :: row_restitution(n_contacts) = 1.0_wp !< (4) Newton's restitution of row k
+    !> The bodies and rows as the two-body kernels see them (impact1d_modes' pair_type: in
+    !> lanes, impact1d_lanes): with one body, padded by a phantom (unit mass, at rest, no
+    !> friction, on no row) in the idle lane.
+    type(pair_type) :: pair
+    ! run --------------------------------------------------------------------------------
     real(wp) :: t_end, dt, dt_out
     real(wp) :: zero_velocity = default_zero_velocity
     integer :: max_impulses = default_max_impulses, max_step_events = default_max_step_events
@@ -449,8 +459,7 @@ contains
     type(table_type), intent(in) :: tables(2)
     type(scene_type), intent(out) :: scene
     type(error_type), allocatable, intent(out) :: error
-    integer :: i, k
-    real(wp) :: g
+    integer :: k
 
     call validate(input, .true., error)
     if (allocated(error)) return
@@ -458,30 +467,13 @@ contains
     scene%title = trim(input%text(i_title)%s)
     scene%method = 'event'
     if (len_trim(input%text(i_method)%s) > 0) scene%method = trim(input%text(i_method)%s)
-    scene%mass = input%value([i_m1, i_m2])
-    scene%normal = contact_normals(input)
-    if (.not. input%given(i_m2)) then
-      ! One body: body 2 is a unit mass at rest at 0 that nothing acts on.
-      scene%n_bodies = 1
-      scene%mass(2) = 1.0_wp
-    end if
-    g = default_gravity
-    if (input%given(i_g)) g = input%value(i_g)
-    scene%friction = 0.0_wp
-    do i = 1, 2
-      if (input%given(i_mu1 + i - 1)) scene%friction(i) = input%value(i_mu1 + i - 1) * scene%mass(i) * g
-    end do
-    scene%friction = max(scene%friction, 0.0_wp)
-    scene%static_friction = scene%friction
-    do i = 1, 2
-      if (input%given(i_mus1 + i - 1)) scene%static_friction(i) = input%value(i_mus1 + i - 1) * scene%mass(i) * g
-    end do
-    scene%static_friction = max(scene%static_friction, scene%friction)
+    call set_bodies(input, tables, scene)
     do k = 1, n_contacts
-      scene%has_contact(k) = has_limit(input, k)
-      if (.not. scene%has_contact(k)) cycle
-      scene%offset(k) = offset_sign(k) * limit_value(input, k)
-      if (input%given(limit_index(k) + 1)) scene%restitution(k) = input%value(limit_index(k) + 1)
+      scene%row_present(k) = has_limit(input, k)
+      if (.not. scene%row_present(k)) cycle
+      ! (A limit of -0 enters as +0: snap puts a body at -offset / normal, which is then +0.)
+      scene%row_offset(k) = offset_sign(k) * (limit_value(input, k) + 0.0_wp)
+      if (input%given(limit_index(k) + 1)) scene%row_restitution(k) = input%value(limit_index(k) + 1)
     end do
     do k = 1, n_elements
       if (input%given(spring_index(k))) then
@@ -493,24 +485,8 @@ contains
     scene%springs%has_spring = any(input%given(spring_index))
     scene%springs%has_damper = any(input%given(spring_index + 2))
     scene%springs%present = scene%springs%has_spring .or. scene%springs%has_damper
-    scene%x0 = input%value([i_x1, i_x2])
-    if (scene%n_bodies == 1) scene%x0(2) = 0.0_wp
-    scene%v0 = 0.0_wp
-    if (input%given(i_v1)) scene%v0(1) = input%value(i_v1)
-    if (input%given(i_v2)) scene%v0(2) = input%value(i_v2)
-
-    do i = 1, 2
-      if (input%given(i_f1 + i - 1)) scene%forcing%constant(i) = input%value(i_f1 + i - 1)
-      scene%forcing%has_table(i) = len_trim(input%text(i_f1_table + i - 1)%s) > 0
-      if (scene%forcing%has_table(i)) scene%forcing%table(i) = tables(i)
-      k = i_f1_amp + 3 * (i - 1)
-      scene%forcing%has_sine(i) = input%given(k)
-      if (scene%forcing%has_sine(i)) then
-        scene%forcing%amp(i) = input%value(k)
-        scene%forcing%omega(i) = 2.0_wp * acos(-1.0_wp) / input%value(k + 1)
-        if (input%given(k + 2)) scene%forcing%phase(i) = input%value(k + 2)
-      end if
-    end do
+    ! The lightest mass as the kernel sees it (the phantom's 1 with one body).
+    call scene%springs%set_frequency(minval(scene%pair%mass))
 
     scene%t_end = input%value(i_t_end)
     scene%dt = input%value(i_dt)
@@ -526,6 +502,63 @@ contains
     scene%n_samples = int(row_count(scene%t_end, scene%dt_out))
   end subroutine build_scene
 
+  !> The bodies (N: 2 with m2, else 1), their forces, and the kernels' view of them (pair).
+  subroutine set_bodies(input, tables, scene)
+    type(scene_input), intent(in) :: input
+    type(table_type), intent(in) :: tables(2)
+    type(scene_type), intent(inout) :: scene
+    integer :: i, k, n
+    real(wp) :: g
+    n = merge(2, 1, input%given(i_m2))
+    scene%n_bodies = n
+    allocate(scene%body_mass(n), scene%body_friction(n), scene%body_static(n), scene%body_x0(n), &
+      scene%body_v0(n))
+    scene%body_mass = input%value(i_m1:i_m1 + n - 1)
+    g = default_gravity
+    if (input%given(i_g)) g = input%value(i_g)
+    scene%body_friction = 0.0_wp
+    do i = 1, n
+      if (input%given(i_mu1 + i - 1)) scene%body_friction(i) = input%value(i_mu1 + i - 1) * scene%body_mass(i) * g
+    end do
+    scene%body_friction = max(scene%body_friction, 0.0_wp)
+    scene%body_static = scene%body_friction
+    do i = 1, n
+      if (input%given(i_mus1 + i - 1)) scene%body_static(i) = input%value(i_mus1 + i - 1) * scene%body_mass(i) * g
+    end do
+    scene%body_static = max(scene%body_static, scene%body_friction)
+    ! The kernels' view: the bodies padded to two, the rows' normals on both (with one body
+    ! both walls hold body 1).
+    scene%pair%n = n
+    scene%pair%mass(1:n) = scene%body_mass
+    scene%pair%friction(1:n) = scene%body_friction
+    scene%pair%static_friction(1:n) = scene%body_static
+    scene%pair%normal = contact_normals(input)
+    ! Inputs of -0 enter as +0 (the limits too, in build_scene): sums over bodies and contacts
+    ! drop absent terms exactly only when nothing they meet is -0, and a root formula takes
+    ! the sign of a zero (docs/architecture.md, "Signed zeros").
+    scene%body_x0(1) = input%value(i_x1) + 0.0_wp
+    scene%body_v0 = 0.0_wp
+    if (input%given(i_v1)) scene%body_v0(1) = input%value(i_v1) + 0.0_wp
+    if (n == 2) then
+      scene%body_x0(2) = input%value(i_x2) + 0.0_wp
+      if (input%given(i_v2)) scene%body_v0(2) = input%value(i_v2) + 0.0_wp
+    end if
+    call scene%forcing%allocate_bodies(n)
+    do i = 1, n
+      if (input%given(i_f1 + i - 1)) scene%forcing%constant(i) = input%value(i_f1 + i - 1)
+      scene%forcing%has_table(i) = len_trim(input%text(i_f1_table + i - 1)%s) > 0
+      if (scene%forcing%has_table(i)) scene%forcing%table(i) = tables(i)
+      k = i_f1_amp + 3 * (i - 1)
+      scene%forcing%has_sine(i) = input%given(k)
+      if (scene%forcing%has_sine(i)) then
+        scene%forcing%amp(i) = input%value(k)
+        scene%forcing%omega(i) = 2.0_wp * acos(-1.0_wp) / input%value(k + 1)
+        if (input%given(k + 2)) scene%forcing%phase(i) = input%value(k + 2)
+      end if
+    end do
+    call scene%forcing%set_varies()
+  end subroutine set_bodies
+
   !> RK4's step against the modes of the springs and dampers (impact1d_stability): past the
   !> largest stable step the numbers would be garbage (positions to 1e76 with a normal exit),
   !> so the scene is refused; a stable step that is coarse for the fastest mode gets a warning
@@ -540,7 +573,7 @@ contains
     integer :: j
 
     call scene%springs%linear_part(scene%n_bodies, k, c)
-    call linear_modes(scene%mass(:scene%n_bodies), c, k, lambda, ok)
+    call linear_modes(scene%body_mass, c, k, lambda, ok)
     if (.not. ok) then
       call raise(error, status_input, 'the modes of the springs and dampers could not be found ' // &
         '(eigenvalues did not converge): please report the scene')
@@ -586,13 +619,16 @@ contains
   end function mode_text
 
   !> The spring or damper with the fastest rate of its own ('k12 = 1e4'): sqrt(k / m) or c / m
-  !> with m the mass it moves (the reduced mass between the bodies).
+  !> with m the mass it moves (the reduced mass between the bodies; the pair's masses as the
+  !> mode kernel sees them).
   pure function fastest_element(scene) result(text)
     type(scene_type), intent(in) :: scene
     character(len=fmt_width + 24) :: text     ! blank padded: callers trim
     real(wp) :: mass(n_elements), rate(2 * n_elements)
     integer :: j
-    mass = [scene%mass(1), scene%mass(2), 1.0_wp / (1.0_wp / scene%mass(1) + 1.0_wp / scene%mass(2))]
+    associate (m => scene%pair%mass)
+      mass = [m(1), m(2), 1.0_wp / (1.0_wp / m(1) + 1.0_wp / m(2))]
+    end associate
     rate = [sqrt(scene%springs%k / mass), scene%springs%c / mass]
     j = maxloc(rate, 1)
     if (j <= n_elements) then

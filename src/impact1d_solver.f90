@@ -15,8 +15,9 @@ module impact1d_solver
   use impact1d_output, only: sink_type, run_stats, emit_sample, checkpoint
   use impact1d_vissim, only: run_vissim
   use impact1d_interrupt, only: interrupt_count
-  use impact1d_state, only: state_type, renormalise, finite_state, constant_step, &
-    constant_steps, unpack_motion, pack_motion
+  use impact1d_state, only: state_type, lane_state_type, load_lanes, store_lanes, new_state, renormalise, &
+    finite_state, constant_step, constant_steps, add_compensated
+  use impact1d_lanes, only: max_lanes, to_lanes
   use impact1d_contacts, only: gap, gap_tolerance, u_tolerance
   use impact1d_stepping, only: rk4_type, book_constant_ledger, books_ledger
   use impact1d_location, only: watch_type, refine, constraints_hold
@@ -45,17 +46,24 @@ contains
     type(run_stats), intent(out) :: stats
     type(error_type), allocatable, intent(out) :: error
 
-    type(state_type) :: s, trial
+    type(state_type) :: s
     type(mode_type) :: mode
     type(rk4_type) :: rk
     type(watch_type) :: watch
     type(event_log_type) :: event_log
     type(stops_type) :: stops
-    real(wp) :: ke0, pe0, t_stop, window_start
+    real(wp) :: ke0, pe0, t_stop, window_start, x0(max_lanes)
     logical :: located, at_stop, glided, event_due
     integer :: watched, window_events
 
     stats%interrupt_epoch = interrupt_count()
+    ! The stepping kernels take the bodies in lanes (impact1d_lanes); scenes have no more
+    ! bodies than that until the cluster solver (issue 19, stage 4).
+    if (scene%n_bodies > max_lanes) then
+      call raise(error, status_simulation, 'internal: ' // trim(fmt(scene%n_bodies)) // ' bodies: the ' // &
+        'solver takes at most ' // trim(fmt(max_lanes)) // ' (N-body scenes need the cluster solver, issue 19)')
+      return
+    end if
     if (scene%method == 'vissim') then
       call run_vissim(scene, sink, stats, error)
       return
@@ -64,12 +72,16 @@ contains
     rk%polynomial_forcing = scene%forcing%is_polynomial() .and. .not. scene%springs%present
     rk%constant_forcing = .not. (any(scene%forcing%has_table) .or. any(scene%forcing%has_sine) .or. &
       scene%springs%present)
-    s%t = 0.0_wp
-    s%x = scene%x0
-    s%v = scene%v0
+    ! Every array of the run, once: nothing allocates per step.
+    call new_state(scene%n_bodies, s)
+    allocate(watch%quiet_body(scene%n_bodies))
+    call event_log%allocate_bodies(scene%n_bodies)
+    s%x(:) = scene%body_x0
+    s%v(:) = scene%body_v0
     ke0 = kinetic_energy(scene, s%v)
     pe0 = 0.0_wp
-    if (scene%springs%present) pe0 = scene%springs%potential(s%x, s%x_lo)
+    call to_lanes(scene%body_x0, x0)
+    if (scene%springs%present) pe0 = scene%springs%potential(x0, [0.0_wp, 0.0_wp])
     window_events = 0
     window_start = 0.0_wp
 
@@ -95,7 +107,7 @@ contains
       at_stop = glided
       if (.not. at_stop) then
         ! Locate and re-step: one step toward the stop, cut at the earliest event in it.
-        call advance(scene, mode, rk, watch, t_stop, s, trial, located, watched, at_stop, sink, stats, error)
+        call advance(scene, mode, rk, watch, t_stop, s, located, watched, at_stop, sink, stats, error)
         if (allocated(error)) return
       end if
 
@@ -148,25 +160,26 @@ contains
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
     type(error_type), allocatable, intent(out) :: error
+    type(lane_state_type) :: ls
     real(wp) :: pe
+    call load_lanes(s, ls)
     pe = 0.0_wp
-    if (scene%springs%present) pe = scene%springs%potential(s%x, s%x_lo)
-    call emit_sample(sink, stats, s%t, s%x, s%v, scene%mass, ke0, s%work, s%friction_loss, s%impact_loss, &
-      scene%springs%present, [pe, pe0, s%damping_loss], error)
+    if (scene%springs%present) pe = scene%springs%potential(ls%x, ls%x_lo)
+    call emit_sample(sink, stats, ls%t, ls%x, ls%v, scene%pair%mass, ke0, ls%work, ls%friction_loss, &
+      ls%impact_loss, scene%springs%present, [pe, pe0, ls%damping_loss], error)
     j_sample = j_sample + 1
   end subroutine emit
 
   !> One step from s toward t_stop, ended at the earliest event located in it (located,
   !> watched: what it found) or at the stop (at_stop). A step whose end breaks a constraint
   !> (a root the location missed: only possible for non-polynomial forcing) is retried shorter.
-  subroutine advance(scene, mode, rk, watch, t_stop, s, trial, located, watched, at_stop, sink, stats, error)
+  subroutine advance(scene, mode, rk, watch, t_stop, s, located, watched, at_stop, sink, stats, error)
     type(scene_type), intent(in) :: scene
     type(mode_type), intent(in) :: mode
     type(rk4_type), intent(inout) :: rk
     type(watch_type), intent(in) :: watch
     real(wp), intent(in) :: t_stop
     type(state_type), intent(inout) :: s
-    type(state_type), intent(inout) :: trial   !< scratch: the step's end (inout: no default init)
     logical, intent(out) :: located, at_stop
     integer, intent(out) :: watched
     class(sink_type), intent(inout) :: sink
@@ -174,7 +187,10 @@ contains
     type(error_type), allocatable, intent(inout) :: error
     real(wp) :: h, h_event
     integer :: halvings
+    ! The step's start and end in lanes: loaded from s once, the end stored back once.
+    type(lane_state_type) :: start, trial
 
+    call load_lanes(s, start)
     h = step_toward(scene, s, t_stop)
     halvings = 0
     do
@@ -182,26 +198,26 @@ contains
       watched = 0
       ! An event that landed exactly on the stop leaves nothing to step.
       if (h <= 0.0_wp) then
-        trial = s
+        trial = start
         exit
       end if
-      call rk%step(scene, mode, s, h, trial)
+      call rk%step(scene, mode, start, h, trial)
       if (.not. watch%watching) exit      ! nothing in this mode can end it: no location needed
-      call watch%locate(scene, mode, rk%constant_forcing, rk%polynomial_forcing, s, trial, h, h_event, watched)
+      call watch%locate(scene, mode, rk%constant_forcing, rk%polynomial_forcing, start, trial, h, h_event, watched)
       located = h_event <= h
       if (located) then
         h = h_event
         if (h > 0.0_wp) then
-          call refine(rk, scene, mode, s, h, watched, trial)
+          call refine(rk, scene, mode, start, h, watched, trial)
         else
-          trial = s     ! the event is at the step's start: nothing to step
+          trial = start     ! the event is at the step's start: nothing to step
           exit
         end if
       end if
       ! Under polynomial forcing the dense output is exact and nothing can be missed; only
       ! a sine's approximate dense output needs the step's end checked.
       if (rk%polynomial_forcing) exit
-      if (constraints_hold(scene, mode, s, trial, merge(watched, 0, located))) exit
+      if (constraints_hold(scene, mode, start, trial, merge(watched, 0, located))) exit
       halvings = halvings + 1
       if (halvings > max_halvings) then
         call raise(error, status_simulation, 'at t = ' // trim(fmt(s%t)) // &
@@ -212,7 +228,7 @@ contains
     end do
 
     at_stop = .not. located .and. h == (t_stop - s%t) - s%t_lo
-    s = trial
+    call store_lanes(trial, s)
     if (at_stop) then
       s%t = t_stop
       s%t_lo = 0.0_wp
@@ -275,130 +291,179 @@ contains
     type(run_stats), intent(inout) :: stats
     logical, intent(out) :: at_stop      !< the steps reached the stop (stops say which)
     type(error_type), allocatable, intent(inout) :: error
-    real(wp) :: t_quiet, t_stop, h, t, t_lo, x(2), x_lo(2), v(2), v_lo(2), dv(2), half_dv(2)
-    real(wp) :: x_start(2), x_lo_start(2)
-    integer(int64) :: n_bulk, n
+    real(wp) :: t_quiet, t_stop, h, x_start(max_lanes), x_lo_start(max_lanes)
+    integer(int64) :: n_bulk
+    ! The state in lanes through the glide: loaded once, stored back once.
+    type(lane_state_type) :: ls
 
-    t_quiet = minval(watch%quiet_until)
+    at_stop = .false.
+    t_quiet = watch%quiet_time()
+    call load_lanes(s, ls)
     ! Samples a step apart take a loop of their own.
-    call step_to_samples(scene, mode, rk, t_quiet, ke0, pe0, stops, s, sink, stats, error)
-    if (allocated(error)) return
+    call step_to_samples(scene, mode, rk, t_quiet, ke0, pe0, stops, ls, sink, stats, error)
+    if (allocated(error)) then
+      call store_lanes(ls, s)
+      return
+    end if
     do
       at_stop = .false.
       t_stop = min(stops%sample_t, stops%t_break, stops%t_rest)
-      if (s%t + step_toward(scene, s, t_stop) >= t_quiet) return
-      x_start = s%x
-      x_lo_start = s%x_lo
+      if (ls%t + step_length(scene%dt, (t_stop - ls%t) - ls%t_lo) >= t_quiet) exit
+      x_start = ls%x
+      x_lo_start = ls%x_lo
       ! Whole steps of dt ending at least a step short of the stop and the quiet time
       ! (capped where the count would not fit an integer: such a run never ends anyway).
       ! No bulk for a stop within two steps, as with a sample every step (the state is left
       ! as it is: renormalising an already normalised sum changes no bit); below 1.5 steps
       ! the count is 0 without the division.
       n_bulk = 0
-      if ((t_stop - s%t) - s%t_lo >= 1.5_wp * scene%dt) n_bulk = &
-        int(min(min((t_stop - s%t) - s%t_lo, t_quiet - s%t) / scene%dt, 1.0e18_wp), int64) - 1
-      if (n_bulk > 0) then
-        h = scene%dt
-        dv = h * rk%constant_acceleration
-        half_dv = 0.5_wp * dv
-        call unpack_motion(s, t, t_lo, x, x_lo, v, v_lo)
-        do while (n_bulk > 0)
-          ! In runs of up to the next progress report.
-          n = min(n_bulk, 4096_int64 - iand(stats%steps, 4095_int64))
-          call constant_steps(n, h, dv, half_dv, t, t_lo, x, x_lo, v, v_lo)
-          n_bulk = n_bulk - n
-          stats%steps = stats%steps + n
-          if (iand(stats%steps, 4095_int64) == 0) then
-            call checkpoint(sink, stats, t, scene%t_end, error)
-            if (allocated(error)) return       ! (an interrupt: the state is left as it is)
-          end if
-        end do
-        call renormalise(t, t_lo)
-        call renormalise(x, x_lo)
-        call renormalise(v, v_lo)
-        call pack_motion(t, t_lo, x, x_lo, v, v_lo, s)
-      end if
+      if ((t_stop - ls%t) - ls%t_lo >= 1.5_wp * scene%dt) n_bulk = &
+        int(min(min((t_stop - ls%t) - ls%t_lo, t_quiet - ls%t) / scene%dt, 1.0e18_wp), int64) - 1
+      if (n_bulk > 0) call bulk_steps(scene, rk, n_bulk, ls, sink, stats, error)
+      if (allocated(error)) exit       ! (an interrupt: the run ends here)
       ! The last steps: to the stop by the step rule, while they stay quiet.
       do
-        h = step_toward(scene, s, t_stop)
-        if (h <= 0.0_wp .or. s%t + h >= t_quiet) exit
-        at_stop = h == (t_stop - s%t) - s%t_lo
-        call rk%advance_constant(s, h)
+        h = step_length(scene%dt, (t_stop - ls%t) - ls%t_lo)
+        if (h <= 0.0_wp .or. ls%t + h >= t_quiet) exit
+        at_stop = h == (t_stop - ls%t) - ls%t_lo
+        call add_compensated(ls%t, ls%t_lo, h)
+        call constant_step(h, rk%constant_acceleration, ls%x, ls%x_lo, ls%v, ls%v_lo)
         stats%steps = stats%steps + 1
         if (iand(stats%steps, 4095_int64) == 0) then
-          call checkpoint(sink, stats, s%t, scene%t_end, error)
-          if (allocated(error)) return
+          call checkpoint(sink, stats, ls%t, scene%t_end, error)
+          if (allocated(error)) exit
         end if
         if (at_stop) then
-          s%t = t_stop
-          s%t_lo = 0.0_wp
+          ls%t = t_stop
+          ls%t_lo = 0.0_wp
           exit
         end if
       end do
-      call book_constant_ledger(scene, mode, x_start, x_lo_start, s%x, s%x_lo, s)
-      call check_finite(s, error)
-      if (allocated(error)) return
-      if (.not. (at_stop .and. quiet_sample(scene, stops, t_stop))) return
-      call emit(scene, s, ke0, pe0, stops%j_sample, sink, stats, error)
-      if (allocated(error)) return
+      if (allocated(error)) exit
+      call book_constant_ledger(scene, mode, x_start, x_lo_start, ls%x, ls%x_lo, ls%work, ls%work_lo, &
+        ls%friction_loss, ls%friction_lo)
+      if (.not. finite_state(ls%x, ls%v, ls%work)) then
+        call raise_not_finite(ls%t, error)
+        exit
+      end if
+      if (.not. (at_stop .and. quiet_sample(scene, stops, t_stop))) exit
+      call emit_lanes(scene, ls, ke0, pe0, stops, sink, stats, error)
+      if (allocated(error)) exit
       stops%sample_t = sample_time(scene, stops%j_sample)
     end do
+    call store_lanes(ls, s)
   end subroutine glide
+
+  !> n_bulk steps of dt under the mode's constant acceleration (constant_steps), in runs of
+  !> up to the next progress report; renormalised once at the end. In lanes: the loop keeps
+  !> the bodies in registers (3 ns a step; on the state's arrays the compiler spilled a
+  !> running sum to memory and a step took 4.5 ns).
+  subroutine bulk_steps(scene, rk, n_bulk, ls, sink, stats, error)
+    type(scene_type), intent(in) :: scene
+    type(rk4_type), intent(in) :: rk
+    integer(int64), intent(in) :: n_bulk
+    type(lane_state_type), intent(inout) :: ls
+    class(sink_type), intent(inout) :: sink
+    type(run_stats), intent(inout) :: stats
+    type(error_type), allocatable, intent(inout) :: error
+    real(wp) :: h, t, t_lo, x(max_lanes), x_lo(max_lanes), v(max_lanes), v_lo(max_lanes)
+    real(wp) :: dv(max_lanes), half_dv(max_lanes)
+    integer(int64) :: left, n
+    h = scene%dt
+    dv = h * rk%constant_acceleration
+    half_dv = 0.5_wp * dv
+    ! Plain local copies: the compiler keeps them in registers through the loop.
+    t = ls%t
+    t_lo = ls%t_lo
+    x = ls%x
+    x_lo = ls%x_lo
+    v = ls%v
+    v_lo = ls%v_lo
+    left = n_bulk
+    do while (left > 0)
+      n = min(left, 4096_int64 - iand(stats%steps, 4095_int64))
+      call constant_steps(n, h, dv, half_dv, t, t_lo, x, x_lo, v, v_lo)
+      left = left - n
+      stats%steps = stats%steps + n
+      if (iand(stats%steps, 4095_int64) == 0) then
+        call checkpoint(sink, stats, t, scene%t_end, error)
+        if (allocated(error)) return       ! (an interrupt: the run ends, the state as it was)
+      end if
+    end do
+    call renormalise(t, t_lo)
+    call renormalise(x, x_lo)
+    call renormalise(v, v_lo)
+    ls%t = t
+    ls%t_lo = t_lo
+    ls%x = x
+    ls%x_lo = x_lo
+    ls%v = v
+    ls%v_lo = v_lo
+  end subroutine bulk_steps
+
+  !> Sample j_sample of the run from a state in lanes (a glide's: no springs, so no potential
+  !> energy); then the next one is due.
+  subroutine emit_lanes(scene, ls, ke0, pe0, stops, sink, stats, error)
+    type(scene_type), intent(in) :: scene
+    type(lane_state_type), intent(in) :: ls
+    real(wp), intent(in) :: ke0, pe0
+    type(stops_type), intent(inout) :: stops
+    class(sink_type), intent(inout) :: sink
+    type(run_stats), intent(inout) :: stats
+    type(error_type), allocatable, intent(out) :: error
+    ! In lanes with the pair's masses (an idle lane: x2 = v2 = 0 and no kinetic energy, the
+    ! columns a one-body scene's sinks leave out).
+    call emit_sample(sink, stats, ls%t, ls%x, ls%v, scene%pair%mass, ke0, ls%work, ls%friction_loss, &
+      ls%impact_loss, .false., [0.0_wp, pe0, 0.0_wp], error)
+    stops%j_sample = stops%j_sample + 1
+  end subroutine emit_lanes
 
   !> Quiet samples one step apart (dt_out = dt, as in the tutorial's scenes), each stop a
   !> single step from the last: with glide's per-stop set-up a step cost ~17 ns, here ~10
-  !> (samples aside), so they take this loop, with t, x and v in local variables and the state written back at
-  !> the end. The step (constant_step), the ledger and the sample are glide's: the same
-  !> bits. Scenes here have no springs (constant forces), so the sample has no potential
-  !> energy. Returns at the first stop that is not such a sample.
-  subroutine step_to_samples(scene, mode, rk, t_quiet, ke0, pe0, stops, s, sink, stats, error)
+  !> (samples aside), so they take this loop. The step (constant_step), the ledger and the
+  !> sample are glide's: the same bits. Scenes here have no springs (constant forces), so
+  !> the sample has no potential energy. Returns at the first stop that is not such a sample.
+  subroutine step_to_samples(scene, mode, rk, t_quiet, ke0, pe0, stops, ls, sink, stats, error)
     type(scene_type), intent(in) :: scene
     type(mode_type), intent(in) :: mode
     type(rk4_type), intent(in) :: rk
     real(wp), intent(in) :: t_quiet, ke0, pe0
     type(stops_type), intent(inout) :: stops
-    type(state_type), intent(inout) :: s
+    type(lane_state_type), intent(inout) :: ls
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
     type(error_type), allocatable, intent(inout) :: error
-    real(wp) :: t_stop, remaining, h, a(2), t, t_lo, x(2), x_lo(2), v(2), v_lo(2)
+    real(wp) :: t_stop, remaining, h, x_start(max_lanes), x_lo_start(max_lanes)
     logical :: books
 
-    a = rk%constant_acceleration
     books = books_ledger(scene, mode)
-    call unpack_motion(s, t, t_lo, x, x_lo, v, v_lo)
     do
       t_stop = min(stops%sample_t, stops%t_break, stops%t_rest)
       if (.not. quiet_sample(scene, stops, t_stop)) exit
-      remaining = (t_stop - t) - t_lo
+      remaining = (t_stop - ls%t) - ls%t_lo
       h = step_length(scene%dt, remaining)
-      if (h /= remaining .or. h <= 0.0_wp .or. t + h >= t_quiet) exit
-      call constant_step(h, a, x, x_lo, v, v_lo)
-      t = t_stop        ! (the step ends at the stop: the clock is set to it, as in glide)
-      t_lo = 0.0_wp
+      if (h /= remaining .or. h <= 0.0_wp .or. ls%t + h >= t_quiet) exit
+      x_start = ls%x
+      x_lo_start = ls%x_lo
+      call constant_step(h, rk%constant_acceleration, ls%x, ls%x_lo, ls%v, ls%v_lo)
+      ls%t = t_stop        ! (the step ends at the stop: the clock is set to it, as in glide)
+      ls%t_lo = 0.0_wp
       stats%steps = stats%steps + 1
       if (iand(stats%steps, 4095_int64) == 0) then
-        call checkpoint(sink, stats, t, scene%t_end, error)
+        call checkpoint(sink, stats, ls%t, scene%t_end, error)
         if (allocated(error)) exit
       end if
-      if (books) then
-        ! (s%x: where the last step began.)
-        call book_constant_ledger(scene, mode, s%x, s%x_lo, x, x_lo, s)
-        s%x = x
-        s%x_lo = x_lo
-      end if
-      call emit_sample(sink, stats, t, x, v, scene%mass, ke0, s%work, s%friction_loss, s%impact_loss, &
-        .false., [0.0_wp, pe0, 0.0_wp], error)
+      if (books) call book_constant_ledger(scene, mode, x_start, x_lo_start, ls%x, ls%x_lo, ls%work, ls%work_lo, &
+        ls%friction_loss, ls%friction_lo)
+      call emit_lanes(scene, ls, ke0, pe0, stops, sink, stats, error)
       if (allocated(error)) then
         ! The sample's row is checked whole (checking the state first cost ~15% of this
         ! loop); a state that is not finite is named as glide names it.
-        if (.not. finite_state(x, v, s%work)) call raise_not_finite(t, error)
+        if (.not. finite_state(ls%x, ls%v, ls%work)) call raise_not_finite(ls%t, error)
         exit
       end if
-      stops%j_sample = stops%j_sample + 1
       stops%sample_t = sample_time(scene, stops%j_sample)
     end do
-    call pack_motion(t, t_lo, x, x_lo, v, v_lo, s)
   end subroutine step_to_samples
 
   subroutine check_finite(s, error)
@@ -421,11 +486,14 @@ contains
     type(mode_type), intent(in) :: mode
     type(state_type), intent(in) :: s
     integer :: k
+    type(lane_state_type) :: m
+    real(wp), parameter :: no_scale(max_lanes) = 0.0_wp
     impact_due = .false.
+    call load_lanes(s, m)
     do k = 1, n_contacts
-      if (.not. scene%has_contact(k) .or. mode%active(k)) cycle
-      if (gap(scene, k, s) <= gap_tolerance(scene, k, s, 0.0_wp) .and. &
-          normal_velocity(scene, k, s%v) < -u_tolerance(scene, mode, s, k, [0.0_wp, 0.0_wp])) impact_due = .true.
+      if (.not. scene%row_present(k) .or. mode%active(k)) cycle
+      if (gap(scene, k, m) <= gap_tolerance(scene, k, m, 0.0_wp) .and. &
+          normal_velocity(scene, k, m%v) < -u_tolerance(scene, mode, m, k, no_scale)) impact_due = .true.
     end do
   end function impact_due
 end module impact1d_solver

@@ -1,27 +1,51 @@
-!> The compensated state of the two bodies (METHOD.md 3) and its arithmetic: time,
+!> The compensated state of the bodies (METHOD.md 3) and its arithmetic: time,
 !> positions, velocities and the ledger integrals are sums of many step increments, each
 !> kept as a value and its rounding error (the _lo parts).
 module impact1d_state
   use, intrinsic :: iso_fortran_env, only: int64
   use impact1d_kinds, only: wp
+  use impact1d_lanes, only: max_lanes
   implicit none
   private
-  public :: state_type, add_compensated, accumulate, renormalise, finite_state, constant_step, &
-    constant_steps, unpack_motion, pack_motion
+  public :: state_type, lane_state_type, load_lanes, store_lanes, new_state, add_compensated, accumulate, &
+    renormalise, finite_state, constant_step, constant_steps
 
   !> Time, positions, velocities and the ledger integrals, compensated: a micrometre bounce
   !> near a wall at x = 10 m keeps its digits, and 10^6 steps of 1e-5 s do not drift the clock
   !> by 1e-10 s. This is what keeps polynomial scenes at rounding error whatever the step count.
   type :: state_type
     real(wp) :: t = 0.0_wp, t_lo = 0.0_wp
-    real(wp) :: x(2) = 0.0_wp, x_lo(2) = 0.0_wp, v(2) = 0.0_wp, v_lo(2) = 0.0_wp
+    real(wp), allocatable :: x(:), x_lo(:), v(:), v_lo(:)   !< (N) positions, velocities
     real(wp) :: work = 0.0_wp, work_lo = 0.0_wp, friction_loss = 0.0_wp, friction_lo = 0.0_wp
     real(wp) :: impact_loss = 0.0_wp
     !> What the dampers dissipated (scenes with dampers only).
     real(wp) :: damping_loss = 0.0_wp, damping_lo = 0.0_wp
   end type state_type
 
+  !> A state in lanes (impact1d_lanes' max_lanes; a lane past N idle at 0): what a step and
+  !> its location work on. advance loads it from the run's state once and stores it back
+  !> once; fixed-size, it needs no descriptors and holds two bodies in one register.
+  type :: lane_state_type
+    real(wp) :: t = 0.0_wp, t_lo = 0.0_wp
+    real(wp), dimension(max_lanes) :: x = 0.0_wp, x_lo = 0.0_wp, v = 0.0_wp, v_lo = 0.0_wp
+    real(wp) :: work = 0.0_wp, work_lo = 0.0_wp, friction_loss = 0.0_wp, friction_lo = 0.0_wp
+    real(wp) :: impact_loss = 0.0_wp
+    real(wp) :: damping_loss = 0.0_wp, damping_lo = 0.0_wp
+  end type lane_state_type
+
 contains
+
+  !> The state of n bodies at rest at 0, at t = 0 (the run's one allocation of it).
+  pure subroutine new_state(n, s)
+    integer, intent(in) :: n
+    type(state_type), intent(inout) :: s
+    if (allocated(s%x)) deallocate(s%x, s%x_lo, s%v, s%v_lo)
+    allocate(s%x(n), s%x_lo(n), s%v(n), s%v_lo(n))
+    s%x = 0.0_wp
+    s%x_lo = 0.0_wp
+    s%v = 0.0_wp
+    s%v_lo = 0.0_wp
+  end subroutine new_state
 
   !> hi + lo += increment: the exact rounding error of hi + increment (Knuth's two-sum, valid
   !> whichever is larger) goes into lo; then hi takes what of lo it can hold (Fast2Sum), so
@@ -60,8 +84,8 @@ contains
   !> renormalised. On the parts, not the state, so that a loop can keep them in registers;
   !> the clock is the caller's (a step to a stop sets it to the stop).
   pure subroutine constant_step(h, a, x, x_lo, v, v_lo)
-    real(wp), intent(in) :: h, a(2)
-    real(wp), intent(inout) :: x(2), x_lo(2), v(2), v_lo(2)
+    real(wp), intent(in) :: h, a(max_lanes)
+    real(wp), dimension(max_lanes), intent(inout) :: x, x_lo, v, v_lo
     call add_compensated(x, x_lo, h * ((v + v_lo) + (0.5_wp * h) * a))
     call add_compensated(v, v_lo, h * a)
   end subroutine constant_step
@@ -69,13 +93,15 @@ contains
   !> n steps of h under the constant velocity change dv per step (half_dv = dv / 2): RK4's
   !> closed form, the sums accumulated but not renormalised (the low parts carry the
   !> rounding meanwhile; the caller renormalises once at the end). Kept here, next to
-  !> accumulate, so the compiler inlines it into this hottest loop.
+  !> accumulate, so the compiler inlines it into this hottest loop. The bodies in max_lanes
+  !> lanes (fixed-size arrays, unpack_motion's): the compiler keeps them in registers
+  !> through the loop and takes the lanes' chains of additions side by side.
   pure subroutine constant_steps(n, h, dv, half_dv, t, t_lo, x, x_lo, v, v_lo)
     integer(int64), intent(in) :: n
-    real(wp), intent(in) :: h, dv(2), half_dv(2)
-    real(wp), intent(inout) :: t, t_lo, x(2), x_lo(2), v(2), v_lo(2)
+    real(wp), intent(in) :: h, dv(max_lanes), half_dv(max_lanes)
+    real(wp), intent(inout) :: t, t_lo, x(max_lanes), x_lo(max_lanes), v(max_lanes), v_lo(max_lanes)
     integer(int64) :: j
-    real(wp) :: t_, t_lo_, x_(2), x_lo_(2), v_(2), v_lo_(2)
+    real(wp) :: t_, t_lo_, x_(max_lanes), x_lo_(max_lanes), v_(max_lanes), v_lo_(max_lanes)
     ! Local copies: the compiler keeps them in registers through the loop.
     t_ = t
     t_lo_ = t_lo
@@ -96,33 +122,57 @@ contains
     v_lo = v_lo_
   end subroutine constant_steps
 
-  !> A state's clock, positions and velocities with their low parts as plain variables,
-  !> which a loop of steps keeps in registers (pack_motion puts them back).
-  pure subroutine unpack_motion(s, t, t_lo, x, x_lo, v, v_lo)
+  !> ls = s in lanes (a lane past N at 0). Lane by lane in a loop of max_lanes trips: moves
+  !> the compiler unrolls (a loop of N trips became calls to memcpy).
+  pure subroutine load_lanes(s, ls)
     type(state_type), intent(in) :: s
-    real(wp), intent(out) :: t, t_lo, x(2), x_lo(2), v(2), v_lo(2)
-    t = s%t
-    t_lo = s%t_lo
-    x = s%x
-    x_lo = s%x_lo
-    v = s%v
-    v_lo = s%v_lo
-  end subroutine unpack_motion
+    type(lane_state_type), intent(out) :: ls
+    integer :: i
+    ls%t = s%t
+    ls%t_lo = s%t_lo
+    do i = 1, max_lanes
+      if (i > size(s%x)) exit
+      ls%x(i) = s%x(i)
+      ls%x_lo(i) = s%x_lo(i)
+      ls%v(i) = s%v(i)
+      ls%v_lo(i) = s%v_lo(i)
+    end do
+    ls%work = s%work
+    ls%work_lo = s%work_lo
+    ls%friction_loss = s%friction_loss
+    ls%friction_lo = s%friction_lo
+    ls%impact_loss = s%impact_loss
+    ls%damping_loss = s%damping_loss
+    ls%damping_lo = s%damping_lo
+  end subroutine load_lanes
 
-  pure subroutine pack_motion(t, t_lo, x, x_lo, v, v_lo, s)
-    real(wp), intent(in) :: t, t_lo, x(2), x_lo(2), v(2), v_lo(2)
+  !> s = ls (its N bodies).
+  pure subroutine store_lanes(ls, s)
+    type(lane_state_type), intent(in) :: ls
     type(state_type), intent(inout) :: s
-    s%t = t
-    s%t_lo = t_lo
-    s%x = x
-    s%x_lo = x_lo
-    s%v = v
-    s%v_lo = v_lo
-  end subroutine pack_motion
+    integer :: i
+    s%t = ls%t
+    s%t_lo = ls%t_lo
+    do i = 1, max_lanes
+      if (i > size(s%x)) exit
+      s%x(i) = ls%x(i)
+      s%x_lo(i) = ls%x_lo(i)
+      s%v(i) = ls%v(i)
+      s%v_lo(i) = ls%v_lo(i)
+    end do
+    s%work = ls%work
+    s%work_lo = ls%work_lo
+    s%friction_loss = ls%friction_loss
+    s%friction_lo = ls%friction_lo
+    s%impact_loss = ls%impact_loss
+    s%damping_loss = ls%damping_loss
+    s%damping_lo = ls%damping_lo
+  end subroutine store_lanes
 
   !> All of the state a run reports is finite.
   pure logical function finite_state(x, v, work)
-    real(wp), intent(in) :: x(2), v(2), work
+    real(wp), intent(in) :: work
+    real(wp), contiguous, intent(in) :: x(:), v(:)
     finite_state = all(abs(x) <= huge(1.0_wp)) .and. all(abs(v) <= huge(1.0_wp)) .and. &
       abs(work) <= huge(1.0_wp)
   end function finite_state

@@ -5,53 +5,46 @@ module impact1d_stepping
   use impact1d_scene, only: scene_type
   use impact1d_modes, only: mode_type
   use impact1d_events, only: hermite
-  use impact1d_state, only: state_type, add_compensated, constant_step
+  use impact1d_lanes, only: max_lanes
+  use impact1d_state, only: lane_state_type, add_compensated, constant_step
   implicit none
   private
   public :: rk4_type, book_constant_ledger, books_ledger, dense_output
 
-  !> What the integrator keeps between steps.
+  !> What the integrator keeps between steps, in lanes (impact1d_lanes' max_lanes: a lane past
+  !> N idle at 0).
   type :: rk4_type
     !> No table, no sine: the forces are constant and so is each mode's acceleration.
     logical :: constant_forcing = .false.
     !> Tables and constants: the dense output is exact, so no root can be missed.
     logical :: polynomial_forcing = .false.
     !> The mode's acceleration under constant forces, worked out once at the event point.
-    real(wp) :: constant_acceleration(2) = 0.0_wp
+    real(wp) :: constant_acceleration(max_lanes) = 0.0_wp
     !> The force at the end of the last step taken, and when: the next step's start force.
-    real(wp) :: end_force(2) = 0.0_wp, end_force_t = -huge(1.0_wp)
+    real(wp) :: end_force(max_lanes) = 0.0_wp, end_force_t = -huge(1.0_wp)
     !> With springs the force depends on the state too: the state it was evaluated in.
-    real(wp) :: end_x(2) = 0.0_wp, end_x_lo(2) = 0.0_wp, end_v(2) = 0.0_wp, end_v_lo(2) = 0.0_wp
-    real(wp) :: end_external(2) = 0.0_wp   !< and its external (time-only) part
+    real(wp), dimension(max_lanes) :: end_x = 0.0_wp, end_x_lo = 0.0_wp, end_v = 0.0_wp, end_v_lo = 0.0_wp
+    real(wp) :: end_external(max_lanes) = 0.0_wp   !< and its external (time-only) part
   contains
     procedure :: step => rk4_step
-    procedure :: advance_constant
   end type rk4_type
 
 contains
 
-  !> One step of the mode under constant acceleration: RK4 is exact there, and its step is
-  !> the quadratic x + h v + h^2 a / 2, v + h a.
-  pure subroutine advance_constant(self, state, step)
-    class(rk4_type), intent(in) :: self
-    type(state_type), intent(inout) :: state
-    real(wp), intent(in) :: step
-    call add_compensated(state%t, state%t_lo, step)
-    call constant_step(step, self%constant_acceleration, state%x, state%x_lo, state%v, state%v_lo)
-  end subroutine advance_constant
-
   !> Under constant forces the work and the friction loss over any stretch of one mode are
-  !> the forces times the displacement, exactly (no quadrature): from x_a to x_b, into s.
-  pure subroutine book_constant_ledger(scene, mode, x_a, x_lo_a, x_b, x_lo_b, s)
+  !> the forces times the displacement, exactly (no quadrature): from x_a to x_b, into the
+  !> ledger (work, friction_loss with their low parts).
+  pure subroutine book_constant_ledger(scene, mode, x_a, x_lo_a, x_b, x_lo_b, work, work_lo, friction_loss, &
+      friction_lo)
     type(scene_type), intent(in) :: scene
     type(mode_type), intent(in) :: mode
-    real(wp), intent(in) :: x_a(2), x_lo_a(2), x_b(2), x_lo_b(2)
-    type(state_type), intent(inout) :: s
-    real(wp) :: dx(2)
+    real(wp), dimension(max_lanes), intent(in) :: x_a, x_lo_a, x_b, x_lo_b   !< in lanes
+    real(wp), intent(inout) :: work, work_lo, friction_loss, friction_lo
+    real(wp) :: dx(max_lanes)
     if (.not. books_ledger(scene, mode)) return
     dx = (x_b - x_a) + (x_lo_b - x_lo_a)
-    call add_compensated(s%work, s%work_lo, dot_product(scene%forcing%constant, dx))
-    call add_compensated(s%friction_loss, s%friction_lo, -dot_product(mode%f_slide, dx))
+    call add_compensated(work, work_lo, dot_product(scene%forcing%constant_lanes, dx))
+    call add_compensated(friction_loss, friction_lo, -dot_product(mode%f_slide, dx))
   end subroutine book_constant_ledger
 
   !> Whether a stretch of this mode under constant forces has work or friction to book: not
@@ -60,20 +53,20 @@ contains
   pure logical function books_ledger(scene, mode)
     type(scene_type), intent(in) :: scene
     type(mode_type), intent(in) :: mode
-    books_ledger = any(scene%forcing%constant /= 0.0_wp) .or. any(mode%f_slide /= 0.0_wp)
+    books_ledger = any(scene%forcing%constant_lanes /= 0.0_wp) .or. any(mode%f_slide /= 0.0_wp)
   end function books_ledger
 
-  !> One classical RK4 step of the mode's equations from a to b; the energy ledger by
-  !> Simpson's rule on the step's Hermite velocity, exact where RK4 is (polynomial forcing).
+  !> One classical RK4 step of the mode's equations from a to b (states in lanes: an idle
+  !> lane adds +0 to the ledger's sums); the energy ledger by Simpson's rule on the step's
+  !> Hermite velocity, exact where RK4 is (polynomial forcing).
   subroutine rk4_step(self, scene, mode, a, step, b)
     class(rk4_type), intent(inout) :: self
     type(scene_type), intent(in) :: scene
     type(mode_type), intent(in) :: mode
-    type(state_type), intent(in) :: a
+    type(lane_state_type), intent(in) :: a
     real(wp), intent(in) :: step
-    type(state_type), intent(inout) :: b     ! all of it is set (inout: no default init)
-    real(wp) :: f0(2), fm(2), f1(2), a0(2), am(2), a1(2)
-    real(wp) :: v0(2), vm(2)
+    type(lane_state_type), intent(out) :: b
+    real(wp), dimension(max_lanes) :: f0, fm, f1, a0, am, a1, v0, vm
     if (scene%springs%present) then
       call state_dependent_step(self, scene, mode, a, step, b)
       return
@@ -81,8 +74,10 @@ contains
     b = a
     if (self%constant_forcing) then
       ! The mode's acceleration was worked out once, at the event point.
-      call self%advance_constant(b, step)
-      call book_constant_ledger(scene, mode, a%x, a%x_lo, b%x, b%x_lo, b)
+      call add_compensated(b%t, b%t_lo, step)
+      call constant_step(step, self%constant_acceleration, b%x, b%x_lo, b%v, b%v_lo)
+      call book_constant_ledger(scene, mode, a%x, a%x_lo, b%x, b%x_lo, b%work, b%work_lo, b%friction_loss, &
+        b%friction_lo)
       return
     end if
     ! A step's end force is the next step's start force: evaluated once (a sine costs).
@@ -90,16 +85,16 @@ contains
     if (a%t == self%end_force_t) then
       f0 = self%end_force
     else
-      f0 = scene%forcing%force(a%t)
+      call scene%forcing%force(a%t, f0)
     end if
-    fm = scene%forcing%force(a%t + 0.5_wp * step)
-    f1 = scene%forcing%force(b%t)
+    call scene%forcing%force(a%t + 0.5_wp * step, fm)
+    call scene%forcing%force(b%t, f1)
     self%end_force_t = b%t
     self%end_force = f1
     ! Within a mode the acceleration depends on time only, so stages 2 and 3 share it.
-    a0 = mode%acceleration(f0)
-    am = mode%acceleration(fm)
-    a1 = mode%acceleration(f1)
+    call mode%acceleration(f0, a0)
+    call mode%acceleration(fm, am)
+    call mode%acceleration(f1, a1)
     ! RK4's stages collapse (the acceleration does not depend on the state): x gains
     ! h v + h^2/6 (a0 + 2 am) and v gains h/6 (a0 + 4 am + a1).
     v0 = a%v + a%v_lo
@@ -120,13 +115,15 @@ contains
     class(rk4_type), intent(inout) :: self
     type(scene_type), intent(in) :: scene
     type(mode_type), intent(in) :: mode
-    type(state_type), intent(in) :: a
+    type(lane_state_type), intent(in) :: a
     real(wp), intent(in) :: step
-    type(state_type), intent(inout) :: b
-    real(wp) :: kx(2, 4), kv(2, 4), v0(2), v1(2), vm(2), f(2), acc_end(2), half
+    type(lane_state_type), intent(out) :: b
+    real(wp) :: half
+    real(wp), dimension(max_lanes) :: v0, v1, vm, f, load, acc_end, dx
+    real(wp), dimension(max_lanes) :: kx1, kx2, kx3, kx4, kv1, kv2, kv3, kv4
     ! The external forces at the step's start, middle and end (stages 2 and 3 share the
     ! middle's): evaluated once each and used by the stages and by the work's quadrature.
-    real(wp) :: f0(2), fm(2), f1(2)
+    real(wp), dimension(max_lanes) :: f0, fm, f1
     half = 0.5_wp * step
     v0 = a%v + a%v_lo
     if (a%t == self%end_force_t .and. all(a%x == self%end_x) .and. all(a%x_lo == self%end_x_lo) &
@@ -134,26 +131,39 @@ contains
       f0 = self%end_external
       f = self%end_force
     else
-      f0 = scene%forcing%force(a%t)
-      f = f0 + scene%springs%force(a%x, a%x_lo, v0)
+      call scene%forcing%force(a%t, f0)
+      f = f0
+      call scene%springs%add_force(a%x, a%x_lo, v0, f)
     end if
-    fm = scene%forcing%force(a%t + half)
-    f1 = scene%forcing%force(a%t + step)
-    kx(:, 1) = v0
-    kv(:, 1) = mode%acceleration(f)
-    kx(:, 2) = v0 + half * kv(:, 1)
-    kv(:, 2) = mode%acceleration(fm + scene%springs%force(a%x, a%x_lo + half * kx(:, 1), kx(:, 2)))
-    kx(:, 3) = v0 + half * kv(:, 2)
-    kv(:, 3) = mode%acceleration(fm + scene%springs%force(a%x, a%x_lo + half * kx(:, 2), kx(:, 3)))
-    kx(:, 4) = v0 + step * kv(:, 3)
-    kv(:, 4) = mode%acceleration(f1 + scene%springs%force(a%x, a%x_lo + step * kx(:, 3), kx(:, 4)))
+    call scene%forcing%force(a%t + half, fm)
+    call scene%forcing%force(a%t + step, f1)
+    ! The stages: velocities kx, accelerations kv (each stage's displacement named: an
+    ! expression as an argument was packed at each call).
+    kx1 = v0
+    call mode%acceleration(f, kv1)
+    kx2 = v0 + half * kv1
+    dx = a%x_lo + half * kx1
+    load = fm
+    call scene%springs%add_force(a%x, dx, kx2, load)
+    call mode%acceleration(load, kv2)
+    kx3 = v0 + half * kv2
+    dx = a%x_lo + half * kx2
+    load = fm
+    call scene%springs%add_force(a%x, dx, kx3, load)
+    call mode%acceleration(load, kv3)
+    kx4 = v0 + step * kv3
+    dx = a%x_lo + step * kx3
+    load = f1
+    call scene%springs%add_force(a%x, dx, kx4, load)
+    call mode%acceleration(load, kv4)
     b = a
     call add_compensated(b%t, b%t_lo, step)
-    call add_compensated(b%x, b%x_lo, (step / 6.0_wp) * (kx(:, 1) + 2.0_wp * (kx(:, 2) + kx(:, 3)) + kx(:, 4)))
-    call add_compensated(b%v, b%v_lo, (step / 6.0_wp) * (kv(:, 1) + 2.0_wp * (kv(:, 2) + kv(:, 3)) + kv(:, 4)))
+    call add_compensated(b%x, b%x_lo, (step / 6.0_wp) * (kx1 + 2.0_wp * (kx2 + kx3) + kx4))
+    call add_compensated(b%v, b%v_lo, (step / 6.0_wp) * (kv1 + 2.0_wp * (kv2 + kv3) + kv4))
     ! The end force is the next step's start force.
     v1 = b%v + b%v_lo
-    f = f1 + scene%springs%force(b%x, b%x_lo, v1)
+    f = f1
+    call scene%springs%add_force(b%x, b%x_lo, v1, f)
     self%end_external = f1
     self%end_force = f
     self%end_force_t = b%t
@@ -161,8 +171,8 @@ contains
     self%end_x_lo = b%x_lo
     self%end_v = b%v
     self%end_v_lo = b%v_lo
-    acc_end = mode%acceleration(f)
-    vm = 0.5_wp * (v0 + v1) + 0.125_wp * step * (kv(:, 1) - acc_end)
+    call mode%acceleration(f, acc_end)
+    vm = 0.5_wp * (v0 + v1) + 0.125_wp * step * (kv1 - acc_end)
     call add_compensated(b%work, b%work_lo, step / 6.0_wp * (dot_product(f0, v0) + &
       4.0_wp * dot_product(fm, vm) + dot_product(f1, v1)))
     if (any(mode%f_slide /= 0.0_wp)) call add_compensated(b%friction_loss, b%friction_lo, step / 6.0_wp * &
@@ -172,12 +182,14 @@ contains
       scene%springs%damping_power(v1)))
   end subroutine state_dependent_step
 
-  !> The step's dense output: Hermite coefficients of both bodies' displacements.
-  pure function dense_output(a, b, step) result(c)
-    type(state_type), intent(in) :: a, b
+  !> The step's dense output: Hermite coefficients of each body's displacement (lanes).
+  pure subroutine dense_output(a, b, step, c)
+    type(lane_state_type), intent(in) :: a, b
     real(wp), intent(in) :: step
-    real(wp) :: c(3, 2)
-    c(:, 1) = hermite((b%x(1) - a%x(1)) + (b%x_lo(1) - a%x_lo(1)), a%v(1), b%v(1), step)
-    c(:, 2) = hermite((b%x(2) - a%x(2)) + (b%x_lo(2) - a%x_lo(2)), a%v(2), b%v(2), step)
-  end function dense_output
+    real(wp), intent(out) :: c(3, max_lanes)
+    integer :: i
+    do i = 1, max_lanes
+      c(:, i) = hermite((b%x(i) - a%x(i)) + (b%x_lo(i) - a%x_lo(i)), a%v(i), b%v(i), step)
+    end do
+  end subroutine dense_output
 end module impact1d_stepping

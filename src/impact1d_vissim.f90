@@ -5,14 +5,18 @@
 !> one-step delay); walls are limited integrators (positions clamped); friction follows the
 !> diagram's rules with a zero-velocity threshold (static friction's bound when at rest).
 !> Springs and dampers add their forces to the applied ones. Its errors are O(dt) by design.
+!> On the bodies in lanes (impact1d_lanes) and the pair's view of the scene (scene%pair): one
+!> body is the pair with an idle second lane, which nothing moves.
 module impact1d_vissim
   use, intrinsic :: iso_fortran_env, only: int64
   use impact1d_kinds, only: wp
+  use impact1d_lanes, only: max_lanes, to_lanes
   use impact1d_error, only: error_type, raise, status_simulation, fmt
   use impact1d_scene, only: scene_type, n_contacts, i_left, i_right, i_slot_min, i_slot_max, &
     sample_time
   use impact1d_impacts, only: impulse, kinetic_energy
   use impact1d_output, only: sink_type, run_stats, emit_sample, event_impact, checkpoint
+  use impact1d_event_log, only: log_event
   use impact1d_loads, only: applied_force
   implicit none
   private
@@ -25,8 +29,9 @@ contains
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats   !< fresh from run (its interrupt epoch set)
     type(error_type), allocatable, intent(out) :: error
-    real(wp) :: t, x(2), v(2), v_prev(2), x_new(2), v_new(2), work, friction_loss, impact_loss
-    real(wp) :: ke0, pe0, h, t_sample, gap_before(n_contacts), v_hit(2), dwork, dfriction
+    real(wp), dimension(max_lanes) :: x, v, v_prev, x_new, v_new, v_hit
+    real(wp) :: t, work, friction_loss, impact_loss
+    real(wp) :: ke0, pe0, h, t_sample, gap_before(n_contacts), dwork, dfriction
     real(wp) :: damping_loss, ddamping
     integer :: j_sample, k
     integer, parameter :: slot_first(n_contacts) = [i_slot_min, i_slot_max, i_left, i_right]
@@ -34,8 +39,8 @@ contains
     ! v is the velocity integrator's state; the diagram passes it through the zero-velocity
     ! threshold before anything uses it (Figure 13), so what moves the bodies is threshold(v).
     t = 0.0_wp
-    x = scene%x0
-    v = scene%v0
+    call to_lanes(scene%body_x0, x)
+    call to_lanes(scene%body_v0, v)
     work = 0.0_wp
     friction_loss = 0.0_wp
     impact_loss = 0.0_wp
@@ -71,22 +76,21 @@ contains
       ! Collisions seen at the step's end: the slot's first, then the walls on what it left.
       do k = 1, n_contacts
         associate (c => slot_first(k))
-          if (.not. scene%has_contact(c)) cycle
+          if (.not. scene%row_present(c)) cycle
           if (.not. (gap_before(c) >= 0.0_wp .and. gap(c, x) < 0.0_wp)) cycle
           v_hit = threshold(v)
           ! A wall clamps the body it faces: normal . x + offset = 0.
           if (c == i_left .or. c == i_right) then
-            associate (i => merge(1, 2, scene%normal(1, c) /= 0.0_wp))
-              x(i) = -scene%offset(c) / scene%normal(i, c)
+            associate (i => merge(1, 2, scene%pair%normal(1, c) /= 0.0_wp))
+              x(i) = -scene%row_offset(c) / scene%pair%normal(i, c)
             end associate
           end if
-          v_new = impulse(scene, c, scene%restitution(c), threshold(v_prev))
-          where (scene%normal(:, c) == 0.0_wp) v_new = v
+          call impulse(scene, c, scene%row_restitution(c), threshold(v_prev), v_new)
+          where (scene%pair%normal(:, c) == 0.0_wp) v_new = v
           impact_loss = impact_loss + kinetic_energy(scene, threshold(v)) - kinetic_energy(scene, threshold(v_new))
           v = v_new
           v_prev = v
-          stats%events(event_impact + c) = stats%events(event_impact + c) + 1
-          call sink%put_event(t, event_impact + c, v_hit, threshold(v))
+          call log_event(sink, stats, t, event_impact + c, v_hit, threshold(v))
         end associate
       end do
       if (t == t_sample) then
@@ -99,33 +103,33 @@ contains
   contains
 
     subroutine emit()
-      call emit_sample(sink, stats, t, x, threshold(v), scene%mass, ke0, work, friction_loss, impact_loss, &
+      call emit_sample(sink, stats, t, x, threshold(v), scene%pair%mass, ke0, work, friction_loss, impact_loss, &
         scene%springs%present, [scene%springs%potential(x, [0.0_wp, 0.0_wp]), pe0, damping_loss], error)
       j_sample = j_sample + 1
     end subroutine emit
 
     pure real(wp) function gap(k, positions)
       integer, intent(in) :: k
-      real(wp), intent(in) :: positions(2)
-      gap = dot_product(scene%normal(:, k), positions) + scene%offset(k)
+      real(wp), intent(in) :: positions(max_lanes)
+      gap = dot_product(scene%pair%normal(:, k), positions) + scene%row_offset(k)
     end function gap
 
     !> The diagram's "no movement on zero velocity": |v| <= threshold reads as zero.
     pure function threshold(velocity) result(thresholded)
-      real(wp), intent(in) :: velocity(2)
-      real(wp) :: thresholded(2)
+      real(wp), intent(in) :: velocity(max_lanes)
+      real(wp) :: thresholded(max_lanes)
       thresholded = merge(0.0_wp, velocity, abs(velocity) <= scene%zero_velocity)
     end function threshold
 
     !> The diagram's friction block: sliding friction when moving, otherwise the smaller of
     !> the static bound and the applied force, opposing the applied force.
     pure function friction(velocity, f) result(force)
-      real(wp), intent(in) :: velocity(2), f(2)
-      real(wp) :: force(2)
+      real(wp), intent(in) :: velocity(max_lanes), f(max_lanes)
+      real(wp) :: force(max_lanes)
       where (abs(velocity) > scene%zero_velocity)
-        force = -scene%friction * sign(1.0_wp, velocity)
+        force = -scene%pair%friction * sign(1.0_wp, velocity)
       elsewhere
-        force = -sign(min(scene%static_friction, abs(f)), f)
+        force = -sign(min(scene%pair%static_friction, abs(f)), f)
       end where
     end function friction
 
@@ -133,9 +137,10 @@ contains
     !> and damping dissipation integrated by the same stages (f: the applied forces, springs'
     !> and dampers' included; the work is the external forces' only).
     subroutine rk4(t0, x0, v0, step, x1, v1, dw, dd, dc)
-      real(wp), intent(in) :: t0, x0(2), v0(2), step
-      real(wp), intent(out) :: x1(2), v1(2), dw, dd, dc
-      real(wp) :: kx(2, 4), kv(2, 4), kw(4), kd(4), kc(4), f(2), fr(2), vs(2), ts, dx(2)
+      real(wp), intent(in) :: t0, x0(max_lanes), v0(max_lanes), step
+      real(wp), intent(out) :: x1(max_lanes), v1(max_lanes), dw, dd, dc
+      real(wp) :: kx(max_lanes, 4), kv(max_lanes, 4), kw(4), kd(4), kc(4), f(max_lanes), fr(max_lanes)
+      real(wp) :: vs(max_lanes), ts, dx(max_lanes), f_ext(max_lanes)
       integer :: stage
       real(wp), parameter :: c(4) = [0.0_wp, 0.5_wp, 0.5_wp, 1.0_wp], b(4) = [1.0_wp, 2.0_wp, 2.0_wp, 1.0_wp]
       do stage = 1, 4
@@ -145,11 +150,12 @@ contains
         if (stage > 1) vs = v0 + c(stage) * step * kv(:, stage - 1)
         if (stage > 1) dx = c(stage) * step * kx(:, stage - 1)
         vs = threshold(vs)
-        f = applied_force(scene, ts, x0, dx, vs)
+        call applied_force(scene, ts, x0, dx, vs, f)
         fr = friction(vs, f)
         kx(:, stage) = vs
-        kv(:, stage) = (f + fr) / scene%mass
-        kw(stage) = dot_product(scene%forcing%force(ts), vs)
+        kv(:, stage) = (f + fr) / scene%pair%mass
+        call scene%forcing%force(ts, f_ext)
+        kw(stage) = dot_product(f_ext, vs)
         kd(stage) = -dot_product(fr, vs)
         kc(stage) = scene%springs%damping_power(vs)
       end do

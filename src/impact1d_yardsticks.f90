@@ -25,8 +25,8 @@ contains
   !> is still as large as what a step changes it by.
   pure real(wp) function force_scale(scene, f, df)
     type(scene_type), intent(in) :: scene
-    real(wp), intent(in) :: f(2), df(2)
-    force_scale = sum(abs(f)) + 2.0_wp * sum(scene%static_friction) + sum(abs(df)) * scene%dt
+    real(wp), contiguous, intent(in) :: f(:), df(:)
+    force_scale = sum(abs(f)) + 2.0_wp * sum(scene%body_static) + sum(abs(df)) * scene%dt
   end function force_scale
 
   !> Instants closer than the clock resolves are one (t_later >= t_earlier).

@@ -5,14 +5,14 @@ program test_event_log
   use impact1d_scene, only: scene_type, i_left
   use impact1d_output, only: memory_sink, run_stats, event_rest
   use impact1d_event_log, only: event_log_type
-  use testing, only: check, finish
+  use testing, only: check, finish, two_body
   implicit none
   type(event_log_type) :: event_log
   type(memory_sink) :: sink
   type(run_stats) :: stats
   type(scene_type) :: scene
 
-  scene%dt = 1.0e-3_wp
+  call two_body('dt = 1e-3', scene)
   call sink%reserve(4, [1, 2, 3])   ! (samples are not used here)
   event_log%pending_rest(i_left) = 3.0_wp
   call event_log%flush_pending_rest(2.5_wp, [0.0_wp, 1.0_wp], sink, stats)

@@ -32,6 +32,13 @@ program test_events
   theta = earliest_crossing([5.0_wp, -1.0_wp, 0.0_wp, 0.0_wp], 1.0_wp, [1.0e-15_wp, 0.0_wp, 0.0_wp, 0.0_wp])
   call check(theta > 1.0_wp, 'no root when the gap stays positive')
 
+  ! The sign of a zero coefficient does not move the root: the stable root formula for the
+  ! extrema takes sign(.., 2 p(2)), and a sum of absent terms may give -0 (one ulp apart).
+  theta = earliest_crossing([3.0631851310927851e-4_wp, -0.75281648389631761_wp, 0.0_wp, 8.8975327938671018_wp], &
+    1.0_wp, [1.0e-15_wp, 0.0_wp, 0.0_wp, 0.0_wp])
+  call check(theta == earliest_crossing([3.0631851310927851e-4_wp, -0.75281648389631761_wp, -0.0_wp, &
+    8.8975327938671018_wp], 1.0_wp, [1.0e-15_wp, 0.0_wp, 0.0_wp, 0.0_wp]), 'p(2) = -0 finds the root of p(2) = +0')
+
   ! Hermite dense output reproduces a cubic motion exactly: x = 2 t - 3 t^2 + 0.5 t^3 on [0, 0.7].
   c = hermite(motion(0.7_wp), velocity(0.0_wp), velocity(0.7_wp), 0.7_wp)
   call check(all(abs(c - [2.0_wp, -3.0_wp, 0.5_wp]) < 1.0e-13_wp), 'Hermite is exact for a cubic')

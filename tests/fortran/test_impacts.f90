@@ -5,7 +5,7 @@ program test_impacts
   use impact1d_scene, only: scene_type, i_left, i_right, i_slot_min, i_slot_max
   use impact1d_impacts, only: impulse, normal_velocity, most_approaching, restitution_of, &
     joint_inelastic, inelastic_projection
-  use testing, only: check, finish
+  use testing, only: check, finish, two_body
   implicit none
   ! One impulse is a handful of flops on O(10) numbers: a few ulps of them.
   real(wp), parameter :: tol = 1.0e-13_wp
@@ -15,12 +15,15 @@ program test_impacts
   real(wp), parameter :: no_tol(4) = 0.0_wp
   ! The solver's rounding level of a normal velocity of about 8 m/s (64 ulps of it).
   real(wp), parameter :: u_rounding(4) = 64.0_wp * epsilon(1.0_wp) * 8.0_wp
+  real(wp), parameter :: mass(2) = [1.0_wp, 2.0_wp]
+  ! Every contact: walls either side, a slot between the bodies.
+  character(len=*), parameter :: contacts = 'm2 = 2, x_left = -1, x_right = 5, d_min = 0.5, d_max = 2'
 
-  scene%mass = [1.0_wp, 2.0_wp]
+  call two_body(contacts, scene)
   v = [-9.0_wp, 1.0_wp]
   r = 0.7_wp
-  v_after = impulse(scene, i_slot_max, r, v)
-  call check(abs(dot_product(scene%mass, v_after) - dot_product(scene%mass, v)) < tol, &
+  call impulse(scene, i_slot_max, r, v, v_after)
+  call check(abs(dot_product(mass, v_after) - dot_product(mass, v)) < tol, &
     'slot impact keeps momentum')
   call check(abs(normal_velocity(scene, i_slot_max, v_after) + r * normal_velocity(scene, i_slot_max, v)) < tol, &
     'slot impact: relative velocity after = -r times before')
@@ -28,11 +31,11 @@ program test_impacts
   expected(2) = ((2.0_wp - r * 1.0_wp) * v(2) + (1.0_wp + r) * 1.0_wp * v(1)) / 3.0_wp
   call check(all(abs(v_after - expected) < tol), "slot impact equals the tutorial's formula")
 
-  v_after = impulse(scene, i_left, 0.5_wp, [-2.0_wp, 3.0_wp])
+  call impulse(scene, i_left, 0.5_wp, [-2.0_wp, 3.0_wp], v_after)
   call check(v_after(1) == 1.0_wp .and. v_after(2) == 3.0_wp, 'left wall: v1 -> -r v1, v2 untouched')
-  v_after = impulse(scene, i_right, 1.0_wp, [-2.0_wp, 3.0_wp])
+  call impulse(scene, i_right, 1.0_wp, [-2.0_wp, 3.0_wp], v_after)
   call check(v_after(1) == -2.0_wp .and. v_after(2) == -3.0_wp, 'right wall: v2 -> -v2, v1 untouched')
-  v_after = impulse(scene, i_slot_min, 0.0_wp, [8.0_wp, 0.0_wp])
+  call impulse(scene, i_slot_min, 0.0_wp, [8.0_wp, 0.0_wp], v_after)
   call check(all(abs(v_after - 8.0_wp / 3.0_wp) < tol), 'perfectly inelastic: common velocity 8/3')
 
   closed = [.true., .false., .true., .false.]
@@ -41,13 +44,13 @@ program test_impacts
   call check(most_approaching(scene, closed, [1.0_wp, 3.0_wp], [0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp]) == 0, &
     'separating contacts get no impulse')
 
-  scene%restitution = 1.0_wp
+  call two_body(contacts // ', r_left = 1, r_right = 1, r_min = 1, r_max = 1', scene)
   closed = [.false., .false., .true., .true.]
   call check(restitution_of(scene, i_slot_min, closed) == 0.0_wp, 'a rigid link (both slot limits closed) does not rebound')
 
   ! A body pinned between a wall and a heavier body, every contact perfectly inelastic: the
   ! joint impact stops both at once (sequential impulses only approach it geometrically).
-  scene%restitution = 0.0_wp
+  call two_body(contacts // ', r_left = 0, r_right = 0, r_min = 0, r_max = 0', scene)
   closed = [.true., .false., .true., .false.]
   call check(joint_inelastic(scene, closed), 'r = 0 everywhere: one joint inelastic impact')
   call inelastic_projection(scene, closed, [0.0_wp, -5.0_wp], no_tol, v_after, pushed)
@@ -61,7 +64,8 @@ program test_impacts
   ! in the kinetic-energy metric is the common one (the slot face), not the vertex.
   closed = [.false., .false., .true., .false.]
   call inelastic_projection(scene, closed, [8.0_wp, 0.0_wp], u_rounding, v_after, pushed)
-  call check(all(v_after == impulse(scene, i_slot_min, 0.0_wp, [8.0_wp, 0.0_wp])), &
+  call impulse(scene, i_slot_min, 0.0_wp, [8.0_wp, 0.0_wp], expected)
+  call check(all(v_after == expected), &
     'one closed contact: the projection is the r = 0 impulse')
   ! A rigid link (both slot limits closed) driven into the left wall: the pair stops as one.
   closed = [.true., .false., .true., .true.]
@@ -70,10 +74,10 @@ program test_impacts
   ! Nothing approaches: nothing changes.
   call inelastic_projection(scene, closed, [1.0_wp, 1.0_wp], no_tol, v_after, pushed)
   call check(all(v_after == 1.0_wp) .and. .not. any(pushed), 'separating contacts: no impulse')
-  scene%restitution(i_left) = 0.5_wp
+  call two_body(contacts // ', r_left = 0.5, r_right = 0, r_min = 0, r_max = 0', scene)
   closed = [.true., .false., .true., .false.]
   call check(.not. joint_inelastic(scene, closed), 'an elastic closed contact: no joint projection')
-  scene%restitution = 0.0_wp
+  call two_body(contacts // ', r_left = 0, r_right = 0, r_min = 0, r_max = 0', scene)
   call check(.not. joint_inelastic(scene, [.false., .false., .true., .false.]), 'one closed contact: one impulse')
   call check(.not. joint_inelastic(scene, [.false., .false., .true., .true.]), 'a rigid link alone: one impulse')
 

@@ -3,10 +3,11 @@
 program test_location
   use impact1d_kinds, only: wp, eps_wp
   use impact1d_scene, only: scene_type
+  use impact1d_forcing, only: table_type
   use impact1d_modes, only: mode_type, solve_mode
   use impact1d_location, only: hold_crossing, first_negative
-  use impact1d_state, only: state_type
-  use testing, only: check, finish
+  use impact1d_state, only: lane_state_type
+  use testing, only: check, finish, two_body
   implicit none
   ! Bisection stops within 2 eps of the clock: a few ulps of t = 0.5.
   real(wp), parameter :: tol = 8.0_wp * eps_wp
@@ -14,18 +15,14 @@ program test_location
   type(mode_type) :: mode
   logical :: found
   real(wp) :: theta, c(3, 2) = 0.0_wp
-  type(state_type) :: a
+  type(lane_state_type) :: a
+  type(table_type) :: ramp
 
-  scene%mass = [1.0_wp, 2.0_wp]
-  scene%friction = [10.0_wp, 20.0_wp]
-  scene%static_friction = scene%friction
-  scene%has_contact = .false.
-  scene%dt = 0.2_wp
   ! Body 1 pushed by f = 20 t: its friction bound 10 is reached at t = 0.5.
-  scene%forcing%has_table(1) = .true.
-  scene%forcing%table(1)%t = [0.0_wp, 1.0_wp]
-  scene%forcing%table(1)%f = [0.0_wp, 20.0_wp]
-  call solve_mode(scene, [0.0_wp, 0.0_wp], [20.0_wp, 0.0_wp], [.false., .false., .false., .false.], &
+  ramp%t = [0.0_wp, 1.0_wp]
+  ramp%f = [0.0_wp, 20.0_wp]
+  call two_body('m2 = 2, mu1 = 1, mu2 = 1, g = 10, dt = 0.2', scene, ramp)
+  call solve_mode(scene%pair, [0.0_wp, 0.0_wp], [20.0_wp, 0.0_wp], [.false., .false., .false., .false.], &
     [.true., .true.], [0.0_wp, 0.0_wp], mode, found)
   call check(found .and. all(mode%stuck) .and. mode%n_hold > 0, 'both bodies stuck at t = 0')
   a%t = 0.4_wp

@@ -3,8 +3,8 @@
 program test_state
   use, intrinsic :: iso_fortran_env, only: int64
   use impact1d_kinds, only: wp
-  use impact1d_state, only: state_type, add_compensated, renormalise, constant_steps
-  use impact1d_stepping, only: rk4_type
+  use impact1d_lanes, only: max_lanes
+  use impact1d_state, only: lane_state_type, add_compensated, renormalise, constant_step, constant_steps
   use testing, only: check, finish
   implicit none
   integer, parameter :: n_steps = 1000000
@@ -12,9 +12,6 @@ program test_state
   ! A plain sum of 10^6 increments of 1e-5 drifts by ~1e-10: far outside this bound.
   real(wp), parameter :: naive_drift_floor = 1.0e-12_wp
   real(wp) :: t, t_lo, naive
-  type(state_type) :: stepped, bulk
-  type(rk4_type) :: rk
-  real(wp) :: dv(2), half_dv(2)
   integer :: j
 
   t = 0.0_wp
@@ -28,22 +25,42 @@ program test_state
   call check(abs(t - 10.0_wp) <= spacing(10.0_wp), 'compensated clock: 10^6 steps of 1e-5 s give 10 s')
   call check(abs(naive - 10.0_wp) > naive_drift_floor, 'the plain sum does drift (the check can fail)')
 
-  ! Bulk steps (accumulated, renormalised once) against step-by-step advance_constant.
-  rk%constant_acceleration = [-9.81_wp, 0.37_wp]
-  stepped%x = [0.3_wp, 10.0_wp]
-  stepped%v = [1.7_wp, -0.2_wp]
-  bulk = stepped
-  do j = 1, 1000
-    call rk%advance_constant(stepped, dt)
-  end do
-  dv = dt * rk%constant_acceleration
-  half_dv = 0.5_wp * dv
-  call constant_steps(1000_int64, dt, dv, half_dv, bulk%t, bulk%t_lo, bulk%x, bulk%x_lo, bulk%v, bulk%v_lo)
-  call renormalise(bulk%t, bulk%t_lo)
-  call renormalise(bulk%x, bulk%x_lo)
-  call renormalise(bulk%v, bulk%v_lo)
-  call check(bulk%t == stepped%t .and. bulk%t_lo == stepped%t_lo, 'bulk steps: same clock bits')
-  call check(all(bulk%x == stepped%x) .and. all(bulk%v == stepped%v), &
-    'bulk steps: same position and velocity bits as step by step')
+  ! Bulk steps (accumulated, renormalised once, in lanes) against step by step, for one
+  ! body and two.
+  call bulk_against_steps(1)
+  call bulk_against_steps(2)
   call finish('test_state')
+
+contains
+
+  !> n bodies in lanes (the other lane idle): 1000 steps of constant_step against one call
+  !> of constant_steps, renormalised.
+  subroutine bulk_against_steps(n)
+    integer, intent(in) :: n
+    real(wp), parameter :: acc(2) = [-9.81_wp, 0.37_wp], x0(2) = [0.3_wp, 10.0_wp], v0(2) = [1.7_wp, -0.2_wp]
+    type(lane_state_type) :: stepped, bulk
+    real(wp), dimension(max_lanes) :: a, dv, half_dv
+    character(len=8) :: bodies
+    integer :: j
+    write(bodies, '(i0, a)') n, ' bodies'
+    a = 0.0_wp
+    a(:n) = acc(:n)
+    stepped%x(:n) = x0(:n)
+    stepped%v(:n) = v0(:n)
+    bulk = stepped
+    do j = 1, 1000
+      call add_compensated(stepped%t, stepped%t_lo, dt)
+      call constant_step(dt, a, stepped%x, stepped%x_lo, stepped%v, stepped%v_lo)
+    end do
+    dv = dt * a
+    half_dv = 0.5_wp * dv
+    call constant_steps(1000_int64, dt, dv, half_dv, bulk%t, bulk%t_lo, bulk%x, bulk%x_lo, bulk%v, bulk%v_lo)
+    call renormalise(bulk%t, bulk%t_lo)
+    call renormalise(bulk%x, bulk%x_lo)
+    call renormalise(bulk%v, bulk%v_lo)
+    call check(bulk%t == stepped%t .and. bulk%t_lo == stepped%t_lo, 'bulk steps, ' // trim(bodies) // &
+      ': same clock bits')
+    call check(all(bulk%x == stepped%x) .and. all(bulk%v == stepped%v), 'bulk steps, ' // trim(bodies) // &
+      ': same position and velocity bits as step by step')
+  end subroutine bulk_against_steps
 end program test_state

@@ -1,11 +1,19 @@
 !> The few lines every Fortran unit test needs: count failed checks, say which, and end
-!> the test program with a non-zero status if any failed (meson test reads it).
+!> the test program with a non-zero status if any failed (meson test reads it); and a scene
+!> built as a user's is (two_body), so that the tests name what a scene has in the
+!> tutorial's words and survive changes of the model's layout.
 module testing
+  use impact1d_kinds, only: wp
+  use impact1d_error, only: error_type
+  use impact1d_forcing, only: table_type
+  use impact1d_scene, only: scene_input, scene_type, build_scene, real_names, n_real, i_f1_table, set_text, n_text
   implicit none
   private
-  public :: check, finish
+  public :: check, finish, two_body
 
   integer, save :: failures = 0
+  !> What two_body starts from: two unit masses a metre apart, a second's run at 1 ms steps.
+  character(len=*), parameter :: base_scene = 'm1 = 1, m2 = 1, x1 = 0, x2 = 1, t_end = 1, dt = 1e-3'
 
 contains
 
@@ -22,4 +30,56 @@ contains
     if (failures > 0) error stop 1
     print '(a)', test_name // ': all passed'
   end subroutine finish
+
+  !> A scene checked and built by build_scene from 'name = value' assignments in the
+  !> namelist's names ('m2 = 2, mu1 = 1, g = 10, x_left = -1'), over base_scene; with
+  !> f1_table, body 1's force table. A scene the validator refuses ends the test.
+  subroutine two_body(assignments, scene, f1_table)
+    character(len=*), intent(in) :: assignments
+    type(scene_type), intent(out) :: scene
+    type(table_type), intent(in), optional :: f1_table
+    type(scene_input) :: input
+    type(table_type) :: tables(2)
+    type(error_type), allocatable :: error
+    integer :: k
+    do k = 1, n_text
+      call set_text(input, k, '')
+    end do
+    call assign(base_scene, input)
+    call assign(assignments, input)
+    if (present(f1_table)) then
+      call set_text(input, i_f1_table, 'f1_table')
+      tables(1) = f1_table
+    end if
+    call build_scene(input, tables, scene, error)
+    if (allocated(error)) then
+      print '(a)', 'two_body(''' // assignments // '''): ' // error%message
+      error stop 1
+    end if
+  end subroutine two_body
+
+  !> Set the fields named in a comma-separated list of 'name = value'.
+  subroutine assign(assignments, input)
+    character(len=*), intent(in) :: assignments
+    type(scene_input), intent(inout) :: input
+    integer :: start, length, equals, k
+    start = 1
+    do while (start <= len(assignments))
+      length = index(assignments(start:), ',') - 1
+      if (length < 0) length = len(assignments) - start + 1
+      associate (item => assignments(start:start + length - 1))
+        equals = index(item, '=')
+        do k = 1, n_real
+          if (real_names(k) == adjustl(item(:equals - 1))) exit
+        end do
+        if (equals == 0 .or. k > n_real) then
+          print '(a)', 'two_body: not a scene field assignment: ''' // item // ''''
+          error stop 1
+        end if
+        read(item(equals + 1:), *) input%value(k)
+        input%given(k) = .true.
+      end associate
+      start = start + length + 1
+    end do
+  end subroutine assign
 end module testing
