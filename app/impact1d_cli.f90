@@ -39,7 +39,8 @@ program impact1d_cli
   end interface
 
   character(len=*), parameter :: usage = &
-    'usage: impact1d SCENE [--t-end T] [--dt DT] [--dt-out DT_OUT] [--method event|vissim] [-o OUT.dat]'
+    'usage: impact1d SCENE [--t-end T] [--dt DT] [--dt-out DT_OUT] [--method event|vissim] [-o OUT.dat]' // &
+    ' [--quiet]'
   character(len=*), parameter :: nl = new_line('a')
   character(len=*), parameter :: help = usage // nl // nl // &
     'Runs SCENE (a namelist scene, or a VisSim-style .dat parameter file) and writes its samples' // nl // &
@@ -53,6 +54,9 @@ program impact1d_cli
     '                   vissim  the VisSim tutorial''s fixed-step scheme, O(dt) (any letter case)' // nl // &
     '  -o OUT.dat       where the samples go (never one of the run''s own input files; a link' // nl // &
     '                   to a regular file is written through, a FIFO or a device refused)' // nl // &
+    '  --quiet          no progress line (a run of over a second on a terminal shows one on' // nl // &
+    '                   stderr: the simulated time, events so far and the time left; never' // nl // &
+    '                   in a pipe or a file)' // nl // &
     '  -h, --help       this text' // nl // &
     '  --version        the version' // nl // nl // &
     'Exit status: 0 done; 1 bad input (scene, tables, options, output path), nothing written;' // nl // &
@@ -68,7 +72,7 @@ program impact1d_cli
   character(len=:), allocatable :: scene_path, out_path, option, value
   integer :: i, n_args, k, equals
   real(wp) :: overrides(3)
-  logical :: overridden(3), has_value, out_given
+  logical :: overridden(3), has_value, out_given, quiet
   character(len=64) :: method
 
   overridden = .false.
@@ -77,6 +81,7 @@ program impact1d_cli
   scene_path = ''
   out_path = ''
   out_given = .false.
+  quiet = .false.
   n_args = command_argument_count()
   i = 1
   do while (i <= n_args)
@@ -97,6 +102,9 @@ program impact1d_cli
     case ('--version')
       call say('impact1d ' // version // nl, 'the version')
       stop
+    case ('--quiet')
+      if (has_value) call fail(status_input, '--quiet takes no value; ' // usage)
+      quiet = .true.
     case ('--t-end', '--dt', '--dt-out', '--method', '-o')
       if (.not. has_value) then
         if (i > n_args) call fail(status_input, option // ' needs a value')
@@ -155,7 +163,7 @@ program impact1d_cli
   call guard_temporaries(sink%part // c_null_char, sink%event_part // c_null_char)
   call allow_signals()
   ! Progress only where a person watches: stderr a terminal (file descriptor 2).
-  sink%show_progress = c_isatty(2_c_int) == 1
+  sink%show_progress = c_isatty(2_c_int) == 1 .and. .not. quiet
   call run(scene, sink, stats, error)
   call hold_signals()
   call sink%close(.not. allocated(error), close_error)

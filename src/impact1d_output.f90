@@ -47,7 +47,7 @@ module impact1d_output
   end type run_stats
 
   !> Every sink can show progress on stderr for long runs: once a run has taken a second,
-  !> a one-line '47% (t = 2.8 of 6 s)' refreshed four times a second, cleared at the end.
+  !> a one-line '47% (t = 2.8 of 6 s, 1234 events, about 3 s left)' refreshed four times a second,
   type, abstract :: sink_type
     logical :: show_progress = .false.
     integer(int64) :: clock_start = -1, clock_shown = 0
@@ -235,18 +235,20 @@ contains
     type(run_stats), intent(in) :: stats
     real(wp), intent(in) :: t, t_end
     type(error_type), allocatable, intent(inout) :: error
-    call sink%progress(t, t_end)
+    call sink%progress(t, t_end, sum(stats%events))
     if (interrupt_count() /= stats%interrupt_epoch) &
       call raise(error, status_interrupted, 'interrupted at t = ' // trim(fmt(t)) // ' s')
   end subroutine checkpoint
 
   !> Called by the stepping loop every few thousand steps: cheap unless a line is due.
-  subroutine progress(self, t, t_end)
+  subroutine progress(self, t, t_end, n_events)
     class(sink_type), intent(inout) :: self
     real(wp), intent(in) :: t, t_end
+    integer, intent(in) :: n_events     !< events logged so far
     integer(int64) :: count, rate
     character(len=8) :: percent
-    character(len=16) :: now
+    character(len=16) :: now, left
+    real(wp) :: elapsed
     if (.not. self%show_progress) return
     call system_clock(count, rate)
     if (self%clock_start < 0) then
@@ -257,8 +259,13 @@ contains
     self%clock_shown = count
     write(percent, '(i3, a)') int(100.0_wp * t / t_end), '%'
     write(now, '(f16.2)') t
+    ! The time left at the rate so far (simulated time per second of wall time).
+    elapsed = real(count - self%clock_start, wp) / real(rate, wp)
+    left = '?'
+    if (t > 0.0_wp) write(left, '(i0)') nint(min(elapsed * (t_end - t) / t, 1.0e15_wp), int64)
     write(error_unit, '(a)', advance='no') achar(13) // 'impact1d: ' // trim(adjustl(percent)) // &
-      ' (t = ' // trim(adjustl(now)) // ' of ' // trim(fmt(t_end)) // ' s)   '
+      ' (t = ' // trim(adjustl(now)) // ' of ' // trim(fmt(t_end)) // ' s, ' // &
+      trim(fmt(n_events)) // ' events, about ' // trim(adjustl(left)) // ' s left)   '
     flush(error_unit)
     self%progress_shown = .true.
   end subroutine progress
@@ -267,7 +274,7 @@ contains
   subroutine end_progress(self)
     class(sink_type), intent(inout) :: self
     if (.not. self%progress_shown) return
-    write(error_unit, '(a)', advance='no') achar(13) // repeat(' ', 60) // achar(13)
+    write(error_unit, '(a)', advance='no') achar(13) // repeat(' ', 100) // achar(13)
     flush(error_unit)
     self%progress_shown = .false.
   end subroutine end_progress

@@ -1,6 +1,7 @@
 """The `impact1d` command line: same numbers as the Python API, files numpy can read."""
 
 import os
+import re
 import subprocess
 import sys
 from importlib import metadata
@@ -182,6 +183,43 @@ def test_no_progress_line_when_stderr_is_not_a_terminal(cli, tmp_path):
                      "&run t_end = 1.5e4, dt = 1.0e-3, dt_out = 1.0e4 /\n")
     done = run_cli(cli, scene, "-o", tmp_path / "long.dat", cwd=tmp_path)
     assert done.stderr == ""
+
+
+def _run_on_a_terminal(cli, tmp_path, *options):
+    """The long run above with stderr (and stdout) on a pseudo-terminal, as a person runs it:
+    everything the terminal received."""
+    import pty
+    scene = tmp_path / "long.nml"
+    scene.write_text("&bodies m1 = 1.0, m2 = 2.0 /\n&initial x1 = 0.0, v1 = 1.0, x2 = 5.0 /\n"
+                     "&forces f1 = 0.001, f1_amp = 0.1, f1_period = 7.0 /\n"
+                     "&run t_end = 1.5e4, dt = 1.0e-3, dt_out = 1.0e4 /\n")
+    main, terminal = pty.openpty()
+    process = subprocess.Popen([cli, str(scene), "-o", str(tmp_path / "long.dat"), *options],
+                               stdin=subprocess.DEVNULL, stdout=terminal, stderr=terminal, cwd=tmp_path)
+    os.close(terminal)
+    received = b""
+    while True:
+        try:
+            chunk = os.read(main, 4096)
+        except OSError:          # the terminal closed: the process is done
+            break
+        if not chunk:
+            break
+        received += chunk
+    os.close(main)
+    assert process.wait(timeout=120) == 0
+    return received.decode()
+
+
+def test_progress_line_on_a_terminal_and_quiet(cli, tmp_path):
+    """On a terminal a run of over a second shows its progress on stderr (simulated time,
+    events so far, the time left), then clears it; --quiet shows none. (In a pipe nothing:
+    the test above.)"""
+    shown = _run_on_a_terminal(cli, tmp_path)
+    assert re.search(r"\d+% \(t = [0-9.]+ of 15000\.0 s, \d+ events, about \d+ s left\)", shown), shown
+    assert "impact1d: " in shown and "steps" in shown          # the summary follows
+    quiet = _run_on_a_terminal(cli, tmp_path, "--quiet")
+    assert "% (t = " not in quiet and "steps" in quiet
 
 
 # --- what a new user meets first (issue 12) ----------------------------------------------
