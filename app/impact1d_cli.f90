@@ -182,6 +182,9 @@ contains
     text = 'impact1d: ' // trim(input%text(i_title)%s) // nl
     text = text // '  scene     ' // scene_path // ' (method ' // scene%method // ', dt = ' // &
       trim(fmt(scene%dt)) // ' s, t_end = ' // trim(fmt(scene%t_end)) // ' s)' // nl
+    if (scene%substeps > 1) text = text // '  substeps  ' // trim(fmt(scene%substeps)) // &
+      ' RK4 steps per dt given (substeps = ''auto'': the springs'' fastest mode at |lambda| dt <= ' // &
+      '0.5)' // nl
     text = text // '  output    ' // out_path // ' (' // trim(fmt(scene%n_samples)) // ' rows every ' // &
       trim(fmt(scene%dt_out)) // ' s) and ' // trim(events_path(out_path)) // ' (' // &
       trim(fmt(sum(stats%events))) // ' events)' // nl

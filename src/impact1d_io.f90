@@ -6,7 +6,8 @@ module impact1d_io
   use impact1d_error, only: error_type, raise, status_input, fmt
   use impact1d_scene, only: scene_input, scene_type, build_scene, validate, set_text, n_real, n_text, &
     real_names, text_names, i_m1, i_m2, i_mu1, i_mu2, i_g, i_r_left, i_r_right, i_r_min, i_r_max, i_x_left, i_x_right, &
-    i_d_min, i_d_max, i_x1, i_x2, i_v1, i_v2, i_f1, i_f2, i_title, i_f1_table, i_f2_table, i_method
+    i_d_min, i_d_max, i_x1, i_x2, i_v1, i_v2, i_f1, i_f2, i_title, i_f1_table, i_f2_table, i_method, &
+    i_substeps
   use impact1d_forcing, only: table_type
   use impact1d_files, only: check_input_file
   implicit none
@@ -16,11 +17,11 @@ module impact1d_io
   character(len=*), parameter :: known_groups(8) = [character(len=7) :: &
     'scene', 'bodies', 'walls', 'link', 'initial', 'forces', 'springs', 'run']
   !> Each group's variables: which group a name belongs to, and the message about a misspelt one.
-  character(len=*), parameter :: group_variables(size(known_groups)) = [character(len=96) :: &
+  character(len=*), parameter :: group_variables(size(known_groups)) = [character(len=112) :: &
     'title', 'm1, m2, mu1, mu2, mus1, mus2, g', 'x_left, r_left, x_right, r_right', 'd_min, r_min, d_max, r_max', &
     'x1, v1, x2, v2', 'f1, f2, f1_table, f2_table, f1_amp, f1_period, f1_phase, f2_amp, f2_period, f2_phase', &
     'k1, x1_rest, c1, k2, x2_rest, c2, k12, d_rest, c12', &
-    't_end, dt, dt_out, method, zero_vel, max_rows, max_impulses, max_step_events']
+    't_end, dt, dt_out, method, zero_vel, max_rows, max_impulses, max_step_events, substeps']
   !> The tutorial's parameter files list these, in its Table 1 order; g is 10 there.
   integer, parameter :: dat_order(17) = [i_m1, i_m2, i_mu1, i_r_left, i_r_right, i_r_min, &
     i_r_max, i_x_left, i_x_right, i_d_min, i_d_max, i_x1, i_x2, i_v1, i_v2, i_f1, i_f2]
@@ -365,8 +366,9 @@ contains
       if (.not. ok) then
         call raise(error, status_input, name // ' = ' // value // ' is not one quoted text (write ' // name // &
           ' = ''...'')')
-      else if (field - n_real == i_method) then
-        call set_text(input, i_method, lower(text))
+      else if (any(field - n_real == [i_method, i_substeps])) then
+        ! Keywords, in any letter case.
+        call set_text(input, field - n_real, lower(text))
       else if (field - n_real == i_title) then
         call set_text(input, i_title, text)
       else

@@ -18,9 +18,9 @@ module impact1d_scene
     i_f1_phase, i_f2_amp, i_f2_period, i_f2_phase, i_t_end, i_dt, i_dt_out, i_mus1, i_mus2, &
     i_k1, i_x1_rest, i_c1, i_k2, i_x2_rest, i_c2, i_k12, i_d_rest, i_c12
   public :: sample_time, set_text
-  public :: i_title, i_f1_table, i_f2_table, i_method, default_gravity
+  public :: i_title, i_f1_table, i_f2_table, i_method, i_substeps, default_gravity
 
-  integer, parameter :: n_real = 43, n_text = 4
+  integer, parameter :: n_real = 43, n_text = 5
   !> Names of the real inputs, as in the namelist and in Python's Scene, in this order.
   character(len=*), parameter :: real_names(n_real) = [character(len=15) :: &
     'm1', 'm2', 'mu1', 'mu2', 'g', 'x_left', 'r_left', 'x_right', 'r_right', &
@@ -29,7 +29,7 @@ module impact1d_scene
     'zero_vel', 'max_rows', 'max_impulses', 'max_step_events', 'mus1', 'mus2', &
     'k1', 'x1_rest', 'c1', 'k2', 'x2_rest', 'c2', 'k12', 'd_rest', 'c12']
   character(len=*), parameter :: text_names(n_text) = [character(len=8) :: &
-    'title', 'f1_table', 'f2_table', 'method']
+    'title', 'f1_table', 'f2_table', 'method', 'substeps']
   integer, parameter :: i_m1 = 1, i_m2 = 2, i_mu1 = 3, i_mu2 = 4, i_g = 5, i_x_left = 6, &
     i_r_left = 7, i_x_right = 8, i_r_right = 9, i_d_min = 10, i_r_min = 11, i_d_max = 12, &
     i_r_max = 13, i_x1 = 14, i_v1 = 15, i_x2 = 16, i_v2 = 17, i_f1 = 18, i_f2 = 19, &
@@ -43,7 +43,7 @@ module impact1d_scene
     i_f2_phase, i_k2, i_x2_rest, i_c2, i_k12, i_d_rest, i_c12, i_d_min, i_r_min, i_d_max, i_r_max]
   !> Each spring element's stiffness; its rest position and damping follow it.
   integer, parameter :: spring_index(n_elements) = [i_k1, i_k2, i_k12]
-  integer, parameter :: i_title = 1, i_f1_table = 2, i_f2_table = 3, i_method = 4
+  integer, parameter :: i_title = 1, i_f1_table = 2, i_f2_table = 3, i_method = 4, i_substeps = 5
 
   !> The four optional unilateral constraints: gap_k = normal(:,k) . x + offset_k >= 0.
   integer, parameter :: n_contacts = 4, i_left = 1, i_right = 2, i_slot_min = 3, i_slot_max = 4
@@ -93,6 +93,9 @@ module impact1d_scene
     character(len=:), allocatable :: title, method
     !> What the run should know but does not stop it (a coarse step), one per line; '' if none.
     character(len=:), allocatable :: warnings
+    !> RK4 steps per dt (&run substeps = 'auto' with springs or dampers coarse for dt: the
+    !> step taken is dt / substeps); 1 otherwise.
+    integer :: substeps = 1
     ! bodies ------------------------------------------------------------------------------
     integer :: n_bodies = 2                          !< N: 1 (m2 not given) or 2
     real(wp), allocatable :: body_mass(:)            !< (N) kg
@@ -328,6 +331,8 @@ contains
         return
       end if
     end if
+    call keyword(input, i_substeps, ['none', 'auto'], error)
+    if (allocated(error)) return
     if (len_trim(input%text(i_method)%s) > 0) then
       if (trim(input%text(i_method)%s) /= 'event' .and. trim(input%text(i_method)%s) /= 'vissim') then
         call raise(error, status_input, "method = '" // trim(input%text(i_method)%s) // &
@@ -336,6 +341,24 @@ contains
       end if
     end if
   end subroutine validate
+
+  !> Text field i, when given, is one of the words allowed.
+  subroutine keyword(input, i, allowed, error)
+    type(scene_input), intent(in) :: input
+    integer, intent(in) :: i
+    character(len=*), intent(in) :: allowed(:)
+    type(error_type), allocatable, intent(inout) :: error
+    character(len=:), allocatable :: listed
+    integer :: j
+    if (allocated(error) .or. len_trim(input%text(i)%s) == 0) return
+    if (any(trim(input%text(i)%s) == allowed)) return
+    listed = ''
+    do j = 1, size(allowed)
+      listed = listed // merge(', ', '  ', j > 1) // "'" // trim(allowed(j)) // "'"
+    end do
+    call raise(error, status_input, trim(text_names(i)) // " = '" // trim(input%text(i)%s) // &
+      "' is unknown: it is one of " // trim(adjustl(listed)))
+  end subroutine keyword
 
   !> Each of indices is given (the first that is not is the error).
   subroutine require(input, indices, error)
@@ -494,7 +517,7 @@ contains
     if (input%given(i_dt_out)) scene%dt_out = input%value(i_dt_out)
     if (input%given(i_zero_vel)) scene%zero_velocity = input%value(i_zero_vel)
     scene%warnings = ''
-    if (scene%springs%present) call check_step(scene, error)
+    if (scene%springs%present) call check_step(scene, input%text(i_substeps)%s == 'auto', error)
     if (allocated(error)) return
     if (input%given(i_max_impulses)) scene%max_impulses = int(input%value(i_max_impulses))
     if (input%given(i_max_step_events)) scene%max_step_events = int(input%value(i_max_step_events))
@@ -564,8 +587,12 @@ contains
   !> so the scene is refused; a stable step that is coarse for the fastest mode gets a warning
   !> with the error RK4 makes on that mode (a spring at w dt = 1 loses most of its energy in a
   !> few periods without it). Each message names the element that sets the fastest rate.
-  subroutine check_step(scene, error)
+  !> With substeps (&run substeps = 'auto') a dt coarse for the fastest mode is divided
+  !> instead: the step becomes dt / n with n the fewest that bring |lambda| h to coarse_rate
+  !> (samples stay every dt_out, its default the dt given).
+  subroutine check_step(scene, substeps, error)
     type(scene_type), intent(inout) :: scene
+    logical, intent(in) :: substeps
     type(error_type), allocatable, intent(inout) :: error
     real(wp) :: k(scene%n_bodies, scene%n_bodies), c(scene%n_bodies, scene%n_bodies), h_stable
     complex(wp) :: lambda(2 * scene%n_bodies), fastest
@@ -581,11 +608,22 @@ contains
     end if
     h_stable = minval([(stable_step(lambda(j)), j = 1, size(lambda))])
     fastest = lambda(maxloc(abs(lambda), 1))
+    if (substeps .and. abs(fastest) * scene%dt > coarse_rate) then
+      scene%substeps = ceiling(min(abs(fastest) * scene%dt / coarse_rate, real(huge(1), wp)))
+      if (scene%dt / scene%substeps < clock_resolution_ulps * spacing(scene%t_end)) then
+        call raise(error, status_input, 'substeps = ''auto'' would step dt = ' // trim(fmt(scene%dt)) // &
+          ' in ' // trim(fmt(scene%substeps)) // ' steps, below the clock''s resolution at t_end: the ' // &
+          'fastest mode (' // trim(mode_text(fastest)) // ', set by ' // trim(fastest_element(scene)) // &
+          ') is too fast for this run')
+        return
+      end if
+      scene%dt = scene%dt / scene%substeps
+    end if
     if (scene%dt > h_stable) then
       call raise(error, status_input, 'dt = ' // trim(fmt(scene%dt)) // ' is past RK4''s stability ' // &
         'limit for this scene''s springs and dampers: its fastest mode (' // trim(mode_text(fastest)) // &
         ', set by ' // trim(fastest_element(scene)) // ') needs dt <= ' // trim(fmt(h_stable)) // &
-        ' (the numbers would grow without bound): lower dt')
+        ' (the numbers would grow without bound): lower dt, or set &run substeps = ''auto''')
     else if (abs(fastest) * scene%dt > coarse_rate) then
       scene%warnings = 'dt = ' // trim(fmt(scene%dt)) // ' is coarse for this scene''s fastest mode (' // &
         trim(mode_text(fastest)) // ', set by ' // trim(fastest_element(scene)) // '): |lambda| dt = ' // &

@@ -15,11 +15,14 @@ w dt = 2 sqrt 2 for an undamped spring, c dt / m = 2.7852935634 for a damper alo
 
 import math
 import re
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 import impact1d
+
+ROOT = Path(__file__).resolve().parents[1]
 
 # Bounds found by bisection to ~1e-15 relative in the engine; numpy's roots agree to 1e-9.
 BOUND_RTOL = 1e-9
@@ -140,3 +143,35 @@ def test_the_cli_summary_carries_the_warning(tmp_path):
     assert out.returncode == 0, out.stderr
     warning = [line for line in out.stdout.splitlines() if line.strip().startswith("warning")]
     assert len(warning) == 1 and "k1 = 800.0" in warning[0] and "coarse" in warning[0]
+
+
+def test_substeps_auto_divides_a_coarse_or_unstable_dt():
+    """substeps = 'auto' steps a dt that is coarse (or past the limit) for the fastest mode in
+    n = ceil(|lambda| dt / 0.5) steps: the run equals one at dt / n, samples stay at the dt
+    given, and no warning remains. Without springs, or with a fine dt, it changes nothing."""
+    exact = largest_stable_dt(*matrices(ONE_SPRING))
+    for dt in (exact * 1.5, exact * 0.9, 0.1):
+        n = math.ceil(20.0 * dt / 0.5)                       # |lambda| = w = 20
+        scene = impact1d.Scene(**ONE_SPRING, t_end=1.0, dt=dt, substeps="Auto")
+        res = impact1d.simulate(scene)
+        reference = impact1d.simulate(scene, substeps=None, dt=dt / n, dt_out=dt)
+        np.testing.assert_array_equal(res.samples, reference.samples)
+        assert res.steps == reference.steps and res.warnings == ()
+    fine = impact1d.Scene(**ONE_SPRING, t_end=1.0, dt=0.01)
+    np.testing.assert_array_equal(impact1d.simulate(fine, substeps="auto").samples,
+                                  impact1d.simulate(fine).samples)
+    case3 = impact1d.load_scene(ROOT / "input" / "case3.nml")
+    np.testing.assert_array_equal(impact1d.simulate(case3, substeps="auto").samples,
+                                  impact1d.simulate(case3).samples)
+    with pytest.raises(impact1d.InputError, match="substeps = 'sometimes' is unknown"):
+        impact1d.simulate(fine, substeps="sometimes")
+
+
+def test_substeps_in_a_namelist(tmp_path):
+    scene = tmp_path / "s.nml"
+    scene.write_text("&bodies m1 = 2.0 /\n&initial x1 = 0.1 /\n&springs k1 = 800.0, x1_rest = 0.0 /\n"
+                     "&run t_end = 1.0, dt = 0.2, substeps = 'AUTO' /\n")
+    loaded = impact1d.load_scene(scene)
+    assert loaded.substeps == "auto"
+    res = impact1d.simulate(loaded)
+    assert res.steps == 5 * 8 and res.warnings == ()          # 8 substeps of each 0.2 s step

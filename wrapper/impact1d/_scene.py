@@ -47,7 +47,7 @@ REAL_FIELDS = (
     "t_end", "dt", "dt_out", "zero_vel", "max_rows", "max_impulses", "max_step_events",
     "mus1", "mus2", "k1", "x1_rest", "c1", "k2", "x2_rest", "c2", "k12", "d_rest", "c12",
 )
-TEXT_FIELDS = ("title", "f1_table", "f2_table", "method")
+TEXT_FIELDS = ("title", "f1_table", "f2_table", "method", "substeps")
 
 
 @dataclass
@@ -106,6 +106,7 @@ class Scene:
     f1_table: Optional[str] = None
     f2_table: Optional[str] = None
     method: Optional[str] = None
+    substeps: Optional[str] = None     # 'auto': dt divided for springs coarse at dt
     source: Optional[str] = None
 
 
@@ -143,7 +144,7 @@ def _fortran_text(value) -> bytes:
 
 
 def to_core(scene: Scene):
-    """Scene -> (values, given, title, f1_table, f2_table, method) for the api."""
+    """Scene -> (values, given, *texts in TEXT_FIELDS order) for the api."""
     fields = vars(scene)
     reals = [fields[name] for name in REAL_FIELDS]
     given = np.array([value is not None for value in reals], dtype=np.int32)

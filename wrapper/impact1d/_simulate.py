@@ -46,8 +46,9 @@ def _with_overrides(scene: Scene, overrides: dict) -> Scene:
     (it only assigns the fields): a tenth of the time, which counts when a run is 0.1 ms."""
     changed = object.__new__(Scene)
     vars(changed).update(vars(scene), **overrides)
-    if isinstance(changed.method, str):
-        changed.method = changed.method.lower()      # as the CLI and namelists
+    for name in ("method", "substeps"):        # keywords: as the CLI and namelists
+        if isinstance(getattr(changed, name), str):
+            setattr(changed, name, getattr(changed, name).lower())
     return changed
 
 
@@ -207,7 +208,7 @@ def simulate(scene: Scene, *, progress: bool = False, **overrides) -> Result:
         raise InputError(f"unknown scene field(s) in overrides: {', '.join(unknown)} "
                          f"(known: {', '.join(_OVERRIDABLE)})")
     scene = _with_overrides(scene, overrides)
-    values, given, title, f1_table, f2_table, method = to_core(scene)
+    values, given, *texts = to_core(scene)
 
     # The core fills arrays made for this call (no state is kept between calls, so threads
     # may run at once); when a guess at their size is short it says what is needed.
@@ -215,7 +216,7 @@ def simulate(scene: Scene, *, progress: bool = False, **overrides) -> Result:
     sample_capacity, event_capacity = _sample_capacity(scene), _event_capacity
     while True:
         (samples, has_column, event_t, event_kind, event_v, n_samples, n_events, steps,
-         energy_residual, status, message, warnings) = _api.simulate(values, given, title, f1_table, f2_table, method,
+         energy_residual, status, message, warnings) = _api.simulate(values, given, *texts,
                                           1 if progress else 0, sample_capacity, len(COLUMNS),
                                           event_capacity)
         if int(status) != _STATUS_TOO_SMALL:
