@@ -6,10 +6,11 @@ program impact1d_cli
   use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char
   use impact1d_kinds, only: wp
   use impact1d_error, only: error_type, status_input, status_simulation, fmt
-  use impact1d_scene, only: scene_input, scene_type, set_text, i_t_end, i_dt, i_dt_out, i_method, i_title, &
+  use impact1d_scene, only: scene_input, scene_type, set_text, i_t_end, i_dt, i_dt_out, i_method, i_events, i_title, &
+    events_none, events_impacts, n_contacts, &
     i_f1_table, i_f2_table
   use impact1d_io, only: read_scene_file, prepare_scene, lower
-  use impact1d_output, only: file_sink, event_names, n_event_kinds, events_path, i_pe, i_work, &
+  use impact1d_output, only: file_sink, event_names, event_impact, n_event_kinds, events_path, i_pe, i_work, &
     i_friction_loss, i_impact_loss, i_damping_loss
   use impact1d_files, only: make_folders, resolve, write_stdout
   use impact1d_solver, only: run, run_stats
@@ -40,7 +41,7 @@ program impact1d_cli
 
   character(len=*), parameter :: usage = &
     'usage: impact1d SCENE [--t-end T] [--dt DT] [--dt-out DT_OUT] [--method event|vissim] [-o OUT.dat]' // &
-    ' [--quiet]'
+    ' [--events all|impacts|none] [--quiet]'
   character(len=*), parameter :: nl = new_line('a')
   character(len=*), parameter :: help = usage // nl // nl // &
     'Runs SCENE (a namelist scene, or a VisSim-style .dat parameter file) and writes its samples' // nl // &
@@ -54,6 +55,8 @@ program impact1d_cli
     '                   vissim  the VisSim tutorial''s fixed-step scheme, O(dt) (any letter case)' // nl // &
     '  -o OUT.dat       where the samples go (never one of the run''s own input files; a link' // nl // &
     '                   to a regular file is written through, a FIFO or a device refused)' // nl // &
+    '  --events WHAT    what the event log keeps: all (default), impacts, or none (no events' // nl // &
+    '                   file; an earlier one beside OUT.dat is removed); counts stay exact' // nl // &
     '  --quiet          no progress line (a run of over a second on a terminal shows one on' // nl // &
     '                   stderr: the simulated time, events so far and the time left; never' // nl // &
     '                   in a pipe or a file)' // nl // &
@@ -73,11 +76,12 @@ program impact1d_cli
   integer :: i, n_args, k, equals
   real(wp) :: overrides(3)
   logical :: overridden(3), has_value, out_given, quiet
-  character(len=64) :: method
+  character(len=64) :: method, events
 
   overridden = .false.
   overrides = 0.0_wp
   method = ''
+  events = ''
   scene_path = ''
   out_path = ''
   out_given = .false.
@@ -105,7 +109,7 @@ program impact1d_cli
     case ('--quiet')
       if (has_value) call fail(status_input, '--quiet takes no value; ' // usage)
       quiet = .true.
-    case ('--t-end', '--dt', '--dt-out', '--method', '-o')
+    case ('--t-end', '--dt', '--dt-out', '--method', '--events', '-o')
       if (.not. has_value) then
         if (i > n_args) call fail(status_input, option // ' needs a value')
         value = argument_text(i)
@@ -115,6 +119,9 @@ program impact1d_cli
       case ('--method')
         if (len_trim(value) == 0) call fail(status_input, '--method needs a name: event or vissim')
         method = lower(trim(adjustl(value)))
+      case ('--events')
+        if (len_trim(value) == 0) call fail(status_input, '--events needs a word: all, impacts or none')
+        events = lower(trim(adjustl(value)))
       case ('-o')
         ! An empty name is a mistake (an unset shell variable), not a request for the default.
         if (len_trim(value) == 0) call fail(status_input, '-o needs a file name, got an empty one')
@@ -144,6 +151,7 @@ program impact1d_cli
   input%value([i_t_end, i_dt, i_dt_out]) = merge(overrides, input%value([i_t_end, i_dt, i_dt_out]), overridden)
   input%given([i_t_end, i_dt, i_dt_out]) = input%given([i_t_end, i_dt, i_dt_out]) .or. overridden
   if (len_trim(method) > 0) call set_text(input, i_method, trim(method))
+  if (len_trim(events) > 0) call set_text(input, i_events, trim(events))
   call prepare_scene(input, scene, error)
   if (allocated(error)) call fail(error%status, scene_path // ': ' // error%message)
 
@@ -174,6 +182,21 @@ program impact1d_cli
 
 contains
 
+  !> What the summary says of the event log: its file and what it holds (&run events).
+  function event_log_text() result(text)
+    character(len=:), allocatable :: text
+    select case (scene%events)
+    case (events_none)
+      text = 'no event log (events = ''none''; ' // trim(fmt(sum(stats%events))) // ' events counted)'
+    case (events_impacts)
+      text = trim(events_path(out_path)) // ' (' // &
+        trim(fmt(sum(stats%events(event_impact + 1:event_impact + n_contacts)))) // ' impacts of ' // &
+        trim(fmt(sum(stats%events))) // ' events: events = ''impacts'')'
+    case default
+      text = trim(events_path(out_path)) // ' (' // trim(fmt(sum(stats%events))) // ' events)'
+    end select
+  end function event_log_text
+
   !> The summary on stdout. Every number in ES with a three-digit exponent (7.73913E+157
   !> lost its E in ES12.5).
   subroutine summary()
@@ -186,8 +209,7 @@ contains
       ' RK4 steps per dt given (substeps = ''auto'': the springs'' fastest mode at |lambda| dt <= ' // &
       '0.5)' // nl
     text = text // '  output    ' // out_path // ' (' // trim(fmt(scene%n_samples)) // ' rows every ' // &
-      trim(fmt(scene%dt_out)) // ' s) and ' // trim(events_path(out_path)) // ' (' // &
-      trim(fmt(sum(stats%events))) // ' events)' // nl
+      trim(fmt(scene%dt_out)) // ' s) and ' // trim(event_log_text()) // nl
     line = ''
     do k = 1, n_event_kinds
       if (stats%events(k) > 0) line = line // ' ' // trim(event_names(k)) // ' ' // trim(fmt(stats%events(k)))

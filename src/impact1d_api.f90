@@ -10,7 +10,7 @@ module impact1d_api
   use impact1d_error, only: error_type, status_ok, status_input, status_interrupted
   use impact1d_interrupt, only: catch_interrupts
   use impact1d_scene, only: scene_input, scene_type, n_real, n_text, real_names, text_names, &
-    i_title, i_f1_table, i_f2_table, i_method, i_substeps, n_contacts, set_text
+    i_title, i_f1_table, i_f2_table, i_method, i_substeps, i_events, n_contacts, set_text
   use impact1d_io, only: read_scene_file, prepare_scene
   use impact1d_output, only: memory_sink, summary_sink, column_names_text => column_names, event_names, &
     n_columns, event_impact, present_columns, i_impact_loss, i_friction_loss
@@ -49,7 +49,7 @@ contains
   end subroutine event_kind_names
 
   !> Read and check a scene file ('.dat': VisSim-style parameters; else a namelist). The
-  !> texts (title, f1_table, f2_table, method, substeps), kept whole whatever their length, come back
+  !> texts (title, f1_table, f2_table, method, substeps, events), kept whole whatever their length, come back
   !> as character codes: text_codes(:text_lengths(k), k). When one is longer than
   !> text_room, status is 3 and text_lengths say the room needed: call again with it.
   subroutine read_scene(path, n, text_room, values, given, text_codes, text_lengths, status, message)
@@ -58,8 +58,8 @@ contains
     integer(c_int), intent(in) :: n, text_room
     real(c_double), intent(out) :: values(n)
     integer(c_int), intent(out) :: given(n)
-    integer(c_int), intent(out) :: text_codes(text_room, 5)    ! 5: n_text (f2py needs the number)
-    integer(c_int), intent(out) :: text_lengths(5)
+    integer(c_int), intent(out) :: text_codes(text_room, 6)    ! 6: n_text (f2py needs the number)
+    integer(c_int), intent(out) :: text_lengths(6)
     integer(c_int), intent(out) :: status
     character(len=512), intent(out) :: message
     type(scene_input) :: input
@@ -91,14 +91,14 @@ contains
   !> call again with them. has_column(k) is 1 for the columns the scene has (column_names
   !> lists all of them; x2 and v2 only exist with a second body, pe and damping_loss with
   !> springs and dampers): they fill samples' first columns, in column_names' order.
-  subroutine simulate(n, values, given, title, f1_table, f2_table, method, substeps, progress, max_samples, &
+  subroutine simulate(n, values, given, title, f1_table, f2_table, method, substeps, events, progress, max_samples, &
       n_cols, max_events, samples, has_column, event_t, event_kind, event_v, n_samples, n_events, steps, &
       energy_residual, status, message, warnings)
     !f2py threadsafe
     integer(c_int), intent(in) :: n
     real(c_double), intent(in) :: values(n)
     integer(c_int), intent(in) :: given(n)
-    character(len=*), intent(in) :: title, f1_table, f2_table, method, substeps
+    character(len=*), intent(in) :: title, f1_table, f2_table, method, substeps, events
     integer(c_int), intent(in) :: progress    !< non-zero: show progress on stderr after 1 s
     integer(c_int), intent(in) :: max_samples, n_cols, max_events
     real(c_double), intent(out), target :: samples(max_samples, n_cols)
@@ -129,7 +129,7 @@ contains
       write(message, '(a, i0, a, i0)') 'internal: ', n_cols, ' sample columns asked for, the core has ', n_columns
       return
     end if
-    input = flat_input(values, given, title, f1_table, f2_table, method, substeps)
+    input = flat_input(values, given, title, f1_table, f2_table, method, substeps, events)
     call prepare_scene(input, scene, error)
     if (failed(error, status, message)) return
     warnings = scene%warnings
@@ -144,6 +144,7 @@ contains
       call sink%reserve(scene%n_samples, columns)
     end if
     sink%show_progress = progress /= 0
+    sink%events = scene%events
     call run(scene, sink, stats, error)
     call sink%end_progress()
     if (failed(error, status, message)) return
@@ -167,13 +168,13 @@ contains
   !> summary_sink: no samples): summary(:, j) in the order of summary_names, status(j) and
   !> message_codes(:, j) (the message's character codes, blank-padded) say how it ended. A
   !> failing run is a status, never the end of the batch.
-  subroutine simulate_summaries(n, values, given, title, f1_table, f2_table, method, substeps, n_over, &
+  subroutine simulate_summaries(n, values, given, title, f1_table, f2_table, method, substeps, events, n_over, &
       over_index, n_runs, over_values, n_summary, summary, status, message_codes)
     !f2py threadsafe
     integer(c_int), intent(in) :: n, n_over, n_runs, n_summary
     real(c_double), intent(in) :: values(n), over_values(n_over, n_runs)
     integer(c_int), intent(in) :: given(n), over_index(n_over)
-    character(len=*), intent(in) :: title, f1_table, f2_table, method, substeps
+    character(len=*), intent(in) :: title, f1_table, f2_table, method, substeps, events
     real(c_double), intent(out) :: summary(n_summary, n_runs)
     integer(c_int), intent(out) :: status(n_runs)
     integer(c_int), intent(out) :: message_codes(512, n_runs)   ! 512: message_length (f2py needs the number)
@@ -197,7 +198,7 @@ contains
       call put_codes(message, message_codes(:, 1))
       return
     end if
-    base = flat_input(values, given, title, f1_table, f2_table, method, substeps)
+    base = flat_input(values, given, title, f1_table, f2_table, method, substeps, events)
     call catch_interrupts()
     do j = 1, n_runs
       input = base
@@ -234,10 +235,10 @@ contains
   end subroutine summary_column_names
 
   !> A scene's fields as the flat layer gets them (given: non-zero where set).
-  pure function flat_input(values, given, title, f1_table, f2_table, method, substeps) result(input)
+  pure function flat_input(values, given, title, f1_table, f2_table, method, substeps, events) result(input)
     real(c_double), intent(in) :: values(n_real)
     integer(c_int), intent(in) :: given(n_real)
-    character(len=*), intent(in) :: title, f1_table, f2_table, method, substeps
+    character(len=*), intent(in) :: title, f1_table, f2_table, method, substeps, events
     type(scene_input) :: input
     input%value = real(values, wp)
     input%given = given /= 0
@@ -246,6 +247,7 @@ contains
     call set_text(input, i_f2_table, f2_table)
     call set_text(input, i_method, method)
     call set_text(input, i_substeps, substeps)
+    call set_text(input, i_events, events)
   end function flat_input
 
   !> A text as character codes (byte values, 0 to 255), blank padded or cut to size(codes).

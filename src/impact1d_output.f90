@@ -8,6 +8,7 @@ module impact1d_output
   use impact1d_error, only: error_type, raise, status_input, status_simulation, status_interrupted, fmt
   use impact1d_interrupt, only: interrupt_count
   use impact1d_scene, only: scene_input, real_names, n_real, i_title, i_method, i_g, i_dt_out, &
+    events_all, events_impacts, events_none, events_kept, n_contacts, &
     i_dt, default_gravity, i_k1, i_k2, i_k12, i_c1, i_c2, i_c12, i_m2
   use impact1d_files, only: output_target, make_temporary, resolve, lock_folders, unlock_folders
   implicit none
@@ -50,6 +51,9 @@ module impact1d_output
   !> a one-line '47% (t = 2.8 of 6 s, 1234 events, about 3 s left)' refreshed four times a second,
   type, abstract :: sink_type
     logical :: show_progress = .false.
+    !> What the sink keeps of the event log (&run events: impact1d_scene's events_all,
+    !> events_impacts, events_none); the run's counts (run_stats) have every event.
+    integer :: events = events_all
     integer(int64) :: clock_start = -1, clock_shown = 0
     logical :: progress_shown = .false.
   contains
@@ -57,6 +61,7 @@ module impact1d_output
     procedure(put_event_interface), deferred :: put_event
     procedure :: progress
     procedure :: end_progress
+    procedure :: keeps_event
   end type sink_type
 
   abstract interface
@@ -228,6 +233,14 @@ contains
     end do
   end subroutine names_of
 
+  !> Whether an event of this kind goes into the sink's log (the memory and file sinks ask).
+  pure logical function keeps_event(self, kind)
+    class(sink_type), intent(in) :: self
+    integer, intent(in) :: kind
+    keeps_event = self%events == events_all .or. (self%events == events_impacts .and. &
+      kind > event_impact .and. kind <= event_impact + n_contacts)
+  end function keeps_event
+
   !> Every 4096 steps of a run: progress on stderr where it is shown, and an interrupt
   !> (Ctrl-C while Python waits for the run) ends the run within a fraction of a second.
   subroutine checkpoint(sink, stats, t, t_end, error)
@@ -353,6 +366,7 @@ contains
     real(wp), allocatable :: times(:), velocities(:, :)
     integer, allocatable :: kinds(:)
     integer :: n
+    if (.not. self%keeps_event(kind)) return
     n = self%n_events
     if (n == size(self%event_time)) then
       ! Geometric growth: events are rare next to steps, copies are amortised.
@@ -404,7 +418,11 @@ contains
       call raise(error, status_input, 'cannot write output ' // path // ': ' // trim(reason(message)))
       return
     end if
-    call make_temporary(self%event_target, self%event_unit, self%event_part, ios, message)
+    self%events = events_kept(input)
+    self%event_part = ''
+    ios = 0
+    if (self%events /= events_none) &
+      call make_temporary(self%event_target, self%event_unit, self%event_part, ios, message)
     if (ios /= 0) then
       close(self%unit, status='delete')
       call raise(error, status_input, 'cannot write output ' // self%event_path // ': ' // trim(reason(message)))
@@ -435,6 +453,7 @@ contains
     end do
     call names_of(self%columns, header)
     call self%put_line(self%unit, '#' // header)
+    if (self%events == events_none) return
     call self%put_line(self%event_unit, '# impact1d events')
     if (self%n_bodies == 2) then
       call self%put_line(self%event_unit, '# t kind v1_before v2_before v1_after v2_after')
@@ -460,7 +479,7 @@ contains
     integer, intent(in) :: kind
     integer :: ios
     character(len=512) :: message
-    if (allocated(self%write_failure)) return
+    if (allocated(self%write_failure) .or. .not. self%keeps_event(kind)) return
     if (self%n_bodies == 2) then
       write(self%event_unit, event_format, iostat=ios, iomsg=message) t, event_names(kind), v_before, v_after
     else
@@ -498,17 +517,17 @@ contains
     self%is_open = .false.
     if (keep) then
       call self%finish_file(self%unit, self%path, self%part)
-      call self%finish_file(self%event_unit, self%event_path, self%event_part)
+      if (self%events /= events_none) call self%finish_file(self%event_unit, self%event_path, self%event_part)
     else
       close(self%unit, iostat=ios)
-      close(self%event_unit, iostat=ios)
+      if (self%events /= events_none) close(self%event_unit, iostat=ios)
     end if
     if (keep .and. .not. allocated(self%write_failure)) then
       call replace_pair(self, error)
       if (.not. allocated(error)) return
     end if
     call remove_file(self%part)
-    call remove_file(self%event_part)
+    if (len(self%event_part) > 0) call remove_file(self%event_part)
     if (keep .and. allocated(self%write_failure)) &
       call raise(error, status_simulation, 'cannot write output ' // self%write_failure)
   end subroutine file_close
@@ -575,9 +594,9 @@ contains
     final(2) = self%event_target
     part(1) = self%part
     part(2) = self%event_part
-    do k = 1, 2
-      aside(k) = part(k)(:len_trim(part(k)) - len('.part')) // '.previous'
-    end do
+    aside(1) = part(1)(:len_trim(part(1)) - len('.part')) // '.previous'
+    aside(2) = part(2)(:len_trim(part(2)) - len('.part')) // '.previous'
+    if (len_trim(part(2)) == 0) aside(2) = part(1)(:len_trim(part(1)) - len('.part')) // '.events.previous'
     call lock_folders(trim(final(1)), trim(final(2)), locks)
     kept = .false.
     placed = .false.
@@ -588,6 +607,9 @@ contains
     end do
     status = 0
     do k = 2, 1, -1
+      ! Without an event log (events = 'none') the previous events file is set aside like
+      ! the samples and removed with them: an old log must not pass for this run's.
+      if (len_trim(part(k)) == 0) cycle
       status = c_rename(trim(part(k)) // c_null_char, trim(final(k)) // c_null_char)
       if (status /= 0) exit
       placed(k) = .true.
@@ -598,6 +620,8 @@ contains
         if (placed(k) .and. .not. kept(k)) call remove_file(trim(final(k)))
         if (kept(k)) undone = c_rename(trim(aside(k)) // c_null_char, trim(final(k)) // c_null_char)
       else if (kept(k)) then
+        ! (no new file took the name: the previous one goes, see above)
+        if (len_trim(part(k)) == 0) call remove_file(trim(final(k)))
         call remove_file(trim(aside(k)))
       end if
     end do

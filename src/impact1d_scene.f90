@@ -17,10 +17,11 @@ module impact1d_scene
     i_r_min, i_d_max, i_r_max, i_x1, i_v1, i_x2, i_v2, i_f1, i_f2, i_f1_amp, i_f1_period, &
     i_f1_phase, i_f2_amp, i_f2_period, i_f2_phase, i_t_end, i_dt, i_dt_out, i_mus1, i_mus2, &
     i_k1, i_x1_rest, i_c1, i_k2, i_x2_rest, i_c2, i_k12, i_d_rest, i_c12
-  public :: sample_time, set_text
-  public :: i_title, i_f1_table, i_f2_table, i_method, i_substeps, default_gravity
+  public :: sample_time, set_text, events_kept
+  public :: i_title, i_f1_table, i_f2_table, i_method, i_substeps, i_events, default_gravity
+  public :: events_all, events_impacts, events_none
 
-  integer, parameter :: n_real = 43, n_text = 5
+  integer, parameter :: n_real = 43, n_text = 6
   !> Names of the real inputs, as in the namelist and in Python's Scene, in this order.
   character(len=*), parameter :: real_names(n_real) = [character(len=15) :: &
     'm1', 'm2', 'mu1', 'mu2', 'g', 'x_left', 'r_left', 'x_right', 'r_right', &
@@ -29,7 +30,7 @@ module impact1d_scene
     'zero_vel', 'max_rows', 'max_impulses', 'max_step_events', 'mus1', 'mus2', &
     'k1', 'x1_rest', 'c1', 'k2', 'x2_rest', 'c2', 'k12', 'd_rest', 'c12']
   character(len=*), parameter :: text_names(n_text) = [character(len=8) :: &
-    'title', 'f1_table', 'f2_table', 'method', 'substeps']
+    'title', 'f1_table', 'f2_table', 'method', 'substeps', 'events']
   integer, parameter :: i_m1 = 1, i_m2 = 2, i_mu1 = 3, i_mu2 = 4, i_g = 5, i_x_left = 6, &
     i_r_left = 7, i_x_right = 8, i_r_right = 9, i_d_min = 10, i_r_min = 11, i_d_max = 12, &
     i_r_max = 13, i_x1 = 14, i_v1 = 15, i_x2 = 16, i_v2 = 17, i_f1 = 18, i_f2 = 19, &
@@ -43,7 +44,11 @@ module impact1d_scene
     i_f2_phase, i_k2, i_x2_rest, i_c2, i_k12, i_d_rest, i_c12, i_d_min, i_r_min, i_d_max, i_r_max]
   !> Each spring element's stiffness; its rest position and damping follow it.
   integer, parameter :: spring_index(n_elements) = [i_k1, i_k2, i_k12]
-  integer, parameter :: i_title = 1, i_f1_table = 2, i_f2_table = 3, i_method = 4, i_substeps = 5
+  integer, parameter :: i_title = 1, i_f1_table = 2, i_f2_table = 3, i_method = 4, i_substeps = 5, &
+    i_events = 6
+  !> What the event log keeps (&run events): every event, the impacts only, nothing. The
+  !> run's counts (the summary, a sweep's row) are exact whatever it keeps.
+  integer, parameter :: events_all = 0, events_impacts = 1, events_none = 2
 
   !> The four optional unilateral constraints: gap_k = normal(:,k) . x + offset_k >= 0.
   integer, parameter :: n_contacts = 4, i_left = 1, i_right = 2, i_slot_min = 3, i_slot_max = 4
@@ -96,6 +101,8 @@ module impact1d_scene
     !> RK4 steps per dt (&run substeps = 'auto' with springs or dampers coarse for dt: the
     !> step taken is dt / substeps); 1 otherwise.
     integer :: substeps = 1
+    !> What the event log keeps: events_all, events_impacts or events_none (&run events).
+    integer :: events = events_all
     ! bodies ------------------------------------------------------------------------------
     integer :: n_bodies = 2                          !< N: 1 (m2 not given) or 2
     real(wp), allocatable :: body_mass(:)            !< (N) kg
@@ -332,6 +339,7 @@ contains
       end if
     end if
     call keyword(input, i_substeps, ['none', 'auto'], error)
+    call keyword(input, i_events, ['all    ', 'impacts', 'none   '], error)
     if (allocated(error)) return
     if (len_trim(input%text(i_method)%s) > 0) then
       if (trim(input%text(i_method)%s) /= 'event' .and. trim(input%text(i_method)%s) /= 'vissim') then
@@ -341,6 +349,14 @@ contains
       end if
     end if
   end subroutine validate
+
+  !> What the event log of a run of this input keeps (&run events; all by default).
+  pure integer function events_kept(input)
+    type(scene_input), intent(in) :: input
+    events_kept = events_all
+    if (input%text(i_events)%s == 'impacts') events_kept = events_impacts
+    if (input%text(i_events)%s == 'none') events_kept = events_none
+  end function events_kept
 
   !> Text field i, when given, is one of the words allowed.
   subroutine keyword(input, i, allowed, error)
@@ -519,6 +535,7 @@ contains
     scene%warnings = ''
     if (scene%springs%present) call check_step(scene, input%text(i_substeps)%s == 'auto', error)
     if (allocated(error)) return
+    scene%events = events_kept(input)
     if (input%given(i_max_impulses)) scene%max_impulses = int(input%value(i_max_impulses))
     if (input%given(i_max_step_events)) scene%max_step_events = int(input%value(i_max_step_events))
     ! (validate keeps the count within max_rows, a default integer)

@@ -47,7 +47,7 @@ REAL_FIELDS = (
     "t_end", "dt", "dt_out", "zero_vel", "max_rows", "max_impulses", "max_step_events",
     "mus1", "mus2", "k1", "x1_rest", "c1", "k2", "x2_rest", "c2", "k12", "d_rest", "c12",
 )
-TEXT_FIELDS = ("title", "f1_table", "f2_table", "method", "substeps")
+TEXT_FIELDS = ("title", "f1_table", "f2_table", "method", "substeps", "events")
 
 
 @dataclass
@@ -107,6 +107,7 @@ class Scene:
     f2_table: Optional[str] = None
     method: Optional[str] = None
     substeps: Optional[str] = None     # 'auto': dt divided for springs coarse at dt
+    events: Optional[str] = None       # 'all' (default), 'impacts' or 'none': what the log keeps
     source: Optional[str] = None
 
 

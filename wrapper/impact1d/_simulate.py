@@ -46,7 +46,7 @@ def _with_overrides(scene: Scene, overrides: dict) -> Scene:
     (it only assigns the fields): a tenth of the time, which counts when a run is 0.1 ms."""
     changed = object.__new__(Scene)
     vars(changed).update(vars(scene), **overrides)
-    for name in ("method", "substeps"):        # keywords: as the CLI and namelists
+    for name in ("method", "substeps", "events"):        # keywords: as the CLI and namelists
         if isinstance(getattr(changed, name), str):
             setattr(changed, name, getattr(changed, name).lower())
     return changed

@@ -10,6 +10,7 @@ Fortran run releases the GIL) or to the workers of a dask.distributed Client.
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import math
 import os
@@ -109,8 +110,11 @@ def run_chunk(scene: Scene, overrides: list, keep_results: bool = False):
         return {name: np.asarray(columns[name], dtype=np.float64) for name in SUMMARY_COLUMNS}, errors
     rows, errors, results = [], [], []
     for changes in overrides:
+        # The summary reads the whole event log (its counts and t_rest are exact whatever
+        # `events` keeps); a kept Result then keeps what `events` asked for.
+        events = changes.get("events", scene.events)
         try:
-            result = simulate(scene, **changes)
+            result = simulate(scene, **{**changes, "events": None})
         except (InputError, SimulationError) as error:
             rows.append(_failed_row())
             errors.append(str(error))
@@ -118,6 +122,9 @@ def run_chunk(scene: Scene, overrides: list, keep_results: bool = False):
             continue
         rows.append(summarize(result))
         errors.append("")
+        if keep_results and events is not None and str(events).lower() != "all":
+            keep = np.isin(result.events["kind"], _IMPACT_KINDS if str(events).lower() == "impacts" else ())
+            result = dataclasses.replace(result, events=result.events[keep])
         results.append(result if keep_results else None)
     return (_columns(rows), errors, results) if keep_results else (_columns(rows), errors)
 
