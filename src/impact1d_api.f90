@@ -13,7 +13,7 @@ module impact1d_api
     i_title, i_f1_table, i_f2_table, i_method, i_substeps, i_events, n_contacts, set_text
   use impact1d_io, only: read_scene_file, prepare_scene
   use impact1d_output, only: memory_sink, summary_sink, column_names_text => column_names, event_names, &
-    n_columns, event_impact, present_columns, i_impact_loss, i_friction_loss
+    n_columns, event_impact, present_columns, i_impact_loss, i_friction_loss, i_pe, i_damping_loss
   use impact1d_solver, only: run, run_stats
   implicit none
   private
@@ -23,9 +23,9 @@ module impact1d_api
   integer(c_int), parameter :: status_too_small = 3   !< arrays too small: sizes needed returned
   integer, parameter :: message_length = 512
   !> What simulate_summaries keeps of a run (sweep's columns, in this order).
-  character(len=*), parameter :: summary_names(15) = [character(len=15) :: 'x1_end', 'v1_end', &
+  character(len=*), parameter :: summary_names(17) = [character(len=15) :: 'x1_end', 'v1_end', &
     'x2_end', 'v2_end', 'ke_end', 'n_impacts', 'n_left', 'n_right', 'n_slot_min', 'n_slot_max', &
-    't_rest', 'impact_loss', 'friction_loss', 'energy_residual', 'steps']
+    't_rest', 'impact_loss', 'friction_loss', 'energy_residual', 'steps', 'pe_end', 'damping_loss']
 
 contains
 
@@ -222,7 +222,7 @@ contains
         real(sum(stats%events(event_impact + 1:event_impact + n_contacts)), wp), &
         real(stats%events(event_impact + 1:event_impact + n_contacts), wp), &
         sink%rest_time(stats%last_row), stats%last_row([i_impact_loss, i_friction_loss]), &
-        stats%max_residual, real(stats%steps, wp)]
+        stats%max_residual, real(stats%steps, wp), stats%last_row([i_pe, i_damping_loss])]
       ! A one-body scene has no x2_end, v2_end.
       if (scene%n_bodies == 1) summary(3:4, j) = ieee_value(1.0_c_double, ieee_quiet_nan)
     end do

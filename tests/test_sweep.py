@@ -254,3 +254,17 @@ def test_plot_legend_writes_whole_numbers_whole(case5):
     table = impact1d.sweep(case5, {"r_left": [0.2, 0.8], "max_rows": [1e4, 1e7]})
     labels = [line.get_label() for line in plot.sweep(table, "r_left").axes[0].lines]
     assert labels == ["max_rows = 10000", "max_rows = 10000000"]
+
+
+def test_sweep_rows_carry_the_springs_energy_and_the_dampers_loss():
+    """pe_end and damping_loss (issue 22, item 6): the last sample's, through the core's
+    batch path and through runs kept as Results alike; 0 for a scene without them."""
+    scene = impact1d.load_scene(INPUT / "mounted_stop.nml")
+    res = impact1d.simulate(scene, dt=2e-3)
+    batch = impact1d.sweep(scene, [dict(dt=2e-3)], workers=1)
+    kept, _ = impact1d.sweep(scene, [dict(dt=2e-3)], workers=1, keep="results")
+    for table in (batch, kept):
+        assert table.loc[0, "pe_end"] == res.pe[-1] and table.loc[0, "damping_loss"] == res.damping_loss[-1]
+    assert res.damping_loss[-1] > 0 and res.pe[-1] > 0
+    plain = impact1d.sweep(impact1d.load_scene(INPUT / "case3.nml"), [dict(r_left=1.0)], workers=1)
+    assert plain.loc[0, "pe_end"] == 0.0 and plain.loc[0, "damping_loss"] == 0.0

@@ -28,7 +28,8 @@ __all__ = ["sweep", "SUMMARY_COLUMNS", "summarize", "run_chunk"]
 # Named so that they never clash with a varied field (x1 is a field, x1_end is not).
 SUMMARY_COLUMNS = ("x1_end", "v1_end", "x2_end", "v2_end", "ke_end", "n_impacts",
                    "n_left", "n_right", "n_slot_min", "n_slot_max", "t_rest",
-                   "impact_loss", "friction_loss", "energy_residual", "steps")
+                   "impact_loss", "friction_loss", "energy_residual", "steps", "pe_end",
+                   "damping_loss")
 _IMPACT_KINDS = ("left", "right", "slot_min", "slot_max")
 # Below this many runs a sweep stays on one thread unless asked: a pool costs more than
 # it saves on a few milliseconds of work.
@@ -75,7 +76,10 @@ def summarize(result) -> dict:
            "n_impacts": sum(counts.values()), **{f"n_{k}": counts[k] for k in _IMPACT_KINDS},
            "t_rest": t_rest, "impact_loss": result.impact_loss[-1],
            "friction_loss": result.friction_loss[-1],
-           "energy_residual": result.energy_residual, "steps": result.steps}
+           "energy_residual": result.energy_residual, "steps": result.steps,
+           # The springs' energy and the dampers' loss at t_end: 0 without them.
+           "pe_end": result.pe[-1] if result.pe is not None else 0.0,
+           "damping_loss": result.damping_loss[-1] if result.damping_loss is not None else 0.0}
     return {name: row[name] for name in SUMMARY_COLUMNS}
 
 
