@@ -13,7 +13,7 @@ module impact1d_event_point
   use impact1d_impacts, only: normal_velocity, impulse, most_approaching, restitution_of, &
     kinetic_energy, joint_inelastic, inelastic_projection
   use impact1d_output, only: sink_type, run_stats, event_impact, event_rest, event_stick, event_slip
-  use impact1d_state, only: state_type, lane_state_type, load_lanes, store_lanes, add_compensated
+  use impact1d_state, only: lane_state_type, add_compensated
   use impact1d_yardsticks, only: gap_rounding, velocity_rounding, time_rounding, energy_rounding, force_scale, &
     same_instant
   use impact1d_contacts, only: gap, gap_tolerance, snap, rigid_pair, u_tolerance, u_tolerances
@@ -30,27 +30,9 @@ contains
 
   !> The event point at s%t. which: what the location found (contact k, 100 + body i, -1 a
   !> mode condition) or 0; initial: the start of the run (no mode yet). Leaves the new mode,
-  !> what it needs watched and the integrator's constant acceleration set.
-  subroutine event_point(scene, initial, which, state, mode, event_log, watch, rk, sink, stats, error)
-    type(scene_type), intent(in) :: scene
-    logical, intent(in) :: initial
-    integer, intent(in) :: which
-    type(state_type), intent(inout) :: state
-    type(mode_type), intent(inout) :: mode
-    type(event_log_type), intent(inout) :: event_log
-    type(watch_type), intent(inout) :: watch
-    type(rk4_type), intent(inout) :: rk
-    class(sink_type), intent(inout) :: sink
-    type(run_stats), intent(inout) :: stats
-    type(error_type), allocatable, intent(inout) :: error
-    type(lane_state_type) :: s
-    call load_lanes(state, s)
-    call pair_event_point(scene, initial, which, s, mode, event_log, watch, rk, sink, stats, error)
-    call store_lanes(s, state)
-  end subroutine event_point
-
-  !> event_point on the state in lanes.
-  subroutine pair_event_point(scene, initial, which, s, mode, event_log, watch, rk, sink, stats, error)
+  !> what it needs watched and the integrator's constant acceleration set. s: the run's state,
+  !> in lanes (the run keeps it there: impact1d_solver's run).
+  subroutine event_point(scene, initial, which, s, mode, event_log, watch, rk, sink, stats, error)
     type(scene_type), intent(in) :: scene
     logical, intent(in) :: initial
     integer, intent(in) :: which
@@ -201,7 +183,7 @@ contains
     end if
     watch%watching = mode%n_hold > 0 .or. any(scene%row_present .and. .not. mode%active) .or. &
       any(scene%pair%static_friction > 0.0_wp .and. mode%sgn /= 0.0_wp)
-  end subroutine pair_event_point
+  end subroutine event_point
 
   !> Log what a user can see change between the old mode and new_mode: contacts that start
   !> or stop holding, bodies that come to rest or break away.

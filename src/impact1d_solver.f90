@@ -15,7 +15,7 @@ module impact1d_solver
   use impact1d_output, only: sink_type, run_stats, emit_sample, checkpoint
   use impact1d_vissim, only: run_vissim
   use impact1d_interrupt, only: interrupt_count
-  use impact1d_state, only: state_type, lane_state_type, load_lanes, store_lanes, new_state, renormalise, &
+  use impact1d_state, only: state_type, lane_state_type, load_lanes, new_state, renormalise, &
     finite_state, constant_step, constant_steps, add_compensated
   use impact1d_lanes, only: max_lanes, to_lanes
   use impact1d_contacts, only: gap, gap_tolerance, u_tolerance
@@ -46,7 +46,12 @@ contains
     type(run_stats), intent(out) :: stats
     type(error_type), allocatable, intent(out) :: error
 
-    type(state_type) :: s
+    ! The run's state: N long as the model (its start, s0), in lanes from then on (s). While
+    ! N <= max_lanes the whole run keeps it in lanes: loading it into lanes and storing it
+    ! back at every step and event point cost ~10% of a spring step (docs/performance.md).
+    type(state_type) :: s0
+    type(lane_state_type) :: s
+    type(lane_state_type) :: trial   ! advance's scratch (declared here: a local would be default-initialised every step)
     type(mode_type) :: mode
     type(rk4_type) :: rk
     type(watch_type) :: watch
@@ -73,12 +78,13 @@ contains
     rk%constant_forcing = .not. (any(scene%forcing%has_table) .or. any(scene%forcing%has_sine) .or. &
       scene%springs%present)
     ! Every array of the run, once: nothing allocates per step.
-    call new_state(scene%n_bodies, s)
+    call new_state(scene%n_bodies, s0)
     allocate(watch%quiet_body(scene%n_bodies))
     call event_log%allocate_bodies(scene%n_bodies)
-    s%x(:) = scene%body_x0
-    s%v(:) = scene%body_v0
-    ke0 = kinetic_energy(scene, s%v)
+    s0%x(:) = scene%body_x0
+    s0%v(:) = scene%body_v0
+    ke0 = kinetic_energy(scene, s0%v)
+    call load_lanes(s0, s)
     pe0 = 0.0_wp
     call to_lanes(scene%body_x0, x0)
     if (scene%springs%present) pe0 = scene%springs%potential(x0, [0.0_wp, 0.0_wp])
@@ -107,7 +113,7 @@ contains
       at_stop = glided
       if (.not. at_stop) then
         ! Locate and re-step: one step toward the stop, cut at the earliest event in it.
-        call advance(scene, mode, rk, watch, t_stop, s, located, watched, at_stop, sink, stats, error)
+        call advance(scene, mode, rk, watch, t_stop, s, trial, located, watched, at_stop, sink, stats, error)
         if (allocated(error)) return
       end if
 
@@ -135,7 +141,7 @@ contains
           return
         end if
         call event_log%flush_releases(scene, s%t, .false., sink, stats)
-        call event_log%flush_pending_rest(s%t, s%v, sink, stats)
+        call event_log%flush_pending_rest(s%t, s%v(:scene%n_bodies), sink, stats)
         ! The event point: impacts, rest, the new mode, the log.
         call event_point(scene, .false., merge(watched, 0, located), s, mode, event_log, watch, rk, &
           sink, stats, error)
@@ -154,32 +160,31 @@ contains
   !> Sample j_sample of the run (then the next one is due); a row that is not finite is an error.
   subroutine emit(scene, s, ke0, pe0, j_sample, sink, stats, error)
     type(scene_type), intent(in) :: scene
-    type(state_type), intent(in) :: s
+    type(lane_state_type), intent(in) :: s
     real(wp), intent(in) :: ke0, pe0
     integer, intent(inout) :: j_sample
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
     type(error_type), allocatable, intent(out) :: error
-    type(lane_state_type) :: ls
     real(wp) :: pe
-    call load_lanes(s, ls)
     pe = 0.0_wp
-    if (scene%springs%present) pe = scene%springs%potential(ls%x, ls%x_lo)
-    call emit_sample(sink, stats, ls%t, ls%x, ls%v, scene%pair%mass, ke0, ls%work, ls%friction_loss, &
-      ls%impact_loss, scene%springs%present, [pe, pe0, ls%damping_loss], error)
+    if (scene%springs%present) pe = scene%springs%potential(s%x, s%x_lo)
+    call emit_sample(sink, stats, s%t, s%x, s%v, scene%pair%mass, ke0, s%work, s%friction_loss, &
+      s%impact_loss, scene%springs%present, [pe, pe0, s%damping_loss], error)
     j_sample = j_sample + 1
   end subroutine emit
 
   !> One step from s toward t_stop, ended at the earliest event located in it (located,
   !> watched: what it found) or at the stop (at_stop). A step whose end breaks a constraint
   !> (a root the location missed: only possible for non-polynomial forcing) is retried shorter.
-  subroutine advance(scene, mode, rk, watch, t_stop, s, located, watched, at_stop, sink, stats, error)
+  subroutine advance(scene, mode, rk, watch, t_stop, s, trial, located, watched, at_stop, sink, stats, error)
     type(scene_type), intent(in) :: scene
     type(mode_type), intent(in) :: mode
     type(rk4_type), intent(inout) :: rk
     type(watch_type), intent(in) :: watch
     real(wp), intent(in) :: t_stop
-    type(state_type), intent(inout) :: s
+    type(lane_state_type), intent(inout) :: s
+    type(lane_state_type), intent(inout) :: trial   !< scratch: the step's end (inout: no default init)
     logical, intent(out) :: located, at_stop
     integer, intent(out) :: watched
     class(sink_type), intent(inout) :: sink
@@ -187,10 +192,7 @@ contains
     type(error_type), allocatable, intent(inout) :: error
     real(wp) :: h, h_event
     integer :: halvings
-    ! The step's start and end in lanes: loaded from s once, the end stored back once.
-    type(lane_state_type) :: start, trial
 
-    call load_lanes(s, start)
     h = step_toward(scene, s, t_stop)
     halvings = 0
     do
@@ -198,26 +200,26 @@ contains
       watched = 0
       ! An event that landed exactly on the stop leaves nothing to step.
       if (h <= 0.0_wp) then
-        trial = start
+        trial = s
         exit
       end if
-      call rk%step(scene, mode, start, h, trial)
+      call rk%step(scene, mode, s, h, trial)
       if (.not. watch%watching) exit      ! nothing in this mode can end it: no location needed
-      call watch%locate(scene, mode, rk%constant_forcing, rk%polynomial_forcing, start, trial, h, h_event, watched)
+      call watch%locate(scene, mode, rk%constant_forcing, rk%polynomial_forcing, s, trial, h, h_event, watched)
       located = h_event <= h
       if (located) then
         h = h_event
         if (h > 0.0_wp) then
-          call refine(rk, scene, mode, start, h, watched, trial)
+          call refine(rk, scene, mode, s, h, watched, trial)
         else
-          trial = start     ! the event is at the step's start: nothing to step
+          trial = s     ! the event is at the step's start: nothing to step
           exit
         end if
       end if
       ! Under polynomial forcing the dense output is exact and nothing can be missed; only
       ! a sine's approximate dense output needs the step's end checked.
       if (rk%polynomial_forcing) exit
-      if (constraints_hold(scene, mode, start, trial, merge(watched, 0, located))) exit
+      if (constraints_hold(scene, mode, s, trial, merge(watched, 0, located))) exit
       halvings = halvings + 1
       if (halvings > max_halvings) then
         call raise(error, status_simulation, 'at t = ' // trim(fmt(s%t)) // &
@@ -228,7 +230,7 @@ contains
     end do
 
     at_stop = .not. located .and. h == (t_stop - s%t) - s%t_lo
-    call store_lanes(trial, s)
+    s = trial
     if (at_stop) then
       s%t = t_stop
       s%t_lo = 0.0_wp
@@ -245,7 +247,7 @@ contains
   !> that would end just short of the stop goes to it.
   pure real(wp) function step_toward(scene, s, t_stop) result(h)
     type(scene_type), intent(in) :: scene
-    type(state_type), intent(in) :: s
+    type(lane_state_type), intent(in) :: s
     real(wp), intent(in) :: t_stop
     h = step_length(scene%dt, (t_stop - s%t) - s%t_lo)
   end function step_toward
@@ -279,32 +281,26 @@ contains
   !> needs nothing but its sample: it is emitted here and the glide goes on to the next
   !> stop rather than going back through run's loop for each; the arithmetic is the same
   !> either way.
-  subroutine glide(scene, mode, rk, watch, ke0, pe0, stops, s, sink, stats, at_stop, error)
+  subroutine glide(scene, mode, rk, watch, ke0, pe0, stops, ls, sink, stats, at_stop, error)
     type(scene_type), intent(in) :: scene
     type(mode_type), intent(in) :: mode
     type(rk4_type), intent(in) :: rk
     type(watch_type), intent(in) :: watch
     real(wp), intent(in) :: ke0, pe0
     type(stops_type), intent(inout) :: stops
-    type(state_type), intent(inout) :: s
+    type(lane_state_type), intent(inout) :: ls
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
     logical, intent(out) :: at_stop      !< the steps reached the stop (stops say which)
     type(error_type), allocatable, intent(inout) :: error
     real(wp) :: t_quiet, t_stop, h, x_start(max_lanes), x_lo_start(max_lanes)
     integer(int64) :: n_bulk
-    ! The state in lanes through the glide: loaded once, stored back once.
-    type(lane_state_type) :: ls
 
     at_stop = .false.
     t_quiet = watch%quiet_time()
-    call load_lanes(s, ls)
     ! Samples a step apart take a loop of their own.
     call step_to_samples(scene, mode, rk, t_quiet, ke0, pe0, stops, ls, sink, stats, error)
-    if (allocated(error)) then
-      call store_lanes(ls, s)
-      return
-    end if
+    if (allocated(error)) return
     do
       at_stop = .false.
       t_stop = min(stops%sample_t, stops%t_break, stops%t_rest)
@@ -351,7 +347,6 @@ contains
       if (allocated(error)) exit
       stops%sample_t = sample_time(scene, stops%j_sample)
     end do
-    call store_lanes(ls, s)
   end subroutine glide
 
   !> n_bulk steps of dt under the mode's constant acceleration (constant_steps), in runs of
@@ -467,7 +462,7 @@ contains
   end subroutine step_to_samples
 
   subroutine check_finite(s, error)
-    type(state_type), intent(in) :: s
+    type(lane_state_type), intent(in) :: s
     type(error_type), allocatable, intent(inout) :: error
     if (.not. finite_state(s%x, s%v, s%work)) call raise_not_finite(s%t, error)
   end subroutine check_finite
@@ -484,16 +479,14 @@ contains
   pure logical function impact_due(scene, mode, s)
     type(scene_type), intent(in) :: scene
     type(mode_type), intent(in) :: mode
-    type(state_type), intent(in) :: s
+    type(lane_state_type), intent(in) :: s
     integer :: k
-    type(lane_state_type) :: m
     real(wp), parameter :: no_scale(max_lanes) = 0.0_wp
     impact_due = .false.
-    call load_lanes(s, m)
     do k = 1, n_contacts
       if (.not. scene%row_present(k) .or. mode%active(k)) cycle
-      if (gap(scene, k, m) <= gap_tolerance(scene, k, m, 0.0_wp) .and. &
-          normal_velocity(scene, k, m%v) < -u_tolerance(scene, mode, m, k, no_scale)) impact_due = .true.
+      if (gap(scene, k, s) <= gap_tolerance(scene, k, s, 0.0_wp) .and. &
+          normal_velocity(scene, k, s%v) < -u_tolerance(scene, mode, s, k, no_scale)) impact_due = .true.
     end do
   end function impact_due
 end module impact1d_solver

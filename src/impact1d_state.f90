@@ -7,7 +7,7 @@ module impact1d_state
   use impact1d_lanes, only: max_lanes
   implicit none
   private
-  public :: state_type, lane_state_type, load_lanes, store_lanes, new_state, add_compensated, accumulate, &
+  public :: state_type, lane_state_type, load_lanes, new_state, add_compensated, accumulate, &
     renormalise, finite_state, constant_step, constant_steps
 
   !> Time, positions, velocities and the ledger integrals, compensated: a micrometre bounce
@@ -23,8 +23,9 @@ module impact1d_state
   end type state_type
 
   !> A state in lanes (impact1d_lanes' max_lanes; a lane past N idle at 0): what a step and
-  !> its location work on. advance loads it from the run's state once and stores it back
-  !> once; fixed-size, it needs no descriptors and holds two bodies in one register.
+  !> its location work on, and the run's state from its start on (run loads it from the
+  !> N-long start once); fixed-size, it needs no descriptors and holds two bodies in one
+  !> register.
   type :: lane_state_type
     real(wp) :: t = 0.0_wp, t_lo = 0.0_wp
     real(wp), dimension(max_lanes) :: x = 0.0_wp, x_lo = 0.0_wp, v = 0.0_wp, v_lo = 0.0_wp
@@ -145,29 +146,6 @@ contains
     ls%damping_loss = s%damping_loss
     ls%damping_lo = s%damping_lo
   end subroutine load_lanes
-
-  !> s = ls (its N bodies).
-  pure subroutine store_lanes(ls, s)
-    type(lane_state_type), intent(in) :: ls
-    type(state_type), intent(inout) :: s
-    integer :: i
-    s%t = ls%t
-    s%t_lo = ls%t_lo
-    do i = 1, max_lanes
-      if (i > size(s%x)) exit
-      s%x(i) = ls%x(i)
-      s%x_lo(i) = ls%x_lo(i)
-      s%v(i) = ls%v(i)
-      s%v_lo(i) = ls%v_lo(i)
-    end do
-    s%work = ls%work
-    s%work_lo = ls%work_lo
-    s%friction_loss = ls%friction_loss
-    s%friction_lo = ls%friction_lo
-    s%impact_loss = ls%impact_loss
-    s%damping_loss = ls%damping_loss
-    s%damping_lo = ls%damping_lo
-  end subroutine store_lanes
 
   !> All of the state a run reports is finite.
   pure logical function finite_state(x, v, work)

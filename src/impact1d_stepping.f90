@@ -65,7 +65,7 @@ contains
     type(mode_type), intent(in) :: mode
     type(lane_state_type), intent(in) :: a
     real(wp), intent(in) :: step
-    type(lane_state_type), intent(out) :: b
+    type(lane_state_type), intent(inout) :: b     ! all of it is set (inout: no default init)
     real(wp), dimension(max_lanes) :: f0, fm, f1, a0, am, a1, v0, vm
     if (scene%springs%present) then
       call state_dependent_step(self, scene, mode, a, step, b)
@@ -117,7 +117,7 @@ contains
     type(mode_type), intent(in) :: mode
     type(lane_state_type), intent(in) :: a
     real(wp), intent(in) :: step
-    type(lane_state_type), intent(out) :: b
+    type(lane_state_type), intent(inout) :: b     ! all of it is set (inout: no default init)
     real(wp) :: half
     real(wp), dimension(max_lanes) :: v0, v1, vm, f, load, acc_end, dx
     real(wp), dimension(max_lanes) :: kx1, kx2, kx3, kx4, kv1, kv2, kv3, kv4
