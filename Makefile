@@ -107,40 +107,33 @@ clean:
 bench: setup siconos sundials
 	$(BIN)/python bench/run_all.py
 
+# An optional bench peer's Debian package: $(1) the package, $(2) what the bench then runs
+# without, $(3) a shell test that is true when it is already there. apt-get only when it is
+# missing; where it cannot be installed the bench says so and goes on.
+define optional_peer
+	@if ! $(3); then \
+	  if [ "$$(id -u)" -eq 0 ]; then SUDO=""; \
+	  elif command -v sudo >/dev/null 2>&1; then SUDO="sudo -E"; \
+	  else SUDO="none"; fi; \
+	  if [ "$$SUDO" = none ] || ! command -v apt-get >/dev/null 2>&1; then \
+	    echo "note: $(1) is not installed and apt-get cannot install it here: the bench runs without $(2)"; \
+	  else \
+	    echo "installing $(1) with apt-get"; \
+	    $$SUDO apt-get update -q || true; \
+	    $$SUDO apt-get install -y -q $(1) \
+	      || echo "note: apt-get could not install $(1): the bench runs without $(2)"; \
+	  fi; \
+	fi
+endef
+
 # The Siconos peer (bench/siconos_peer.py) runs under the system interpreter with Debian's
-# python3-siconos: apt-get only when it is missing. Optional: where it cannot be installed
-# the bench runs without it and its docs sections say why.
+# python3-siconos.
 SICONOS_PYTHON ?= /usr/bin/python3
 export SICONOS_PYTHON
 siconos:
-	@if ! $(SICONOS_PYTHON) -c 'import siconos.kernel' >/dev/null 2>&1; then \
-	  if [ "$$(id -u)" -eq 0 ]; then SUDO=""; \
-	  elif command -v sudo >/dev/null 2>&1; then SUDO="sudo -E"; \
-	  else SUDO="none"; fi; \
-	  if [ "$$SUDO" = none ] || ! command -v apt-get >/dev/null 2>&1; then \
-	    echo "note: Siconos is not installed and apt-get cannot install it here: the bench runs without it"; \
-	  else \
-	    echo "installing python3-siconos with apt-get"; \
-	    $$SUDO apt-get update -q || true; \
-	    $$SUDO apt-get install -y -q python3-siconos \
-	      || echo "note: apt-get could not install python3-siconos: the bench runs without it"; \
-	  fi; \
-	fi
+	$(call optional_peer,python3-siconos,Siconos,$(SICONOS_PYTHON) -c 'import siconos.kernel' >/dev/null 2>&1)
 
 # The CVODE peer (bench/cvode_peer.c, compiled by bench/cvode_peer.py into build/bench) links
-# Debian's SUNDIALS: apt-get only when its CVODE header is missing. Optional, as Siconos is:
-# where it cannot be installed the bench says "not compared" for CVODE.
+# Debian's SUNDIALS (its CVODE header tells whether it is there).
 sundials:
-	@if [ ! -f /usr/include/cvode/cvode.h ]; then \
-	  if [ "$$(id -u)" -eq 0 ]; then SUDO=""; \
-	  elif command -v sudo >/dev/null 2>&1; then SUDO="sudo -E"; \
-	  else SUDO="none"; fi; \
-	  if [ "$$SUDO" = none ] || ! command -v apt-get >/dev/null 2>&1; then \
-	    echo "note: SUNDIALS is not installed and apt-get cannot install it here: the bench runs without CVODE"; \
-	  else \
-	    echo "installing libsundials-dev with apt-get"; \
-	    $$SUDO apt-get update -q || true; \
-	    $$SUDO apt-get install -y -q libsundials-dev \
-	      || echo "note: apt-get could not install libsundials-dev: the bench runs without CVODE"; \
-	  fi; \
-	fi
+	$(call optional_peer,libsundials-dev,CVODE,[ -f /usr/include/cvode/cvode.h ])
