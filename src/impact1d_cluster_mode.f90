@@ -1,0 +1,405 @@
+!> The mode solve of one cluster of n bodies (issue 19, stage 4; docs/method.md, "N bodies:
+!> the cluster's mode solve"): which closed rows are held, which bodies at rest stick, the
+!> accelerations. Kernel in place; the engine still uses impact1d_modes for its units of
+!> <= 2 bodies (docs/nbody-plan.md, B7) and is wired to this in stage 4.
+!>
+!> The problem at one instant. Bodies i = 1..n: mass m_i, applied force y_i (external and
+!> elastic) with its right derivative dy_i, sliding bound c_i, static bound s_i >= c_i,
+!> velocity v_i. Rows k: ends a, b (0 = the ground), coefficients (n_a, n_b) on (x_a, x_b);
+!> candidate rows (closed, zero normal velocity) may push: lambda_k >= 0, n_k.a >= 0,
+!> lambda_k n_k.a = 0. A sliding body (v_i /= 0) feels -c_i sgn(v_i). A body at rest with
+!> s_i > 0 feels F_i in [-beta_i, beta_i], with a_i = 0 inside the bound and F_i =
+!> -beta_i sgn(a_i) when it moves. This is the LCP of Gauss's principle with friction
+!> (a convex QP: the accelerations are unique), in the unknowns (lambda_k, rho_i = F_i +
+!> beta_i, mu_i = m_i a_i^-), solved by impact1d_lcp (Lemke, lexicographic).
+!>
+!> What it guarantees (status = cluster_solved):
+!> - The mode that holds just AFTER the instant: ties (a holding force exactly at its
+!>   bound, a contact force exactly 0) are decided by the rate dy, as impact1d_modes does.
+!> - Static above sliding (METHOD 8), stick preferred: the problem is solved with beta = s
+!>   for every body at rest; bodies it moves break away and are solved again with beta = c
+!>   (their F = -c sgn a), until no more break away (at most n + 1 solves).
+!> - Exactness: a stuck body has a = 0 exactly; bodies joined by held rows of the form
+!>   n = (-1, 1) or (1, -1), or a wall, share one acceleration exactly: 0 when joined to the
+!>   ground or to a stuck body, else their mass-weighted mean (closed gaps do not creep).
+!> - Active (held) rows: the closed rows carrying force, then, in row order, the closed
+!>   force-free rows whose ends are not yet joined (the ground and stuck bodies counting as
+!>   joined) - the choice of tests/exact_nbody.py and, where the set is unique, of
+!>   impact1d_modes.
+!> - No allocation: the caller sizes a cluster_work_type once (cluster_reserve).
+module impact1d_cluster_mode
+  use impact1d_kinds, only: wp, eps_wp
+  use impact1d_lcp, only: lcp_work_type, lcp_reserve, lcp_solve, lcp_basis_values, lcp_solved, &
+    lcp_too_large
+  implicit none
+  private
+  public :: cluster_work_type, cluster_reserve, cluster_mode, cluster_solved
+
+  integer, parameter :: cluster_solved = 0    !< otherwise an impact1d_lcp status
+
+  !> Relative size of a zero force (as impact1d_modes' tolerance).
+  real(wp), parameter :: rel_tol = 1.0e3_wp * eps_wp
+
+  !> The mode solve's memory, owned by the caller and sized once (cluster_reserve).
+  type :: cluster_work_type
+    integer :: max_bodies = 0, max_rows = 0
+    type(lcp_work_type) :: lcp
+    integer :: size = 0, n_boxed = 0, n_free_rows = 0   !< the last LCP: unknowns, boxed bodies, candidate rows
+    real(wp), allocatable :: m(:, :)           !< (s, s) LCP matrix, s = max_rows + 2 max_bodies
+    real(wp), allocatable :: q(:), dq(:)       !< (s) its right-hand side and rate
+    real(wp), allocatable :: z(:), w(:), dz(:), dw(:)   !< (s) solution and its rate
+    real(wp), allocatable :: beta(:)           !< (max_bodies) friction bound of a boxed body
+    real(wp), allocatable :: base(:)           !< (max_bodies) y + sliding friction - beta (boxed)
+    real(wp), allocatable :: da(:)             !< (max_bodies) rate of the acceleration
+    integer, allocatable :: row_var(:)         !< (max_rows) LCP unknown of candidate row k, else 0
+    integer, allocatable :: slot(:)            !< (max_bodies) box slot of body i (rho at size_rows + slot), else 0
+    integer, allocatable :: root(:)            !< (0:max_bodies) union-find parent; 0 is the ground
+    logical, allocatable :: broken(:)          !< (max_bodies) at rest, broken away: bound c
+    real(wp), allocatable :: group_mass(:), group_sum(:)   !< (0:max_bodies) per union-find root: sum m, sum m a
+  end type cluster_work_type
+
+contains
+
+  !> Size the work for clusters of up to max_bodies bodies and max_rows rows.
+  subroutine cluster_reserve(work, max_bodies, max_rows)
+    type(cluster_work_type), intent(inout) :: work
+    integer, intent(in) :: max_bodies, max_rows
+    integer :: s
+    if (work%max_bodies >= max_bodies .and. work%max_rows >= max_rows .and. allocated(work%m)) return
+    if (allocated(work%m)) deallocate(work%m, work%q, work%dq, work%z, work%w, work%dz, work%dw, &
+      work%beta, work%base, work%da, work%row_var, work%slot, work%root, work%broken, &
+      work%group_mass, work%group_sum)
+    s = max_rows + 2 * max_bodies
+    allocate(work%m(s, s), work%q(s), work%dq(s), work%z(s), work%w(s), work%dz(s), work%dw(s), &
+      work%beta(max_bodies), work%base(max_bodies), work%da(max_bodies), work%row_var(max_rows), &
+      work%slot(max_bodies), work%root(0:max_bodies), work%broken(max_bodies), &
+      work%group_mass(0:max_bodies), work%group_sum(0:max_bodies))
+    call lcp_reserve(work%lcp, s)
+    work%max_bodies = max_bodies
+    work%max_rows = max_rows
+  end subroutine cluster_reserve
+
+  !> The mode of one cluster (module header). Bodies 1..n = size(mass); rows 1..size(candidate)
+  !> with ends row_body(1:2, k) (0 = ground) and coefficients row_normal(1:2, k).
+  !> Out: acceleration (n), active (rows held), stuck (bodies held by static friction), sgn
+  !> (friction acts as -c sgn on a moving body), contact_force (lambda, 0 off the candidates),
+  !> friction_force (n), status (cluster_solved, else an LCP status: the outputs are not a mode).
+  subroutine cluster_mode(work, mass, force, rate, friction, static_friction, velocity, row_body, &
+      row_normal, candidate, acceleration, active, stuck, sgn, contact_force, friction_force, status)
+    type(cluster_work_type), intent(inout) :: work
+    real(wp), intent(in) :: mass(:), force(:), rate(:), friction(:), static_friction(:), velocity(:)
+    integer, intent(in) :: row_body(:, :)
+    real(wp), intent(in) :: row_normal(:, :)
+    logical, intent(in) :: candidate(:)
+    real(wp), intent(out) :: acceleration(:), contact_force(:), friction_force(:), sgn(:)
+    logical, intent(out) :: active(:), stuck(:)
+    integer, intent(out) :: status
+    integer :: n, solves
+    real(wp) :: tol_f, tol_rate
+    logical :: more
+
+    n = size(mass)
+    active = .false.
+    stuck = .false.
+    acceleration(1:n) = 0.0_wp
+    status = lcp_too_large
+    if (n > work%max_bodies .or. size(candidate) > work%max_rows) return
+    tol_f = rel_tol * (sum(abs(force)) + 2.0_wp * sum(static_friction)) + tiny(1.0_wp)
+    tol_rate = rel_tol * sum(abs(rate))
+    work%broken(1:n) = .false.
+    do solves = 1, n + 1
+      call build_lcp(work, mass, force, rate, friction, static_friction, velocity, row_body, row_normal, candidate)
+      call lcp_solve(work%lcp, work%m(1:work%size, 1:work%size), work%q(1:work%size), work%z, work%w, &
+        status, dq=work%dq(1:work%size))
+      if (status /= lcp_solved) return
+      call lcp_basis_values(work%lcp, work%dq(1:work%size), work%dz, work%dw)
+      call accelerations(work, mass, rate, row_body, row_normal, candidate, acceleration)
+      call break_away(work, mass, static_friction, velocity, acceleration, tol_f, tol_rate, more)
+      if (.not. more) exit
+    end do
+    call mode_of(work, mass, friction, velocity, acceleration, tol_f, tol_rate, &
+      stuck, sgn, contact_force, friction_force)
+    call hold_rows(work, mass, row_body, row_normal, candidate, contact_force, tol_f, tol_rate, &
+      stuck, acceleration, active)
+    status = cluster_solved
+  end subroutine cluster_mode
+
+  !> The LCP w = M z + q in z = (lambda_p over candidate rows, rho_r, mu_r over boxed
+  !> bodies), every w an acceleration: w = (n_p.a, a_i + mu_i/m_i = a_i^+, (2 beta_i - rho_i)/m_i).
+  subroutine build_lcp(work, mass, force, rate, friction, static_friction, velocity, row_body, row_normal, candidate)
+    type(cluster_work_type), intent(inout) :: work
+    real(wp), intent(in) :: mass(:), force(:), rate(:), friction(:), static_friction(:), velocity(:)
+    integer, intent(in) :: row_body(:, :)
+    real(wp), intent(in) :: row_normal(:, :)
+    logical, intent(in) :: candidate(:)
+    integer :: i, k, nc, nb, r
+
+    nc = 0
+    do k = 1, size(candidate)
+      work%row_var(k) = 0
+      if (.not. candidate(k)) cycle
+      nc = nc + 1
+      work%row_var(k) = nc
+    end do
+    nb = 0
+    do i = 1, size(mass)
+      work%slot(i) = 0
+      work%beta(i) = 0.0_wp
+      work%base(i) = force(i)
+      if (velocity(i) /= 0.0_wp) then
+        work%base(i) = force(i) - friction(i) * sign(1.0_wp, velocity(i))
+        cycle
+      end if
+      if (static_friction(i) <= 0.0_wp) cycle
+      work%beta(i) = merge(friction(i), static_friction(i), work%broken(i))
+      if (work%beta(i) <= 0.0_wp) cycle           ! broken away without sliding friction: free
+      work%base(i) = force(i) - work%beta(i)
+      nb = nb + 1
+      work%slot(i) = nb
+    end do
+    work%n_free_rows = nc
+    work%n_boxed = nb
+    work%size = nc + 2 * nb
+    associate (m => work%m, s => work%size)
+      m(1:s, 1:s) = 0.0_wp
+      work%q(1:s) = 0.0_wp
+      work%dq(1:s) = 0.0_wp
+      do k = 1, size(candidate)
+        if (work%row_var(k) > 0) call add_row(work, k, mass, rate, row_body, row_normal, candidate)
+      end do
+      do i = 1, size(mass)
+        r = work%slot(i)
+        if (r == 0) cycle
+        m(nc + r, nc + r) = 1.0_wp / mass(i)
+        m(nc + r, nc + nb + r) = 1.0_wp / mass(i)
+        m(nc + nb + r, nc + r) = -1.0_wp / mass(i)
+        work%q(nc + r) = work%base(i) / mass(i)
+        work%dq(nc + r) = rate(i) / mass(i)
+        work%q(nc + nb + r) = 2.0_wp * work%beta(i) / mass(i)
+      end do
+    end associate
+  end subroutine build_lcp
+
+  !> Candidate row k's LCP row and column: n_k M^-1 n_l with the other candidates, n_k,i / m_i
+  !> with its ends' boxes, n_k . M^-1 base and its rate.
+  subroutine add_row(work, k, mass, rate, row_body, row_normal, candidate)
+    type(cluster_work_type), intent(inout) :: work
+    integer, intent(in) :: k
+    real(wp), intent(in) :: mass(:), rate(:)
+    integer, intent(in) :: row_body(:, :)
+    real(wp), intent(in) :: row_normal(:, :)
+    logical, intent(in) :: candidate(:)
+    integer :: p, l, e, f, i
+    p = work%row_var(k)
+    do e = 1, 2
+      i = row_body(e, k)
+      if (i == 0) cycle
+      work%q(p) = work%q(p) + row_normal(e, k) * (work%base(i) / mass(i))
+      work%dq(p) = work%dq(p) + row_normal(e, k) * (rate(i) / mass(i))
+      if (work%slot(i) > 0) then
+        work%m(p, work%n_free_rows + work%slot(i)) = row_normal(e, k) / mass(i)
+        work%m(work%n_free_rows + work%slot(i), p) = row_normal(e, k) / mass(i)
+      end if
+      do l = 1, size(candidate)
+        if (work%row_var(l) == 0) cycle
+        do f = 1, 2
+          if (row_body(f, l) == i) work%m(p, work%row_var(l)) = work%m(p, work%row_var(l)) + &
+            row_normal(e, k) * row_normal(f, l) / mass(i)
+        end do
+      end do
+    end do
+  end subroutine add_row
+
+  !> a = M^-1 (base + rho + N^T lambda) from the LCP's solution, and its rate da (work%da).
+  subroutine accelerations(work, mass, rate, row_body, row_normal, candidate, acceleration)
+    type(cluster_work_type), intent(inout) :: work
+    real(wp), intent(in) :: mass(:), rate(:)
+    integer, intent(in) :: row_body(:, :)
+    real(wp), intent(in) :: row_normal(:, :)
+    logical, intent(in) :: candidate(:)
+    real(wp), intent(out) :: acceleration(:)
+    integer :: i, k, e, p
+    acceleration(1:size(mass)) = work%base(1:size(mass))
+    work%da(1:size(mass)) = rate
+    do i = 1, size(mass)
+      if (work%slot(i) == 0) cycle
+      acceleration(i) = acceleration(i) + work%z(work%n_free_rows + work%slot(i))
+      work%da(i) = work%da(i) + work%dz(work%n_free_rows + work%slot(i))
+    end do
+    do k = 1, size(candidate)
+      p = work%row_var(k)
+      if (p == 0) cycle
+      do e = 1, 2
+        i = row_body(e, k)
+        if (i == 0) cycle
+        acceleration(i) = acceleration(i) + row_normal(e, k) * work%z(p)
+        work%da(i) = work%da(i) + row_normal(e, k) * work%dz(p)
+      end do
+    end do
+    acceleration(1:size(mass)) = acceleration(1:size(mass)) / mass
+    work%da(1:size(mass)) = work%da(1:size(mass)) / mass
+  end subroutine accelerations
+
+  !> Bodies at rest that the last solve moves (a or its rate not zero) break away: bound c
+  !> from now on. more: some did (solve again).
+  subroutine break_away(work, mass, static_friction, velocity, acceleration, tol_f, tol_rate, more)
+    type(cluster_work_type), intent(inout) :: work
+    real(wp), intent(in) :: mass(:), static_friction(:), velocity(:), acceleration(:), tol_f, tol_rate
+    logical, intent(out) :: more
+    integer :: i
+    more = .false.
+    do i = 1, size(mass)
+      if (velocity(i) /= 0.0_wp .or. static_friction(i) <= 0.0_wp .or. work%broken(i)) cycle
+      if (still(mass(i), acceleration(i), work%da(i), tol_f, tol_rate)) cycle
+      work%broken(i) = .true.
+      more = .true.
+    end do
+  end subroutine break_away
+
+  !> Whether a body's acceleration a and its rate da are zero (in force units, within tol).
+  pure logical function still(mass, a, da, tol_f, tol_rate)
+    real(wp), intent(in) :: mass, a, da, tol_f, tol_rate
+    still = abs(mass * a) <= tol_f .and. abs(mass * da) <= tol_rate
+  end function still
+
+  !> Stuck bodies, sliding directions and the forces of the final solve.
+  subroutine mode_of(work, mass, friction, velocity, acceleration, tol_f, tol_rate, &
+      stuck, sgn, contact_force, friction_force)
+    type(cluster_work_type), intent(in) :: work
+    real(wp), intent(in) :: mass(:), friction(:), velocity(:), tol_f, tol_rate
+    real(wp), intent(inout) :: acceleration(:)
+    logical, intent(out) :: stuck(:)
+    real(wp), intent(out) :: sgn(:), contact_force(:), friction_force(:)
+    integer :: i, k
+    do i = 1, size(mass)
+      stuck(i) = .false.
+      sgn(i) = 0.0_wp
+      friction_force(i) = 0.0_wp
+      if (velocity(i) /= 0.0_wp) then
+        if (friction(i) > 0.0_wp) sgn(i) = sign(1.0_wp, velocity(i))
+      else if (work%slot(i) > 0) then
+        friction_force(i) = work%z(work%n_free_rows + work%slot(i)) - work%beta(i)
+        if (still(mass(i), acceleration(i), work%da(i), tol_f, tol_rate)) then
+          stuck(i) = .true.
+          acceleration(i) = 0.0_wp
+          cycle
+        end if
+        sgn(i) = sign(1.0_wp, acceleration(i))
+        if (abs(mass(i) * acceleration(i)) <= tol_f) sgn(i) = sign(1.0_wp, work%da(i))
+      end if
+      friction_force(i) = -friction(i) * sgn(i)
+    end do
+    do k = 1, size(contact_force)
+      contact_force(k) = 0.0_wp
+      if (work%row_var(k) > 0) contact_force(k) = work%z(work%row_var(k))
+    end do
+  end subroutine mode_of
+
+  !> The held rows (module header), and the exact common accelerations of the bodies they
+  !> and the stuck bodies join.
+  subroutine hold_rows(work, mass, row_body, row_normal, candidate, contact_force, tol_f, tol_rate, &
+      stuck, acceleration, active)
+    type(cluster_work_type), intent(inout) :: work
+    real(wp), intent(in) :: mass(:), row_normal(:, :), contact_force(:), tol_f, tol_rate
+    integer, intent(in) :: row_body(:, :)
+    logical, intent(in) :: candidate(:), stuck(:)
+    real(wp), intent(inout) :: acceleration(:)
+    logical, intent(out) :: active(:)
+    integer :: i, k, pass
+    real(wp) :: dlambda
+    logical :: joined
+    do i = 0, size(mass)
+      work%root(i) = i
+    end do
+    do i = 1, size(mass)
+      if (stuck(i)) work%root(i) = 0
+    end do
+    active = .false.
+    do pass = 1, 2
+      do k = 1, size(candidate)
+        if (.not. candidate(k) .or. active(k)) cycle
+        if (.not. closed(k)) cycle
+        if (pass == 1) then
+          dlambda = work%dz(work%row_var(k))
+          if (contact_force(k) <= tol_f .and. (contact_force(k) < -tol_f .or. dlambda <= tol_rate)) cycle
+          active(k) = .true.
+          if (rigid_row(k)) joined = join(work%root, row_body(1, k), row_body(2, k))
+        else if (rigid_row(k)) then
+          active(k) = join(work%root, row_body(1, k), row_body(2, k))
+        end if
+      end do
+    end do
+    call equalise(work, mass, acceleration)
+
+  contains
+
+    !> Row k closed and staying closed: n.a and its rate zero.
+    logical function closed(k)
+      integer, intent(in) :: k
+      integer :: e
+      real(wp) :: na, nda, inverse_mass
+      na = 0.0_wp
+      nda = 0.0_wp
+      inverse_mass = 0.0_wp
+      do e = 1, 2
+        if (row_body(e, k) == 0) cycle
+        na = na + row_normal(e, k) * acceleration(row_body(e, k))
+        nda = nda + row_normal(e, k) * work%da(row_body(e, k))
+        inverse_mass = inverse_mass + abs(row_normal(e, k)) / mass(row_body(e, k))
+      end do
+      closed = abs(na) <= 2.0_wp * tol_f * inverse_mass .and. abs(nda) <= 2.0_wp * tol_rate * inverse_mass
+    end function closed
+
+    !> A wall, or a body-body row of the form (-1, 1) or (1, -1): it makes its ends move alike.
+    logical function rigid_row(k)
+      integer, intent(in) :: k
+      rigid_row = row_body(1, k) == 0 .or. row_body(2, k) == 0 .or. row_normal(1, k) == -row_normal(2, k)
+    end function rigid_row
+  end subroutine hold_rows
+
+  !> Join a and b (0 = ground, always a root): .false. if they were joined already.
+  logical function join(root, a, b)
+    integer, intent(inout) :: root(0:)
+    integer, intent(in) :: a, b
+    integer :: ra, rb
+    ra = find(root, a)
+    rb = find(root, b)
+    join = ra /= rb
+    if (join) root(max(ra, rb)) = min(ra, rb)
+  end function join
+
+  integer function find(root, i) result(r)
+    integer, intent(inout) :: root(0:)
+    integer, intent(in) :: i
+    r = i
+    do while (root(r) /= r)
+      root(r) = root(root(r))      ! path halving
+      r = root(r)
+    end do
+  end function find
+
+  !> Every group of the union-find gets one acceleration: 0 if joined to the ground, else the
+  !> mass-weighted mean (which the contact forces make the members' common value, to rounding).
+  !> A body alone keeps its own.
+  subroutine equalise(work, mass, acceleration)
+    type(cluster_work_type), intent(inout) :: work
+    real(wp), intent(in) :: mass(:)
+    real(wp), intent(inout) :: acceleration(:)
+    integer :: i, r
+    work%group_mass(0:size(mass)) = 0.0_wp
+    work%group_sum(0:size(mass)) = 0.0_wp
+    do i = 1, size(mass)
+      r = find(work%root, i)
+      work%group_mass(r) = work%group_mass(r) + mass(i)
+      work%group_sum(r) = work%group_sum(r) + mass(i) * acceleration(i)
+    end do
+    do i = 1, size(mass)
+      r = find(work%root, i)
+      if (r == 0) then
+        acceleration(i) = 0.0_wp
+      else if (work%group_mass(r) /= mass(i)) then
+        acceleration(i) = work%group_sum(r) / work%group_mass(r)
+      end if
+    end do
+  end subroutine equalise
+end module impact1d_cluster_mode
