@@ -29,6 +29,7 @@
 !> - No allocation: the caller sizes a cluster_work_type once (cluster_reserve).
 module impact1d_cluster_mode
   use impact1d_kinds, only: wp, eps_wp
+  use impact1d_clusters, only: uf_join, group_means, row_coupling, row_rate
   use impact1d_lcp, only: lcp_work_type, lcp_reserve, lcp_solve, lcp_basis_values, lcp_solved, &
     lcp_too_large
   implicit none
@@ -134,13 +135,6 @@ contains
     logical, intent(in) :: candidate(:)
     integer :: i, k, nc, nb, r
 
-    nc = 0
-    do k = 1, size(candidate)
-      work%row_var(k) = 0
-      if (.not. candidate(k)) cycle
-      nc = nc + 1
-      work%row_var(k) = nc
-    end do
     nb = 0
     do i = 1, size(mass)
       work%slot(i) = 0
@@ -157,15 +151,17 @@ contains
       nb = nb + 1
       work%slot(i) = nb
     end do
+    call row_coupling(mass, row_body, row_normal, candidate, work%row_var, nc, work%m)
     work%n_free_rows = nc
     work%n_boxed = nb
     work%size = nc + 2 * nb
     associate (m => work%m, s => work%size)
-      m(1:s, 1:s) = 0.0_wp
+      m(nc + 1:s, 1:s) = 0.0_wp
+      m(1:nc, nc + 1:s) = 0.0_wp
       work%q(1:s) = 0.0_wp
       work%dq(1:s) = 0.0_wp
       do k = 1, size(candidate)
-        if (work%row_var(k) > 0) call add_row(work, k, mass, rate, row_body, row_normal, candidate)
+        if (work%row_var(k) > 0) call add_row(work, k, mass, rate, row_body, row_normal)
       end do
       do i = 1, size(mass)
         r = work%slot(i)
@@ -180,33 +176,25 @@ contains
     end associate
   end subroutine build_lcp
 
-  !> Candidate row k's LCP row and column: n_k M^-1 n_l with the other candidates, n_k,i / m_i
-  !> with its ends' boxes, n_k . M^-1 base and its rate.
-  subroutine add_row(work, k, mass, rate, row_body, row_normal, candidate)
+  !> Candidate row k's coupling with its ends' boxes (n_k,i / m_i), its right-hand side
+  !> n_k . M^-1 base and rate.
+  subroutine add_row(work, k, mass, rate, row_body, row_normal)
     type(cluster_work_type), intent(inout) :: work
     integer, intent(in) :: k
     real(wp), intent(in) :: mass(:), rate(:)
     integer, intent(in) :: row_body(:, :)
     real(wp), intent(in) :: row_normal(:, :)
-    logical, intent(in) :: candidate(:)
-    integer :: p, l, e, f, i
+    integer :: p, e, i, box
     p = work%row_var(k)
     do e = 1, 2
       i = row_body(e, k)
       if (i == 0) cycle
       work%q(p) = work%q(p) + row_normal(e, k) * (work%base(i) / mass(i))
       work%dq(p) = work%dq(p) + row_normal(e, k) * (rate(i) / mass(i))
-      if (work%slot(i) > 0) then
-        work%m(p, work%n_free_rows + work%slot(i)) = row_normal(e, k) / mass(i)
-        work%m(work%n_free_rows + work%slot(i), p) = row_normal(e, k) / mass(i)
-      end if
-      do l = 1, size(candidate)
-        if (work%row_var(l) == 0) cycle
-        do f = 1, 2
-          if (row_body(f, l) == i) work%m(p, work%row_var(l)) = work%m(p, work%row_var(l)) + &
-            row_normal(e, k) * row_normal(f, l) / mass(i)
-        end do
-      end do
+      if (work%slot(i) == 0) cycle
+      box = work%n_free_rows + work%slot(i)
+      work%m(p, box) = row_normal(e, k) / mass(i)
+      work%m(box, p) = row_normal(e, k) / mass(i)
     end do
   end subroutine add_row
 
@@ -323,31 +311,27 @@ contains
           dlambda = work%dz(work%row_var(k))
           if (contact_force(k) <= tol_f .and. (contact_force(k) < -tol_f .or. dlambda <= tol_rate)) cycle
           active(k) = .true.
-          if (rigid_row(k)) joined = join(work%root, row_body(1, k), row_body(2, k))
+          if (rigid_row(k)) joined = uf_join(work%root, row_body(1, k), row_body(2, k))
         else if (rigid_row(k)) then
-          active(k) = join(work%root, row_body(1, k), row_body(2, k))
+          active(k) = uf_join(work%root, row_body(1, k), row_body(2, k))
         end if
       end do
     end do
-    call equalise(work, mass, acceleration)
+    call group_means(work%root, mass, acceleration, work%group_mass, work%group_sum)
 
   contains
 
     !> Row k closed and staying closed: n.a and its rate zero.
     logical function closed(k)
       integer, intent(in) :: k
+      real(wp) :: inverse_mass
       integer :: e
-      real(wp) :: na, nda, inverse_mass
-      na = 0.0_wp
-      nda = 0.0_wp
       inverse_mass = 0.0_wp
       do e = 1, 2
-        if (row_body(e, k) == 0) cycle
-        na = na + row_normal(e, k) * acceleration(row_body(e, k))
-        nda = nda + row_normal(e, k) * work%da(row_body(e, k))
-        inverse_mass = inverse_mass + abs(row_normal(e, k)) / mass(row_body(e, k))
+        if (row_body(e, k) > 0) inverse_mass = inverse_mass + abs(row_normal(e, k)) / mass(row_body(e, k))
       end do
-      closed = abs(na) <= 2.0_wp * tol_f * inverse_mass .and. abs(nda) <= 2.0_wp * tol_rate * inverse_mass
+      closed = abs(row_rate(row_body, row_normal, k, acceleration)) <= 2.0_wp * tol_f * inverse_mass .and. &
+        abs(row_rate(row_body, row_normal, k, work%da)) <= 2.0_wp * tol_rate * inverse_mass
     end function closed
 
     !> A wall, or a body-body row of the form (-1, 1) or (1, -1): it makes its ends move alike.
@@ -357,49 +341,4 @@ contains
     end function rigid_row
   end subroutine hold_rows
 
-  !> Join a and b (0 = ground, always a root): .false. if they were joined already.
-  logical function join(root, a, b)
-    integer, intent(inout) :: root(0:)
-    integer, intent(in) :: a, b
-    integer :: ra, rb
-    ra = find(root, a)
-    rb = find(root, b)
-    join = ra /= rb
-    if (join) root(max(ra, rb)) = min(ra, rb)
-  end function join
-
-  integer function find(root, i) result(r)
-    integer, intent(inout) :: root(0:)
-    integer, intent(in) :: i
-    r = i
-    do while (root(r) /= r)
-      root(r) = root(root(r))      ! path halving
-      r = root(r)
-    end do
-  end function find
-
-  !> Every group of the union-find gets one acceleration: 0 if joined to the ground, else the
-  !> mass-weighted mean (which the contact forces make the members' common value, to rounding).
-  !> A body alone keeps its own.
-  subroutine equalise(work, mass, acceleration)
-    type(cluster_work_type), intent(inout) :: work
-    real(wp), intent(in) :: mass(:)
-    real(wp), intent(inout) :: acceleration(:)
-    integer :: i, r
-    work%group_mass(0:size(mass)) = 0.0_wp
-    work%group_sum(0:size(mass)) = 0.0_wp
-    do i = 1, size(mass)
-      r = find(work%root, i)
-      work%group_mass(r) = work%group_mass(r) + mass(i)
-      work%group_sum(r) = work%group_sum(r) + mass(i) * acceleration(i)
-    end do
-    do i = 1, size(mass)
-      r = find(work%root, i)
-      if (r == 0) then
-        acceleration(i) = 0.0_wp
-      else if (work%group_mass(r) /= mass(i)) then
-        acceleration(i) = work%group_sum(r) / work%group_mass(r)
-      end if
-    end do
-  end subroutine equalise
 end module impact1d_cluster_mode
