@@ -8,6 +8,7 @@ program test_cluster_impact
   use impact1d_scene, only: scene_type
   use impact1d_impacts, only: inelastic_projection
   use impact1d_lcp, only: lcp_solved
+  use impact1d_clusters, only: row_rate
   use impact1d_cluster_impact, only: impact_work_type, impact_reserve, cluster_projection
   use testing, only: check, finish, two_body
   implicit none
@@ -88,7 +89,7 @@ contains
   subroutine random_chains()
     real(wp) :: mass(max_n), v(max_n), w(max_n), normal(2, max_n + 1), impulse(max_n + 1), tol(max_n + 1)
     real(wp) :: u(3 * max_n), ke_before, ke_after, worst, scale, nw
-    integer :: body(2, max_n + 1), n, nr, k, trial, status, failed, e, several
+    integer :: body(2, max_n + 1), n, nr, k, trial, status, failed, several
     logical :: closed(max_n + 1), pushed(max_n + 1)
     worst = 0.0_wp
     failed = 0
@@ -119,10 +120,7 @@ contains
       worst = max(worst, (ke_after - ke_before) / ke_before)
       do k = 1, nr
         if (.not. closed(k)) cycle
-        nw = 0.0_wp
-        do e = 1, 2
-          if (body(e, k) > 0) nw = nw + normal(e, k) * w(body(e, k))
-        end do
+        nw = row_rate(body, normal, k, w)
         worst = max(worst, -nw / scale, -impulse(k) / (scale * maxval(mass(1:n))), &
           min(impulse(k) / maxval(mass(1:n)), abs(nw)) / scale)
       end do

@@ -1,10 +1,12 @@
 !> The cluster mode solve (impact1d_cluster_mode) against today's exact enumerator
 !> (impact1d_modes' solve_mode, through its pair_type) on random 1- and 2-body problems, and
 !> on closed forms with N bodies: a chain pushed along the ground breaks away when the push
-!> exceeds sum s_i, a stack resting on the floor carries its weight, its top lifted off.
+!> exceeds sum s_i, a stack resting on the floor carries its weight, its top lifted off; and
+!> random chains of 3 to 8 bodies checked against the conditions that define a mode.
 program test_cluster_mode
   use impact1d_kinds, only: wp
   use impact1d_modes, only: mode_type, pair_type, solve_mode
+  use impact1d_clusters, only: row_rate
   use impact1d_cluster_mode, only: cluster_work_type, cluster_reserve, cluster_mode, cluster_solved
   use testing, only: check, finish
   implicit none
@@ -24,6 +26,7 @@ program test_cluster_mode
   call cluster_reserve(work, max_n, 2 * max_n)
 
   call against_enumerator()
+  call random_chains()
   call pushed_chain()
   call stack_on_floor()
   call finish('test_cluster_mode')
@@ -180,6 +183,84 @@ contains
     strict = locked <= 1 .or. (locked == 2 .and. rows(1, 1) * rows(2, 2) /= rows(2, 1) * rows(1, 2))
     if (n == 1 .and. locked == 2) strict = .false.
   end function strict
+
+  !> 5000 random chains of 3..8 bodies (both limits of each link now and then, walls at the
+  !> ends, random candidates, bounds, forces, half the bodies at rest): the solution meets
+  !> every condition of a mode to 1e-13 of the force scale: Newton's law with the reported
+  !> forces, contact forces >= 0 and complementary to n.a >= 0, sliding friction against the
+  !> motion, a stuck body at rest within its static bound, a body breaking away at c against
+  !> its acceleration.
+  subroutine random_chains()
+    real(wp) :: mass(max_n), y(max_n), dy(max_n), c(max_n), s(max_n), v(max_n), a(max_n), sgn(max_n)
+    real(wp) :: ff(max_n), lambda(2 * max_n), normal(2, 2 * max_n), u(8 * max_n), load(max_n), tol, worst, rate
+    integer :: body(2, 2 * max_n), n, nr, k, e, trial, status, failed, moving
+    logical :: candidate(2 * max_n), active(2 * max_n), stuck(max_n)
+    worst = 0.0_wp
+    failed = 0
+    moving = 0
+    do trial = 1, 5000
+      call random_number(u)
+      n = 3 + mod(trial, max_n - 2)
+      mass(1:n) = 0.2_wp * 25.0_wp**u(1:n)
+      c(1:n) = merge(0.0_wp, 3.0_wp * u(n + 1:2 * n), u(2 * n + 1:3 * n) < 0.2_wp)
+      s(1:n) = c(1:n) * (1.0_wp + u(3 * n + 1:4 * n))
+      y(1:n) = 16.0_wp * u(4 * n + 1:5 * n) - 8.0_wp
+      dy(1:n) = 0.0_wp
+      v(1:n) = merge(0.0_wp, sign(0.5_wp, u(5 * n + 1:6 * n) - 0.75_wp), u(5 * n + 1:6 * n) < 0.5_wp)
+      nr = 0
+      do k = 1, n - 1
+        call add_row(body, normal, candidate, nr, [k, k + 1], [-1.0_wp, 1.0_wp], u(6 * n + k) < 0.8_wp)
+        if (u(7 * n + k) < 0.2_wp) call add_row(body, normal, candidate, nr, [k, k + 1], [1.0_wp, -1.0_wp], u(6 * n + k) < 0.8_wp)
+      end do
+      call add_row(body, normal, candidate, nr, [0, 1], [0.0_wp, 1.0_wp], u(7 * n) < 0.5_wp)
+      call add_row(body, normal, candidate, nr, [0, n], [0.0_wp, -1.0_wp], u(8 * n) < 0.5_wp)
+      call cluster_mode(work, mass(1:n), y(1:n), dy(1:n), c(1:n), s(1:n), v(1:n), body(:, 1:nr), normal(:, 1:nr), &
+        candidate(1:nr), a(1:n), active(1:nr), stuck(1:n), sgn(1:n), lambda(1:nr), ff(1:n), status)
+      if (status /= cluster_solved) then
+        failed = failed + 1
+        cycle
+      end if
+      tol = sum(abs(y(1:n))) + 2.0_wp * sum(s(1:n))
+      load(1:n) = y(1:n) + ff(1:n) - mass(1:n) * a(1:n)
+      do k = 1, nr
+        do e = 1, 2
+          if (body(e, k) > 0) load(body(e, k)) = load(body(e, k)) + normal(e, k) * lambda(k)
+        end do
+        worst = max(worst, -lambda(k) / tol, merge(0.0_wp, abs(lambda(k)), candidate(k)) / tol)
+        ! n_k . a in force units (times the lightest mass).
+        rate = row_rate(body, normal, k, a) * minval(mass(1:n))
+        if (candidate(k)) worst = max(worst, -rate / tol, min(lambda(k), abs(rate)) / tol)
+      end do
+      worst = max(worst, maxval(abs(load(1:n))) / tol)
+      do k = 1, n
+        if (v(k) /= 0.0_wp) then
+          worst = max(worst, abs(ff(k) + c(k) * sign(1.0_wp, v(k))) / tol)
+        else if (stuck(k)) then
+          worst = max(worst, abs(a(k)), (abs(ff(k)) - s(k)) / tol)
+        else if (s(k) > 0.0_wp) then
+          moving = moving + 1
+          worst = max(worst, abs(ff(k) + c(k) * sign(1.0_wp, a(k))) / tol, -a(k) * sgn(k) * mass(k) / tol)
+        end if
+      end do
+    end do
+    print '(a, es10.3, a, i0)', 'random chains: worst violation of a mode condition ', worst, &
+      ', bodies breaking away ', moving
+    call check(failed == 0 .and. worst <= 1.0e-13_wp .and. moving > 1000, 'random chains of 3-8 bodies: every mode condition')
+  end subroutine random_chains
+
+  !> One more row of a random chain.
+  subroutine add_row(body, normal, candidate, nr, ends, coefficients, is_candidate)
+    integer, intent(inout) :: body(:, :), nr
+    real(wp), intent(inout) :: normal(:, :)
+    logical, intent(inout) :: candidate(:)
+    integer, intent(in) :: ends(2)
+    real(wp), intent(in) :: coefficients(2)
+    logical, intent(in) :: is_candidate
+    nr = nr + 1
+    body(:, nr) = ends
+    normal(:, nr) = coefficients
+    candidate(nr) = is_candidate
+  end subroutine add_row
 
   !> N blocks in a row along the ground, touching (rows i, i+1 closed), pushed at block 1 by
   !> P towards block N: they stick while P <= sum s_i; beyond it they move as one with
