@@ -118,7 +118,7 @@ contains
       call break_away(work, mass, static_friction, velocity, acceleration, tol_f, tol_rate, more)
       if (.not. more) exit
     end do
-    call mode_of(work, mass, friction, velocity, acceleration, tol_f, tol_rate, &
+    call mode_of(work, mass, friction, velocity, size(candidate), acceleration, tol_f, tol_rate, &
       stuck, sgn, contact_force, friction_force)
     call hold_rows(work, mass, row_body, row_normal, candidate, contact_force, tol_f, tol_rate, &
       stuck, acceleration, active)
@@ -251,10 +251,11 @@ contains
   end function still
 
   !> Stuck bodies, sliding directions and the forces of the final solve.
-  subroutine mode_of(work, mass, friction, velocity, acceleration, tol_f, tol_rate, &
+  subroutine mode_of(work, mass, friction, velocity, n_rows, acceleration, tol_f, tol_rate, &
       stuck, sgn, contact_force, friction_force)
     type(cluster_work_type), intent(in) :: work
     real(wp), intent(in) :: mass(:), friction(:), velocity(:), tol_f, tol_rate
+    integer, intent(in) :: n_rows
     real(wp), intent(inout) :: acceleration(:)
     logical, intent(out) :: stuck(:)
     real(wp), intent(out) :: sgn(:), contact_force(:), friction_force(:)
@@ -277,8 +278,10 @@ contains
       end if
       friction_force(i) = -friction(i) * sgn(i)
     end do
-    do k = 1, size(contact_force)
-      contact_force(k) = 0.0_wp
+    ! Over the rows of this problem only: contact_force may be longer, and row_var beyond
+    ! them holds an earlier problem's numbering.
+    contact_force = 0.0_wp
+    do k = 1, n_rows
       if (work%row_var(k) > 0) contact_force(k) = work%z(work%row_var(k))
     end do
   end subroutine mode_of

@@ -26,6 +26,7 @@ program test_cluster_mode
   call cluster_reserve(work, max_n, 2 * max_n)
 
   call against_enumerator()
+  call longer_outputs()
   call random_chains()
   call pushed_chain()
   call stack_on_floor()
@@ -183,6 +184,27 @@ contains
     strict = locked <= 1 .or. (locked == 2 .and. rows(1, 1) * rows(2, 2) /= rows(2, 1) * rows(1, 2))
     if (n == 1 .and. locked == 2) strict = .false.
   end function strict
+
+  !> Output arrays longer than the problem's rows, after a problem with more rows: the rows
+  !> beyond get no contact force (they read the earlier problem's numbering, and under
+  !> MALLOC_PERTURB_ garbage, before this was fixed).
+  subroutine longer_outputs()
+    real(wp) :: a(2), sgn(2), lambda(4), ff(2)
+    logical :: active(4), stuck(2)
+    integer :: status
+    integer, parameter :: body(2, 4) = reshape([0, 1, 1, 2, 1, 2, 0, 2], [2, 4])
+    real(wp), parameter :: normal(2, 4) = reshape([0.0_wp, 1.0_wp, -1.0_wp, 1.0_wp, 1.0_wp, -1.0_wp, &
+      0.0_wp, -1.0_wp], [2, 4])
+    call cluster_mode(work, [1.0_wp, 1.0_wp], [-1.0_wp, 2.0_wp], [0.0_wp, 0.0_wp], [0.0_wp, 0.0_wp], &
+      [0.0_wp, 0.0_wp], [0.0_wp, 0.0_wp], body, normal, [.true., .true., .true., .true.], a, active, stuck, &
+      sgn, lambda, ff, status)
+    lambda = 7.0_wp
+    call cluster_mode(work, [1.0_wp, 1.0_wp], [-1.0_wp, 2.0_wp], [0.0_wp, 0.0_wp], [0.0_wp, 0.0_wp], &
+      [0.0_wp, 0.0_wp], [0.0_wp, 0.0_wp], body(:, 1:1), normal(:, 1:1), [.true.], a, active, stuck, &
+      sgn, lambda, ff, status)
+    call check(status == cluster_solved .and. lambda(1) == 1.0_wp .and. all(lambda(2:4) == 0.0_wp) &
+      .and. .not. any(active(2:4)), 'outputs longer than the rows: no force beyond them')
+  end subroutine longer_outputs
 
   !> 5000 random chains of 3..8 bodies (both limits of each link now and then, walls at the
   !> ends, random candidates, bounds, forces, half the bodies at rest): the solution meets
