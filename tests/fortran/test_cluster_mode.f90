@@ -29,6 +29,7 @@ program test_cluster_mode
   call longer_outputs()
   call random_chains()
   call pushed_chain()
+  call long_chain()
   call stack_on_floor()
   call finish('test_cluster_mode')
 
@@ -270,6 +271,18 @@ contains
     call check(failed == 0 .and. worst <= 1.0e-13_wp .and. moving > 1000, 'random chains of 3-8 bodies: every mode condition')
   end subroutine random_chains
 
+  !> Rows 1..n-1: block k touching block k + 1 (x_(k+1) - x_k >= its limit).
+  subroutine neighbour_rows(body, normal, n)
+    integer, intent(out) :: body(:, :)
+    real(wp), intent(out) :: normal(:, :)
+    integer, intent(in) :: n
+    integer :: k
+    do k = 1, n - 1
+      body(:, k) = [k, k + 1]
+      normal(:, k) = [-1.0_wp, 1.0_wp]
+    end do
+  end subroutine neighbour_rows
+
   !> One more row of a random chain.
   subroutine add_row(body, normal, candidate, nr, ends, coefficients, is_candidate)
     integer, intent(inout) :: body(:, :), nr
@@ -298,10 +311,7 @@ contains
     s = 0.75_wp * mass          ! sum s = 15.75, sum c = 10.5, sum m = 21
     v = 0.0_wp
     dy = 0.0_wp
-    do k = 1, n - 1
-      body(:, k) = [k, k + 1]
-      normal(:, k) = [-1.0_wp, 1.0_wp]
-    end do
+    call neighbour_rows(body, normal, n)
     y = 0.0_wp
     y(1) = 15.0_wp
     call cluster_mode(work, mass, y, dy, c, s, v, body, normal, [(.true., k = 1, n - 1)], a, active, stuck, &
@@ -323,6 +333,38 @@ contains
     call check(status == cluster_solved .and. .not. any(stuck) .and. all(abs(a - 0.25_wp) <= 1.0e-15_wp), &
       'chain pushed at exactly sum s and rising: breaks away, a = (15.75 - 10.5) / 21')
   end subroutine pushed_chain
+
+  !> 40 unit blocks in a row (c = 0.5, s = 0.75 each: sum s = 30, sum c = 20), pushed at
+  !> block 1: stuck under 30, one body at a = (40 - 20) / 40 under 40; frictionless against a
+  !> wall at block 40, every contact carries the push. An LCP of 119 unknowns.
+  subroutine long_chain()
+    integer, parameter :: n = 40
+    real(wp) :: mass(n), y(n), zero(n), c(n), s(n), a(n), sgn(n), ff(n), lambda(n), normal(2, n)
+    integer :: body(2, n), k, status
+    logical :: active(n), stuck(n)
+    call cluster_reserve(work, n, 2 * n)
+    mass = 1.0_wp
+    c = 0.5_wp
+    s = 0.75_wp
+    zero = 0.0_wp
+    call neighbour_rows(body, normal, n)
+    y = 0.0_wp
+    y(1) = 29.9_wp
+    call cluster_mode(work, mass, y, zero, c, s, zero, body(:, 1:n - 1), normal(:, 1:n - 1), [(.true., k = 1, n - 1)], &
+      a, active, stuck, sgn, lambda, ff, status)
+    call check(status == cluster_solved .and. all(stuck) .and. all(a == 0.0_wp), '40 blocks pushed below sum s: stuck')
+    y(1) = 40.0_wp
+    call cluster_mode(work, mass, y, zero, c, s, zero, body(:, 1:n - 1), normal(:, 1:n - 1), [(.true., k = 1, n - 1)], &
+      a, active, stuck, sgn, lambda, ff, status)
+    call check(status == cluster_solved .and. .not. any(stuck) .and. all(active(1:n - 1)) .and. all(a == a(1)) &
+      .and. abs(a(1) - 0.5_wp) <= 1.0e-14_wp, '40 blocks pushed above sum s: one body, a = 0.5')
+    body(:, n) = [0, n]                    ! a wall to the right of block 40: x_wall - x_40 >= 0
+    normal(:, n) = [0.0_wp, -1.0_wp]
+    call cluster_mode(work, mass, y, zero, zero, zero, zero, body, normal, [(.true., k = 1, n)], &
+      a, active, stuck, sgn, lambda, ff, status)
+    call check(status == cluster_solved .and. all(active) .and. all(a == 0.0_wp) &
+      .and. all(abs(lambda - 40.0_wp) <= 1.0e-12_wp), '40 frictionless blocks pushed into a wall: every contact carries 40')
+  end subroutine long_chain
 
   !> A frictionless stack of N blocks on the floor under gravity (floor row 0-1, rows i, i+1):
   !> at rest, contact k carries the weight above it, g sum_{j >= k} m_j; a lift F > m_N g on
