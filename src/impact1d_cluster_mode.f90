@@ -80,8 +80,9 @@ contains
     work%max_rows = max_rows
   end subroutine cluster_reserve
 
-  !> The mode of one cluster (module header). Bodies 1..n = size(mass); rows 1..size(candidate)
-  !> with ends row_body(1:2, k) (0 = ground) and coefficients row_normal(1:2, k).
+  !> The mode of one cluster (module header). Bodies 1..n = size(mass) (the body arrays of
+  !> size n at least); rows 1..size(candidate) with ends row_body(1:2, k) in 0..n (0 = ground)
+  !> and coefficients row_normal(1:2, k).
   !> Out: acceleration (n), active (rows held), stuck (bodies held by static friction), sgn
   !> (friction acts as -c sgn on a moving body), contact_force (lambda, 0 off the candidates),
   !> friction_force (n), status (cluster_solved, else an LCP status: the outputs are not a mode).
@@ -105,8 +106,8 @@ contains
     acceleration(1:n) = 0.0_wp
     status = lcp_too_large
     if (n > work%max_bodies .or. size(candidate) > work%max_rows) return
-    tol_f = rel_tol * (sum(abs(force)) + 2.0_wp * sum(static_friction)) + tiny(1.0_wp)
-    tol_rate = rel_tol * sum(abs(rate))
+    tol_f = rel_tol * (sum(abs(force(1:n))) + 2.0_wp * sum(static_friction(1:n))) + tiny(1.0_wp)
+    tol_rate = rel_tol * sum(abs(rate(1:n)))
     work%broken(1:n) = .false.
     do solves = 1, n + 1
       call build_lcp(work, mass, force, rate, friction, static_friction, velocity, row_body, row_normal, candidate)
