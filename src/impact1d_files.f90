@@ -9,7 +9,7 @@ module impact1d_files
   implicit none
   private
   public :: check_input_file, output_target, make_folders, make_temporary, lock_folders, &
-    unlock_folders, resolve, write_stdout
+    unlock_folders, resolve, write_text
 
   !> impact1d_file_kind's answers (impact1d_files.c).
   integer, parameter :: kind_missing = 0, kind_regular = 1, kind_folder = 2, kind_link = 7, &
@@ -168,17 +168,18 @@ contains
     end if
   end subroutine folder_of
 
-  !> Write text to stdout (file descriptor 1) as it is; reason is '' when every byte went,
-  !> else why not (a full disk, a closed stdout): unlike a Fortran write, which says
-  !> nothing of either.
-  subroutine write_stdout(text, reason)
+  !> Write text to file descriptor fd (1 stdout, 2 stderr) as it is; reason is '' when every
+  !> byte went, else why not (a full disk, a closed stdout): unlike a Fortran write, which
+  !> says nothing of either.
+  subroutine write_text(fd, text, reason)
+    integer, intent(in) :: fd
     character(len=*), intent(in) :: text
     character(len=:), allocatable, intent(out) :: reason
     integer(c_int) :: number
     reason = ''
-    number = c_write_all(1_c_int, text, int(len(text), c_long))
+    number = c_write_all(int(fd, c_int), text, int(len(text), c_long))
     if (number /= 0) call system_reason(number, reason)
-  end subroutine write_stdout
+  end subroutine write_text
 
   !> The system's text for an error number (strerror).
   subroutine system_reason(number, text)

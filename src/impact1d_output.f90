@@ -2,7 +2,7 @@
 !> streams to files (memory constant in run length) while Python collects arrays.
 module impact1d_output
   use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char
-  use, intrinsic :: iso_fortran_env, only: error_unit, int64
+  use, intrinsic :: iso_fortran_env, only: error_unit, output_unit, int64
   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
   use impact1d_kinds, only: wp
   use impact1d_error, only: error_type, raise, status_input, status_simulation, status_interrupted, fmt
@@ -115,6 +115,9 @@ module impact1d_output
   type, extends(sink_type) :: file_sink
     integer :: unit = 0, event_unit = 0
     logical :: is_open = .false.
+    !> The samples go to standard output as they come (-o -): no temporary, nothing to
+    !> rename, and no event log unless an events file was named.
+    logical :: stream = .false.
     !> The names given (for messages), the files they replace (the name, or the file a
     !> symbolic link there leads to: output_target) and this run's own temporary files
     !> beside those (make_temporary), which a signal guard must remove.
@@ -385,25 +388,35 @@ contains
     self%event_v(:, n) = [v_before, v_after]
   end subroutine memory_put_event
 
-  !> Open OUT (and OUT's events file) under temporary names and write the headers.
-  subroutine file_open(self, path, input, error)
+  !> Open OUT (and OUT's events file: event_file when given and not '', else events_path's
+  !> name) under temporary names and write the headers. OUT '-' is standard output (stream):
+  !> the samples are written there as they come, and the event log only to an event_file.
+  subroutine file_open(self, path, input, error, event_file)
     class(file_sink), intent(inout) :: self
     character(len=*), intent(in) :: path
     type(scene_input), intent(in) :: input
     type(error_type), allocatable, intent(out) :: error
+    character(len=*), intent(in), optional :: event_file
     integer :: ios, k
     character(len=512) :: message
     character(len=:), allocatable :: header, samples_file, events_file
+    logical :: named_events
 
+    named_events = .false.
+    if (present(event_file)) named_events = len(event_file) > 0
     self%path = path
+    self%stream = path == '-'
     self%event_path = trim(events_path(path))
+    if (named_events) self%event_path = event_file
     if (path(len(path):) == '/') then
       call raise(error, status_input, 'cannot write output ' // path // ': it is a folder (give a file name)')
       return
     end if
-    call output_target(self%path, self%target, error)
+    self%target = ''
+    self%event_target = ''
+    if (.not. self%stream) call output_target(self%path, self%target, error)
     if (allocated(error)) return
-    call output_target(self%event_path, self%event_target, error)
+    if (named_events .or. .not. self%stream) call output_target(self%event_path, self%event_target, error)
     if (allocated(error)) return
     ! Two links leading to one file would make the pair one file.
     call resolve(self%target, samples_file)
@@ -413,18 +426,22 @@ contains
         self%event_path // ' are the same file ' // samples_file)
       return
     end if
-    call make_temporary(self%target, self%unit, self%part, ios, message)
+    self%unit = output_unit
+    self%part = ''
+    ios = 0
+    if (.not. self%stream) call make_temporary(self%target, self%unit, self%part, ios, message)
     if (ios /= 0) then
       call raise(error, status_input, 'cannot write output ' // path // ': ' // trim(reason(message)))
       return
     end if
     self%events = events_kept(input)
+    if (self%stream .and. .not. named_events) self%events = events_none
     self%event_part = ''
     ios = 0
     if (self%events /= events_none) &
       call make_temporary(self%event_target, self%event_unit, self%event_part, ios, message)
     if (ios /= 0) then
-      close(self%unit, status='delete')
+      if (.not. self%stream) close(self%unit, status='delete')
       call raise(error, status_input, 'cannot write output ' // self%event_path // ': ' // trim(reason(message)))
       return
     end if
@@ -519,10 +536,14 @@ contains
       call self%finish_file(self%unit, self%path, self%part)
       if (self%events /= events_none) call self%finish_file(self%event_unit, self%event_path, self%event_part)
     else
-      close(self%unit, iostat=ios)
+      ! Standard output stays open (the rows streamed are out already).
+      if (self%stream) flush(self%unit, iostat=ios)
+      if (.not. self%stream) close(self%unit, iostat=ios)
       if (self%events /= events_none) close(self%event_unit, iostat=ios)
     end if
     if (keep .and. .not. allocated(self%write_failure)) then
+      ! A stream without an events file has nothing to put in place.
+      if (self%stream .and. len(self%event_target) == 0) return
       call replace_pair(self, error)
       if (.not. allocated(error)) return
     end if
@@ -545,6 +566,8 @@ contains
       flush(unit, iostat=ios, iomsg=message)
       if (ios /= 0) self%write_failure = path // ': ' // trim(reason(message))
     end if
+    ! Standard output (a stream) is not ours to close, nor a file whose size can be checked.
+    if (len(part) == 0) return
     if (allocated(self%write_failure)) then
       close(unit, iostat=ios)
       return
@@ -597,10 +620,12 @@ contains
     aside(1) = part(1)(:len_trim(part(1)) - len('.part')) // '.previous'
     aside(2) = part(2)(:len_trim(part(2)) - len('.part')) // '.previous'
     if (len_trim(part(2)) == 0) aside(2) = part(1)(:len_trim(part(1)) - len('.part')) // '.events.previous'
+    if (len_trim(final(1)) == 0) final(1) = final(2)      ! a stream: the events file alone
     call lock_folders(trim(final(1)), trim(final(2)), locks)
     kept = .false.
     placed = .false.
     do k = 1, 2
+      if (len_trim(part(k)) == 0 .and. k == 1) cycle       ! (a stream's samples: no file)
       if (.not. exists(trim(final(k)))) cycle
       kept(k) = c_link(trim(final(k)) // c_null_char, trim(aside(k)) // c_null_char) == 0
       if (.not. kept(k)) kept(k) = c_rename(trim(final(k)) // c_null_char, trim(aside(k)) // c_null_char) == 0

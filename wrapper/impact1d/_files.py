@@ -19,6 +19,11 @@ _KINDS = ((stat.S_ISDIR, "a folder"), (stat.S_ISFIFO, "a FIFO (named pipe)"),
           (stat.S_ISSOCK, "a socket"))
 
 
+# Names of standard output, as impact1d's -o takes them (it streams the samples there);
+# impact1d-plot and impact1d-sweep write files only, and say so for these.
+STANDARD_OUTPUT = ("-", "/dev/stdout", "/dev/fd/1", "/proc/self/fd/1")
+
+
 def _kind(mode) -> str:
     for test, name in _KINDS:
         if test(mode):

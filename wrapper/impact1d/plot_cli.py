@@ -128,8 +128,11 @@ def main(argv=None):
     args = _parser().parse_args(argv)
     output = args.output
     from impact1d import InputError
-    from impact1d._files import check_input
+    from impact1d._files import STANDARD_OUTPUT, check_input
 
+    if args.png in STANDARD_OUTPUT:
+        return _fail(f"-o {args.png}: a figure is written to a file (give a PNG name), "
+                     "not to standard output")
     try:
         check_input(output)         # a FIFO or /dev/zero would never end
     except InputError as error:

@@ -20,7 +20,7 @@ import numpy as np
 
 from . import __version__
 from ._scene import InputError, load_scene
-from ._files import output_target, print_line, write_whole
+from ._files import STANDARD_OUTPUT, output_target, print_line, write_whole
 from .sweep import sweep
 
 
@@ -97,6 +97,9 @@ def _main(argv) -> int:
             raise InputError("nothing to vary: give at least one --vary NAME=SPEC")
         if args.output is not None and not args.output.strip():
             raise InputError("-o: an empty output name")
+        if args.output in STANDARD_OUTPUT:
+            raise InputError(f"-o {args.output}: the table is written to a file (.csv or .parquet), "
+                             "not to standard output")
         if args.output and args.output.endswith(".parquet"):
             try:
                 import pyarrow  # noqa: F401
