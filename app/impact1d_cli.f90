@@ -7,7 +7,8 @@ program impact1d_cli
   use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char
   use impact1d_kinds, only: wp
   use impact1d_error, only: error_type, status_input, status_simulation, fmt
-  use impact1d_scene, only: scene_input, scene_type, set_text, i_t_end, i_dt, i_dt_out, i_method, i_events, i_title, &
+  use impact1d_scene, only: scene_input, scene_type, set_text, i_t_end, i_dt, i_dt_out, i_max_events, i_method, &
+    i_events, i_title, &
     events_none, events_impacts, n_contacts, &
     i_f1_table, i_f2_table
   use impact1d_io, only: read_scene_file, prepare_scene, lower
@@ -42,7 +43,7 @@ program impact1d_cli
 
   character(len=*), parameter :: usage = &
     'usage: impact1d SCENE [--t-end T] [--dt DT] [--dt-out DT_OUT] [--method event|vissim] [-o OUT.dat]' // &
-    ' [--events all|impacts|none] [--events-file FILE] [--quiet]'
+    ' [--events all|impacts|none] [--events-file FILE] [--max-events N] [--quiet]'
   character(len=*), parameter :: nl = new_line('a')
   character(len=*), parameter :: help = usage // nl // nl // &
     'Runs SCENE (a namelist scene, or a VisSim-style .dat parameter file) and writes its samples' // nl // &
@@ -61,6 +62,8 @@ program impact1d_cli
     '  --events WHAT    what the event log keeps: all (default), impacts, or none (no events' // nl // &
     '                   file; an earlier one beside OUT.dat is removed); counts stay exact' // nl // &
     '  --events-file F  the event log goes to F (default OUT.events.dat)' // nl // &
+    '  --max-events N   the log keeps the first N events (default 10^7); then it ends with a' // nl // &
+    '                   note, the run goes on and the summary''s counts stay exact' // nl // &
     '  --quiet          no progress line (a run of over a second on a terminal shows one on' // nl // &
     '                   stderr: the simulated time, events so far and the time left; never' // nl // &
     '                   in a pipe or a file)' // nl // &
@@ -78,9 +81,11 @@ program impact1d_cli
   type(error_type), allocatable :: error, close_error
   character(len=:), allocatable :: scene_path, out_path, option, value, events_file
   integer :: i, n_args, k, equals
-  real(wp) :: overrides(3)
-  logical :: overridden(3), has_value, out_given, quiet, stream
+  real(wp) :: overrides(4)
+  logical :: overridden(4), has_value, out_given, quiet, stream
   character(len=64) :: method, events
+  !> The fields --t-end, --dt, --dt-out, --max-events override, in that order.
+  integer, parameter :: overridable(4) = [i_t_end, i_dt, i_dt_out, i_max_events]
 
   overridden = .false.
   overrides = 0.0_wp
@@ -115,7 +120,7 @@ program impact1d_cli
     case ('--quiet')
       if (has_value) call fail(status_input, '--quiet takes no value; ' // usage)
       quiet = .true.
-    case ('--t-end', '--dt', '--dt-out', '--method', '--events', '--events-file', '-o')
+    case ('--t-end', '--dt', '--dt-out', '--max-events', '--method', '--events', '--events-file', '-o')
       if (.not. has_value) then
         if (i > n_args) call fail(status_input, option // ' needs a value')
         value = argument_text(i)
@@ -144,6 +149,8 @@ program impact1d_cli
         call override(2)
       case ('--dt-out')
         call override(3)
+      case ('--max-events')
+        call override(4)
       end select
     case default
       if (has_value) call fail(status_input, 'unknown option ' // option // '; ' // usage)
@@ -159,8 +166,8 @@ program impact1d_cli
 
   call read_scene_file(scene_path, input, error)
   if (allocated(error)) call fail(error%status, error%message)
-  input%value([i_t_end, i_dt, i_dt_out]) = merge(overrides, input%value([i_t_end, i_dt, i_dt_out]), overridden)
-  input%given([i_t_end, i_dt, i_dt_out]) = input%given([i_t_end, i_dt, i_dt_out]) .or. overridden
+  input%value(overridable) = merge(overrides, input%value(overridable), overridden)
+  input%given(overridable) = input%given(overridable) .or. overridden
   if (len_trim(method) > 0) call set_text(input, i_method, trim(method))
   if (len_trim(events) > 0) call set_text(input, i_events, trim(events))
   call prepare_scene(input, scene, error)
@@ -185,6 +192,7 @@ program impact1d_cli
   end if
   ! Held from creating the temporary files until they are registered: a signal in between
   ! would otherwise leave them behind.
+  sink%max_events = scene%max_events
   call hold_signals()
   if (stream) then
     call sink%open('-', input, error, events_file)
@@ -227,6 +235,8 @@ contains
     case default
       text = sink%event_path // ' (' // trim(fmt(sum(stats%events))) // ' events)'
     end select
+    if (sink%n_cut > 0) text = text(:len(text) - 1) // ', cut at ' // trim(fmt(sink%n_logged)) // &
+      ': max_events)'
   end function event_log_text
 
   !> The summary on stdout. Every number in ES with a three-digit exponent (7.73913E+157
@@ -263,6 +273,8 @@ contains
     text = text // '  steps     ' // trim(fmt(stats%steps)) // ' RK4 steps' // nl
     ! Not an error, but the numbers need it said beside them (a step coarse for a spring).
     if (len(scene%warnings) > 0) text = text // '  warning   ' // scene%warnings // nl
+    call sink%cut_note(line)
+    if (len(line) > 0) text = text // '  warning   ' // line // nl
     if (stream) then
       call say(text, 'the summary', '(the samples went to standard output)')
     else
@@ -302,7 +314,7 @@ contains
     if (length > 0) call get_command_argument(i, text)
   end function argument_text
 
-  !> Option k of --t-end, --dt, --dt-out takes the value just read.
+  !> Option k of --t-end, --dt, --dt-out, --max-events takes the value just read.
   subroutine override(k)
     integer, intent(in) :: k
     overrides(k) = number(option, value)

@@ -120,6 +120,7 @@ contains
     type(memory_sink) :: sink
     type(error_type), allocatable :: error
     integer, allocatable :: columns(:)
+    character(len=:), allocatable :: note
 
     n_samples = 0
     n_events = 0
@@ -149,9 +150,13 @@ contains
     end if
     sink%show_progress = progress /= 0
     sink%events = scene%events
+    sink%max_events = scene%max_events
     call run(scene, sink, stats, error)
     call sink%end_progress()
     if (failed(error, status, message)) return
+    ! A log cut at max_events says so beside the scene's warnings (Result.warnings).
+    call sink%cut_note(note)
+    if (len(note) > 0) warnings = trim(warnings) // repeat(new_line('a'), min(len_trim(warnings), 1)) // note
     n_samples = sink%n_samples
     n_events = sink%n_events
     steps = int(min(stats%steps, int(huge(1_c_int), kind(stats%steps))), c_int)

@@ -54,6 +54,10 @@ module impact1d_output
     !> What the sink keeps of the event log (&run events: impact1d_scene's events_all,
     !> events_impacts, events_none); the run's counts (run_stats) have every event.
     integer :: events = events_all
+    !> At most max_events of them go into the log (&run max_events); n_logged went in, n_cut
+    !> would have and did not (the log then ends with a note: cut_note).
+    integer :: max_events = huge(1)
+    integer(int64) :: n_logged = 0, n_cut = 0
     integer(int64) :: clock_start = -1, clock_shown = 0
     logical :: progress_shown = .false.
   contains
@@ -62,6 +66,8 @@ module impact1d_output
     procedure :: progress
     procedure :: end_progress
     procedure :: keeps_event
+    procedure :: logs_event
+    procedure :: cut_note
   end type sink_type
 
   abstract interface
@@ -244,6 +250,32 @@ contains
       kind > event_impact .and. kind <= event_impact + n_contacts)
   end function keeps_event
 
+  !> Whether this event goes into the log: a kind the log keeps, while there is room
+  !> (max_events); every one past the room is counted (n_cut) for the note.
+  logical function logs_event(self, kind)
+    class(sink_type), intent(inout) :: self
+    integer, intent(in) :: kind
+    logs_event = self%keeps_event(kind)
+    if (.not. logs_event) return
+    logs_event = self%n_logged < self%max_events
+    if (logs_event) then
+      self%n_logged = self%n_logged + 1
+    else
+      self%n_cut = self%n_cut + 1
+    end if
+  end function logs_event
+
+  !> '' when the log holds every event it keeps, else why it stops where it does.
+  subroutine cut_note(self, text)
+    class(sink_type), intent(in) :: self
+    character(len=:), allocatable, intent(out) :: text
+    text = ''
+    if (self%n_cut == 0) return
+    text = 'the event log was cut at ' // trim(fmt(self%n_logged)) // ' of ' // &
+      trim(fmt(self%n_logged + self%n_cut)) // ' events (max_events = ' // trim(fmt(self%max_events)) // &
+      '); the run went on to its end and the counts are exact'
+  end subroutine cut_note
+
   !> Every 4096 steps of a run: progress on stderr where it is shown, and an interrupt
   !> (Ctrl-C while Python waits for the run) ends the run within a fraction of a second.
   subroutine checkpoint(sink, stats, t, t_end, error)
@@ -369,7 +401,7 @@ contains
     real(wp), allocatable :: times(:), velocities(:, :)
     integer, allocatable :: kinds(:)
     integer :: n
-    if (.not. self%keeps_event(kind)) return
+    if (.not. self%logs_event(kind)) return
     n = self%n_events
     if (n == size(self%event_time)) then
       ! Geometric growth: events are rare next to steps, copies are amortised.
@@ -496,7 +528,8 @@ contains
     integer, intent(in) :: kind
     integer :: ios
     character(len=512) :: message
-    if (allocated(self%write_failure) .or. .not. self%keeps_event(kind)) return
+    if (allocated(self%write_failure)) return
+    if (.not. self%logs_event(kind)) return
     if (self%n_bodies == 2) then
       write(self%event_unit, event_format, iostat=ios, iomsg=message) t, event_names(kind), v_before, v_after
     else
@@ -529,11 +562,14 @@ contains
     logical, intent(in) :: keep
     type(error_type), allocatable, intent(out) :: error
     integer :: ios
+    character(len=:), allocatable :: note
     call self%end_progress()
     if (.not. self%is_open) return
     self%is_open = .false.
     if (keep) then
       call self%finish_file(self%unit, self%path, self%part)
+      call self%cut_note(note)
+      if (len(note) > 0 .and. self%events /= events_none) call self%put_line(self%event_unit, '# ' // note)
       if (self%events /= events_none) call self%finish_file(self%event_unit, self%event_path, self%event_part)
     else
       ! Standard output stays open (the rows streamed are out already).

@@ -83,6 +83,25 @@ def summarize(result) -> dict:
     return {name: row[name] for name in SUMMARY_COLUMNS}
 
 
+# The core's default &run max_events, and its largest (a summary reads the whole log).
+_DEFAULT_MAX_EVENTS, _WHOLE_LOG = 10_000_000, 2**31 - 1
+
+
+def _is_count(value) -> bool:
+    """A max_events the core takes (else it is passed on, for the core's message)."""
+    return value is None or (isinstance(value, (int, float)) and not isinstance(value, bool)
+                             and float(value).is_integer() and 1 <= value <= _WHOLE_LOG)
+
+
+def _cut_log(result, cap: int):
+    """A kept Result's log cut at max_events as the core cuts it, with its warning."""
+    if len(result.events) <= cap:
+        return result
+    note = (f"the event log was cut at {cap} of {len(result.events)} events (max_events = {cap}); "
+            "the run went on to its end and the counts are exact")
+    return dataclasses.replace(result, events=result.events[:cap], warnings=result.warnings + (note,))
+
+
 def _failed_row() -> dict:
     """A failed run's summary: nothing measured (its `error` says why)."""
     return {name: math.nan for name in SUMMARY_COLUMNS}
@@ -115,10 +134,12 @@ def run_chunk(scene: Scene, overrides: list, keep_results: bool = False):
     rows, errors, results = [], [], []
     for changes in overrides:
         # The summary reads the whole event log (its counts and t_rest are exact whatever
-        # `events` keeps); a kept Result then keeps what `events` asked for.
+        # `events` and `max_events` keep); a kept Result then keeps what they asked for.
         events = changes.get("events", scene.events)
+        cap = changes.get("max_events", scene.max_events)
+        whole = {"events": None, "max_events": _WHOLE_LOG if _is_count(cap) else cap}
         try:
-            result = simulate(scene, **{**changes, "events": None})
+            result = simulate(scene, **{**changes, **whole})
         except (InputError, SimulationError) as error:
             rows.append(_failed_row())
             errors.append(str(error))
@@ -129,6 +150,8 @@ def run_chunk(scene: Scene, overrides: list, keep_results: bool = False):
         if keep_results and events is not None and str(events).lower() != "all":
             keep = np.isin(result.events["kind"], _IMPACT_KINDS if str(events).lower() == "impacts" else ())
             result = dataclasses.replace(result, events=result.events[keep])
+        if keep_results:
+            result = _cut_log(result, _DEFAULT_MAX_EVENTS if cap is None else int(cap))
         results.append(result if keep_results else None)
     return (_columns(rows), errors, results) if keep_results else (_columns(rows), errors)
 
