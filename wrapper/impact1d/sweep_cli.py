@@ -88,6 +88,9 @@ def _main(argv) -> int:
                         help="a field and its values: a:b:n or v1,v2,... (repeat for a grid)")
     parser.add_argument("--workers", type=int, default=None,
                         help="threads to use (default: all cores for big sweeps)")
+    parser.add_argument("--settle", type=float, default=None, metavar="T",
+                        help="add the steady state over [T, t_end]: peak-to-peak and RMS of each "
+                        "position and velocity, impacts per forcing period (docs/formats.md)")
     parser.add_argument("-o", "--output", default=None,
                         help="table to write (default output/<scene>_sweep.csv)")
     parser.add_argument("--version", action="version", version=f"impact1d-sweep {__version__}")
@@ -110,7 +113,7 @@ def _main(argv) -> int:
         out = args.output or os.path.join("output", f"{stem}_sweep.csv")
         output_target(out)         # a FIFO or a folder there: refused before the runs
         scene = load_scene(args.scene)
-        table = sweep(scene, parse_vary(args.vary), workers=args.workers)
+        table = sweep(scene, parse_vary(args.vary), workers=args.workers, settle=args.settle)
     except InputError as error:
         print(f"impact1d-sweep: {error}", file=sys.stderr)
         return 1
