@@ -10,7 +10,7 @@ module impact1d_output
   use impact1d_scene, only: scene_input, real_names, n_real, i_title, i_method, i_g, i_dt_out, &
     events_all, events_impacts, events_none, events_kept, n_contacts, &
     i_dt, default_gravity, i_k1, i_k2, i_k12, i_c1, i_c2, i_c12, i_m2
-  use impact1d_files, only: output_target, make_temporary, resolve, lock_folders, unlock_folders
+  use impact1d_files, only: output_target, make_temporary, resolve, lock_folders, unlock_folders, write_text
   implicit none
   private
   public :: sink_type, memory_sink, summary_sink, file_sink, n_columns, column_names, n_event_kinds, event_names
@@ -124,6 +124,11 @@ module impact1d_output
     !> The samples go to standard output as they come (-o -): no temporary, nothing to
     !> rename, and no event log unless an events file was named.
     logical :: stream = .false.
+    !> A stream's text not yet written (n_pending bytes of pending): it goes out with
+    !> write_text, since the Fortran runtime drops the errors of its writes to stdout (a
+    !> full disk, /dev/full: the rows were lost with exit status 0).
+    character(len=:), allocatable :: pending
+    integer :: n_pending = 0
     !> The names given (for messages), the files they replace (the name, or the file a
     !> symbolic link there leads to: output_target) and this run's own temporary files
     !> beside those (make_temporary), which a signal guard must remove.
@@ -146,6 +151,8 @@ module impact1d_output
     procedure :: close => file_close
     procedure, private :: put_line
     procedure, private :: finish_file
+    procedure, private :: stream_put
+    procedure, private :: stream_flush
   end type file_sink
 
   interface
@@ -460,6 +467,8 @@ contains
     end if
     self%unit = output_unit
     self%part = ''
+    if (self%stream) allocate(character(len=65536) :: self%pending)
+    self%n_pending = 0
     ios = 0
     if (.not. self%stream) call make_temporary(self%target, self%unit, self%part, ios, message)
     if (ios /= 0) then
@@ -516,7 +525,13 @@ contains
     real(wp), intent(in) :: row(n_columns)
     integer :: ios
     character(len=512) :: message
+    character(len=25 * n_columns) :: line
     if (allocated(self%write_failure)) return
+    if (self%stream) then
+      write(line, row_format) row(self%columns)
+      call self%stream_put(trim(line))
+      return
+    end if
     write(self%unit, row_format, iostat=ios, iomsg=message) row(self%columns)
     if (ios /= 0) self%write_failure = self%path // ': ' // trim(reason(message))
     self%bytes(1) = self%bytes(1) + self%sample_bytes
@@ -547,12 +562,41 @@ contains
     integer :: ios
     character(len=512) :: message
     if (allocated(self%write_failure)) return
+    if (self%stream .and. unit == self%unit) then
+      call self%stream_put(text)
+      return
+    end if
     write(unit, '(a)', iostat=ios, iomsg=message) text
     if (ios /= 0 .and. unit == self%unit) self%write_failure = self%path // ': ' // trim(reason(message))
     if (ios /= 0 .and. unit /= self%unit) self%write_failure = self%event_path // ': ' // trim(reason(message))
     if (unit == self%unit) self%bytes(1) = self%bytes(1) + len(text) + 1
     if (unit /= self%unit) self%bytes(2) = self%bytes(2) + len(text) + 1
   end subroutine put_line
+
+  !> A line for a stream (a sample or header line, without its newline).
+  subroutine stream_put(self, text)
+    class(file_sink), intent(inout) :: self
+    character(len=*), intent(in) :: text
+    character(len=:), allocatable :: why
+    if (self%n_pending + len(text) + 1 > len(self%pending)) call self%stream_flush()
+    if (len(text) + 1 > len(self%pending)) then      ! (a header line longer than the buffer)
+      call write_text(1, text // new_line('a'), why)
+      if (len(why) > 0 .and. .not. allocated(self%write_failure)) self%write_failure = 'standard output: ' // why
+      return
+    end if
+    self%pending(self%n_pending + 1:self%n_pending + len(text) + 1) = text // new_line('a')
+    self%n_pending = self%n_pending + len(text) + 1
+  end subroutine stream_put
+
+  !> Write a stream's pending text, noting the first failure.
+  subroutine stream_flush(self)
+    class(file_sink), intent(inout) :: self
+    character(len=:), allocatable :: why
+    if (self%n_pending == 0 .or. allocated(self%write_failure)) return
+    call write_text(1, self%pending(:self%n_pending), why)
+    self%n_pending = 0
+    if (len(why) > 0) self%write_failure = 'standard output: ' // why
+  end subroutine stream_flush
 
   !> Close the files. Only if the run succeeded and every write, flush and close did, the new
   !> pair replaces the previous one (replace_pair); otherwise the temporary files are removed
@@ -572,8 +616,8 @@ contains
       if (len(note) > 0 .and. self%events /= events_none) call self%put_line(self%event_unit, '# ' // note)
       if (self%events /= events_none) call self%finish_file(self%event_unit, self%event_path, self%event_part)
     else
-      ! Standard output stays open (the rows streamed are out already).
-      if (self%stream) flush(self%unit, iostat=ios)
+      ! Standard output stays open (the rows before the failure go out).
+      if (self%stream) call self%stream_flush()
       if (.not. self%stream) close(self%unit, iostat=ios)
       if (self%events /= events_none) close(self%event_unit, iostat=ios)
     end if
@@ -598,12 +642,14 @@ contains
     integer :: ios
     integer(int64) :: on_disk, written
     character(len=512) :: message
+    if (self%stream .and. unit == self%unit) then
+      call self%stream_flush()
+      return
+    end if
     if (.not. allocated(self%write_failure)) then
       flush(unit, iostat=ios, iomsg=message)
       if (ios /= 0) self%write_failure = path // ': ' // trim(reason(message))
     end if
-    ! Standard output (a stream) is not ours to close, nor a file whose size can be checked.
-    if (len(part) == 0) return
     if (allocated(self%write_failure)) then
       close(unit, iostat=ios)
       return

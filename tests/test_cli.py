@@ -565,3 +565,13 @@ def test_tools_that_write_files_refuse_dash(cli, tmp_path, tool, args):
                           cwd=tmp_path, capture_output=True, text=True, timeout=CLI_TIMEOUT)
     assert proc.returncode == 1 and "not to standard output" in proc.stderr
     assert sorted(tmp_path.iterdir()) == before
+
+
+def test_dash_to_a_full_disk_fails(cli, tmp_path):
+    """The Fortran runtime drops the errors of its writes to stdout: `-o - > /dev/full`
+    lost every row with exit status 0. The stream goes out through write(2): status 2."""
+    with open("/dev/full", "w") as full:
+        proc = subprocess.run([cli, str(INPUT / "case3.nml"), "-o", "-"], cwd=tmp_path, stdout=full,
+                              stderr=subprocess.PIPE, text=True, timeout=CLI_TIMEOUT)
+    assert proc.returncode == 2
+    assert "cannot write output standard output: No space left on device" in proc.stderr
