@@ -10,7 +10,8 @@ module impact1d_output
   use impact1d_scene, only: scene_input, real_names, n_real, i_title, i_method, i_g, i_dt_out, &
     events_all, events_impacts, events_none, events_kept, n_contacts, &
     i_dt, default_gravity, i_k1, i_k2, i_k12, i_c1, i_c2, i_c12, i_m2
-  use impact1d_files, only: output_target, make_temporary, resolve, lock_folders, unlock_folders, write_text
+  use impact1d_files, only: output_target, make_temporary, resolve, lock_folders, unlock_folders, write_text, &
+    lock_timed_out, lock_wait
   implicit none
   private
   public :: sink_type, memory_sink, summary_sink, file_sink, n_columns, column_names, n_event_kinds, event_names
@@ -704,6 +705,12 @@ contains
     if (len_trim(part(2)) == 0) aside(2) = part(1)(:len_trim(part(1)) - len('.part')) // '.events.previous'
     if (len_trim(final(1)) == 0) final(1) = final(2)      ! a stream: the events file alone
     call lock_folders(trim(final(1)), trim(final(2)), locks)
+    if (any(locks == lock_timed_out)) then
+      call raise(error, status_simulation, 'cannot write output ' // self%path // &
+        ': another process has held the lock on its folder for ' // trim(fmt(real(lock_wait(), wp))) // &
+        ' s (stopped or hung while putting its own output in place? IMPACT1D_LOCK_WAIT sets the wait)')
+      return
+    end if
     kept = .false.
     placed = .false.
     do k = 1, 2

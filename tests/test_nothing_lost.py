@@ -311,3 +311,31 @@ def test_sweep_and_plot_reports_that_cannot_be_written_fail(cli, tmp_path, stdou
     for args in ([tmp_path / "o.dat"], [tmp_path / "t.csv", "--x", "r_left"]):
         done = run_with_stdout([find_tool("impact1d-plot"), *args], stdout)
         assert_one_line_failure(done, "impact1d-plot", 1)
+
+
+def test_a_lock_held_too_long_ends_the_wait(cli, tmp_path):
+    """A run waited for its folder's lock (flock) without end: a holder stopped while
+    putting its output in place (SIGSTOP, a suspended job) hung every later run there.
+    The wait is bounded (IMPACT1D_LOCK_WAIT seconds, default 60): then status 2, one line
+    saying why, no temporary file, the previous pair untouched. Here this test holds the
+    lock as such a holder would."""
+    import fcntl
+
+    before = previous_output(cli, tmp_path)
+    folder = os.open(tmp_path, os.O_RDONLY)
+    try:
+        fcntl.flock(folder, fcntl.LOCK_EX)
+        done = subprocess.run([cli, str(CASE3), "--dt-out", "0.05", "-o", str(tmp_path / "o.dat")], cwd=ROOT,
+                              capture_output=True, text=True, timeout=30, stdin=subprocess.DEVNULL,
+                              env={**os.environ, "IMPACT1D_LOCK_WAIT": "0.5"})
+        assert_refused_and_untouched(done, tmp_path, before)
+        assert "another process has held the lock on its folder for 0.5 s" in done.stderr
+        # A lock released within the wait is waited for, as before.
+        releaser = threading.Timer(0.3, fcntl.flock, (folder, fcntl.LOCK_UN))
+        releaser.start()
+        done = run(cli, CASE3, "--dt-out", "0.05", "-o", tmp_path / "o.dat", cwd=ROOT)
+        releaser.join()
+        assert done.returncode == 0, done.stderr
+        assert snapshot(tmp_path) != before and temporaries(tmp_path) == []
+    finally:
+        os.close(folder)
