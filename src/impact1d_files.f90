@@ -9,7 +9,7 @@ module impact1d_files
   implicit none
   private
   public :: check_input_file, output_target, make_folders, make_temporary, lock_folders, &
-    unlock_folders, resolve, write_text, lock_timed_out, lock_wait
+    unlock_folders, resolve, resolve_output, write_text, lock_timed_out, lock_wait
 
   !> lock_folders' handle for a lock another process held past lock_wait() seconds.
   integer, parameter :: lock_timed_out = -2
@@ -160,6 +160,20 @@ contains
     if (.not. c_associated(c_realpath(path // c_null_char, buffer))) return
     absolute = buffer(:index(buffer, c_null_char) - 1)
   end subroutine resolve
+
+  !> The absolute path of the file an output at path is or will be: resolve's for an
+  !> existing file, else its folder resolved and its name; '' when the folder does not exist.
+  subroutine resolve_output(path, absolute)
+    character(len=*), intent(in) :: path
+    character(len=:), allocatable, intent(out) :: absolute
+    character(len=:), allocatable :: folder
+    call resolve(path, absolute)
+    if (len(absolute) > 0) return
+    call folder_of(path, folder)
+    call resolve(folder, absolute)
+    if (len(absolute) == 0) return
+    absolute = absolute // '/' // path(index(path, '/', back=.true.) + 1:)
+  end subroutine resolve_output
 
   !> The folder a path is in ('.' for a bare name, '/' for a file at the root).
   subroutine folder_of(path, folder)

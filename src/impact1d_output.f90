@@ -10,7 +10,7 @@ module impact1d_output
   use impact1d_scene, only: scene_input, real_names, n_real, i_title, i_method, i_g, i_dt_out, &
     events_all, events_impacts, events_none, events_kept, n_contacts, &
     i_dt, default_gravity, i_k1, i_k2, i_k12, i_c1, i_c2, i_c12, i_m2
-  use impact1d_files, only: output_target, make_temporary, resolve, lock_folders, unlock_folders, write_text, &
+  use impact1d_files, only: output_target, make_temporary, resolve_output, lock_folders, unlock_folders, write_text, &
     lock_timed_out, lock_wait
   implicit none
   private
@@ -458,9 +458,12 @@ contains
     if (allocated(error)) return
     if (named_events .or. .not. self%stream) call output_target(self%event_path, self%event_target, error)
     if (allocated(error)) return
-    ! Two links leading to one file would make the pair one file.
-    call resolve(self%target, samples_file)
-    call resolve(self%event_target, events_file)
+    ! Two links leading to one file would make the pair one file, and so would an events
+    ! file named as the output (--events-file), existing or not.
+    samples_file = ''
+    events_file = ''
+    if (len(self%target) > 0) call resolve_output(self%target, samples_file)     ! (none for a stream)
+    if (len(self%event_target) > 0) call resolve_output(self%event_target, events_file)
     if (len(samples_file) > 0 .and. samples_file == events_file) then
       call raise(error, status_input, 'cannot write output ' // path // ': it and its events file ' // &
         self%event_path // ' are the same file ' // samples_file)

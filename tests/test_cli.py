@@ -546,6 +546,8 @@ def test_dev_stdout_streams_too(cli, tmp_path):
     (["-o", "-", "--events", "none", "--events-file", "e.dat"], "the scene keeps no event log"),
     (["-o", "x.dat", "--events-file", "-"], "the event log cannot go to standard output"),
     (["-o", "-", "--events-file", ""], "--events-file needs a file name"),
+    # Not yet there, the two names were one file: the samples replaced the log.
+    (["-o", "x.dat", "--events-file", "x.dat"], "are the same file"),
 ])
 def test_dash_refusals(cli, tmp_path, args, message):
     proc = run_cli(cli, INPUT / "case3.nml", *args, cwd=tmp_path, check=False)
