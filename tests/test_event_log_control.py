@@ -142,5 +142,7 @@ def test_cli_max_events_option_and_namelist(tmp_path):
         assert "left 47 right 47 rest_left 1 rest_right 1" in done.stdout       # exact counts
         assert "(96 events, cut at 10: max_events)" in done.stdout
         assert "  warning   " + CUT_NOTE.format(n=10, m=96) in done.stdout
+        read_back = impact1d.read_output(out)                   # the note comes back too
+        assert len(read_back.events) == 10 and read_back.warnings[0].startswith(CUT_NOTE.format(n=10, m=96))
     done = subprocess.run([cli, str(CASE5), "-o", str(out), "--max-events", "2.5"], capture_output=True, text=True)
     assert done.returncode == 1 and "max_events = 2.5 must be a whole number" in done.stderr
