@@ -333,3 +333,14 @@ def test_sweep_cli_settle(tmp_path):
     expected = impact1d.sweep(scene, {"f1_amp": [4.0, 10.0]}, settle=12.0)
     np.testing.assert_allclose(table["impacts_per_period"], expected["impacts_per_period"], rtol=1e-15)
     np.testing.assert_allclose(table["v1_rms"], expected["v1_rms"], rtol=1e-15)
+
+
+def test_steady_state_columns_plot_with_their_units():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    table = impact1d.sweep(impact1d.load_scene(INPUT / "impact_oscillator.nml"), {"f1_amp": [4.0, 10.0]},
+                           settle=12.0)
+    fig = impact1d.plot.sweep(table, "f1_amp", value=["x1_rms", "v2_p2p", "impacts_per_period"])
+    labels = [ax.get_ylabel() for ax in fig.axes]
+    assert labels == ["x1_rms (m)", "v2_p2p (m/s)", "impacts_per_period"]
