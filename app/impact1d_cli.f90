@@ -1,18 +1,20 @@
 !> impact1d command line: a thin main over the library. Reads a scene, applies the options,
-!> streams the run to OUT.dat and OUT.events.dat, prints a summary. Any error: one line on
+!> streams the run to OUT.dat and OUT.events.dat (or the samples to standard output: -o -),
+!> prints a summary. Any error: one line on
 !> stderr and a non-zero exit status (1 bad input, 2 the run could not go on).
 program impact1d_cli
   use, intrinsic :: iso_fortran_env, only: error_unit
   use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char
   use impact1d_kinds, only: wp
   use impact1d_error, only: error_type, status_input, status_simulation, fmt
-  use impact1d_scene, only: scene_input, scene_type, set_text, i_t_end, i_dt, i_dt_out, i_method, i_events, i_title, &
+  use impact1d_scene, only: scene_input, scene_type, set_text, i_t_end, i_dt, i_dt_out, i_max_events, i_method, &
+    i_events, i_title, &
     events_none, events_impacts, n_contacts, &
     i_f1_table, i_f2_table
   use impact1d_io, only: read_scene_file, prepare_scene, lower
   use impact1d_output, only: file_sink, event_names, event_impact, n_event_kinds, events_path, i_pe, i_work, &
     i_friction_loss, i_impact_loss, i_damping_loss
-  use impact1d_files, only: make_folders, resolve, write_stdout
+  use impact1d_files, only: make_folders, resolve, write_text
   use impact1d_solver, only: run, run_stats
   use impact1d_version, only: version
   implicit none
@@ -41,7 +43,7 @@ program impact1d_cli
 
   character(len=*), parameter :: usage = &
     'usage: impact1d SCENE [--t-end T] [--dt DT] [--dt-out DT_OUT] [--method event|vissim] [-o OUT.dat]' // &
-    ' [--events all|impacts|none] [--quiet]'
+    ' [--events all|impacts|none] [--events-file FILE] [--max-events N] [--quiet]'
   character(len=*), parameter :: nl = new_line('a')
   character(len=*), parameter :: help = usage // nl // nl // &
     'Runs SCENE (a namelist scene, or a VisSim-style .dat parameter file) and writes its samples' // nl // &
@@ -54,9 +56,14 @@ program impact1d_cli
     '  --method NAME    event   event-driven: every impact, stop and break-away located (default)' // nl // &
     '                   vissim  the VisSim tutorial''s fixed-step scheme, O(dt) (any letter case)' // nl // &
     '  -o OUT.dat       where the samples go (never one of the run''s own input files; a link' // nl // &
-    '                   to a regular file is written through, a FIFO or a device refused)' // nl // &
+    '                   to a regular file is written through, a FIFO or a device refused);' // nl // &
+    '                   -o - (or /dev/stdout): to standard output as they come, the summary' // nl // &
+    '                   to stderr, and no event log unless --events-file names one' // nl // &
     '  --events WHAT    what the event log keeps: all (default), impacts, or none (no events' // nl // &
     '                   file; an earlier one beside OUT.dat is removed); counts stay exact' // nl // &
+    '  --events-file F  the event log goes to F (default OUT.events.dat)' // nl // &
+    '  --max-events N   the log keeps the first N events (default 10^7); then it ends with a' // nl // &
+    '                   note, the run goes on and the summary''s counts stay exact' // nl // &
     '  --quiet          no progress line (a run of over a second on a terminal shows one on' // nl // &
     '                   stderr: the simulated time, events so far and the time left; never' // nl // &
     '                   in a pipe or a file)' // nl // &
@@ -72,11 +79,13 @@ program impact1d_cli
   type(file_sink) :: sink
   type(run_stats) :: stats
   type(error_type), allocatable :: error, close_error
-  character(len=:), allocatable :: scene_path, out_path, option, value
+  character(len=:), allocatable :: scene_path, out_path, option, value, events_file
   integer :: i, n_args, k, equals
-  real(wp) :: overrides(3)
-  logical :: overridden(3), has_value, out_given, quiet
+  real(wp) :: overrides(4)
+  logical :: overridden(4), has_value, out_given, quiet, stream
   character(len=64) :: method, events
+  !> The fields --t-end, --dt, --dt-out, --max-events override, in that order.
+  integer, parameter :: overridable(4) = [i_t_end, i_dt, i_dt_out, i_max_events]
 
   overridden = .false.
   overrides = 0.0_wp
@@ -84,6 +93,8 @@ program impact1d_cli
   events = ''
   scene_path = ''
   out_path = ''
+  events_file = ''
+  stream = .false.
   out_given = .false.
   quiet = .false.
   n_args = command_argument_count()
@@ -109,7 +120,7 @@ program impact1d_cli
     case ('--quiet')
       if (has_value) call fail(status_input, '--quiet takes no value; ' // usage)
       quiet = .true.
-    case ('--t-end', '--dt', '--dt-out', '--method', '--events', '-o')
+    case ('--t-end', '--dt', '--dt-out', '--max-events', '--method', '--events', '--events-file', '-o')
       if (.not. has_value) then
         if (i > n_args) call fail(status_input, option // ' needs a value')
         value = argument_text(i)
@@ -127,12 +138,19 @@ program impact1d_cli
         if (len_trim(value) == 0) call fail(status_input, '-o needs a file name, got an empty one')
         out_path = value
         out_given = .true.
+      case ('--events-file')
+        if (len_trim(value) == 0) call fail(status_input, '--events-file needs a file name, got an empty one')
+        if (standard_output(value)) call fail(status_input, '--events-file ' // value // &
+          ': the event log cannot go to standard output (give a file name)')
+        events_file = value
       case ('--t-end')
         call override(1)
       case ('--dt')
         call override(2)
       case ('--dt-out')
         call override(3)
+      case ('--max-events')
+        call override(4)
       end select
     case default
       if (has_value) call fail(status_input, 'unknown option ' // option // '; ' // usage)
@@ -148,22 +166,39 @@ program impact1d_cli
 
   call read_scene_file(scene_path, input, error)
   if (allocated(error)) call fail(error%status, error%message)
-  input%value([i_t_end, i_dt, i_dt_out]) = merge(overrides, input%value([i_t_end, i_dt, i_dt_out]), overridden)
-  input%given([i_t_end, i_dt, i_dt_out]) = input%given([i_t_end, i_dt, i_dt_out]) .or. overridden
+  input%value(overridable) = merge(overrides, input%value(overridable), overridden)
+  input%given(overridable) = input%given(overridable) .or. overridden
   if (len_trim(method) > 0) call set_text(input, i_method, trim(method))
   if (len_trim(events) > 0) call set_text(input, i_events, trim(events))
   call prepare_scene(input, scene, error)
   if (allocated(error)) call fail(error%status, scene_path // ': ' // error%message)
 
   if (.not. out_given) out_path = 'output/' // stem(scene_path) // '.dat'
-  call refuse_to_overwrite_inputs(out_path)
-  call refuse_to_overwrite_inputs(trim(events_path(out_path)))
-  call make_folders(out_path, error)
-  if (allocated(error)) call fail(error%status, error%message)
+  ! Standard output by any of its names is a stream (through /dev/stdout's link the output
+  ! used to replace the file stdout was redirected to, and the summary was lost with it).
+  stream = standard_output(out_path)
+  if (len(events_file) > 0 .and. scene%events == events_none) call fail(status_input, '--events-file ' // &
+    events_file // ': the scene keeps no event log (events = ''none'')')
+  if (.not. stream) then
+    call refuse_to_overwrite_inputs(out_path)
+    call make_folders(out_path, error)
+    if (allocated(error)) call fail(error%status, error%message)
+  end if
+  if (len(events_file) == 0 .and. .not. stream) call refuse_to_overwrite_inputs(trim(events_path(out_path)))
+  if (len(events_file) > 0) then
+    call refuse_to_overwrite_inputs(events_file)
+    call make_folders(events_file, error)
+    if (allocated(error)) call fail(error%status, error%message)
+  end if
   ! Held from creating the temporary files until they are registered: a signal in between
   ! would otherwise leave them behind.
+  sink%max_events = scene%max_events
   call hold_signals()
-  call sink%open(out_path, input, error)
+  if (stream) then
+    call sink%open('-', input, error, events_file)
+  else
+    call sink%open(out_path, input, error, events_file)
+  end if
   if (allocated(error)) then
     call release_signals()
     call fail(error%status, error%message)
@@ -185,22 +220,29 @@ contains
   !> What the summary says of the event log: its file and what it holds (&run events).
   function event_log_text() result(text)
     character(len=:), allocatable :: text
+    if (stream .and. len(events_file) == 0 .and. scene%events /= events_none) then
+      text = 'no event log (-o - writes the samples alone: --events-file FILE keeps one; ' // &
+        trim(fmt(sum(stats%events))) // ' events counted)'
+      return
+    end if
     select case (scene%events)
     case (events_none)
       text = 'no event log (events = ''none''; ' // trim(fmt(sum(stats%events))) // ' events counted)'
     case (events_impacts)
-      text = trim(events_path(out_path)) // ' (' // &
+      text = sink%event_path // ' (' // &
         trim(fmt(sum(stats%events(event_impact + 1:event_impact + n_contacts)))) // ' impacts of ' // &
         trim(fmt(sum(stats%events))) // ' events: events = ''impacts'')'
     case default
-      text = trim(events_path(out_path)) // ' (' // trim(fmt(sum(stats%events))) // ' events)'
+      text = sink%event_path // ' (' // trim(fmt(sum(stats%events))) // ' events)'
     end select
+    if (sink%n_cut > 0) text = text(:len(text) - 1) // ', cut at ' // trim(fmt(sink%n_logged)) // &
+      ': max_events)'
   end function event_log_text
 
   !> The summary on stdout. Every number in ES with a three-digit exponent (7.73913E+157
   !> lost its E in ES12.5).
   subroutine summary()
-    character(len=:), allocatable :: text, line
+    character(len=:), allocatable :: text, line, where
     character(len=16) :: number
     text = 'impact1d: ' // trim(input%text(i_title)%s) // nl
     text = text // '  scene     ' // scene_path // ' (method ' // scene%method // ', dt = ' // &
@@ -208,7 +250,9 @@ contains
     if (scene%substeps > 1) text = text // '  substeps  ' // trim(fmt(scene%substeps)) // &
       ' RK4 steps per dt given (substeps = ''auto'': the springs'' fastest mode at |lambda| dt <= ' // &
       '0.5)' // nl
-    text = text // '  output    ' // out_path // ' (' // trim(fmt(scene%n_samples)) // ' rows every ' // &
+    where = out_path
+    if (stream) where = 'standard output'
+    text = text // '  output    ' // where // ' (' // trim(fmt(scene%n_samples)) // ' rows every ' // &
       trim(fmt(scene%dt_out)) // ' s) and ' // trim(event_log_text()) // nl
     line = ''
     do k = 1, n_event_kinds
@@ -229,20 +273,28 @@ contains
     text = text // '  steps     ' // trim(fmt(stats%steps)) // ' RK4 steps' // nl
     ! Not an error, but the numbers need it said beside them (a step coarse for a spring).
     if (len(scene%warnings) > 0) text = text // '  warning   ' // scene%warnings // nl
-    call say(text, 'the summary', '(the output ' // out_path // ' is in place)')
+    call sink%cut_note(line)
+    if (len(line) > 0) text = text // '  warning   ' // line // nl
+    if (stream) then
+      call say(text, 'the summary', '(the samples went to standard output)')
+    else
+      call say(text, 'the summary', '(the output ' // out_path // ' is in place)')
+    end if
   end subroutine summary
 
-  !> Text to stdout. Text that cannot be written (stdout closed, a full disk) is a failure,
-  !> status 2, one line on stderr (ending with note, if given): after a run the output
-  !> files are in place, but nobody saw how it went.
+  !> Text to stdout (to stderr once the samples stream to stdout: -o -). Text that cannot
+  !> be written (stdout closed, a full disk) is a failure, status 2, one line on stderr
+  !> (ending with note, if given): after a run the output files are in place, but nobody
+  !> saw how it went.
   subroutine say(text, what, note)
     character(len=*), intent(in) :: text, what
     character(len=*), intent(in), optional :: note
     character(len=:), allocatable :: reason
-    call write_stdout(text, reason)
+    call write_text(merge(2, 1, stream), text, reason)
     if (len(reason) == 0) return
     if (present(note)) reason = reason // ' ' // note
-    call fail(status_simulation, 'cannot write ' // what // ' to stdout: ' // reason)
+    call fail(status_simulation, 'cannot write ' // what // ' to ' // trim(merge('stderr', 'stdout', stream)) // &
+      ': ' // reason)
   end subroutine say
 
   !> A number for the summary: ES with a three-digit exponent, which fits any double.
@@ -262,7 +314,7 @@ contains
     if (length > 0) call get_command_argument(i, text)
   end function argument_text
 
-  !> Option k of --t-end, --dt, --dt-out takes the value just read.
+  !> Option k of --t-end, --dt, --dt-out, --max-events takes the value just read.
   subroutine override(k)
     integer, intent(in) :: k
     overrides(k) = number(option, value)
@@ -300,6 +352,13 @@ contains
     end do
   end subroutine refuse_to_overwrite_inputs
 
+
+  !> Whether an output name means standard output: '-', or a name of file descriptor 1.
+  logical function standard_output(path)
+    character(len=*), intent(in) :: path
+    standard_output = path == '-' .or. path == '/dev/stdout' .or. path == '/dev/fd/1' .or. &
+      path == '/proc/self/fd/1'
+  end function standard_output
 
   !> File name without folder and extension: input/case3.nml -> case3.
   function stem(path) result(name)

@@ -21,7 +21,11 @@ module impact1d_api
     summary_column_names
 
   integer(c_int), parameter :: status_too_small = 3   !< arrays too small: sizes needed returned
-  integer, parameter :: message_length = 512
+  !> Room for a message: whole for any message the core builds from the paths and texts it
+  !> was given, up to three paths of the system's limit (4096 bytes) each. (It was 512: a
+  !> long path name cut the message.) A sweep keeps 512 characters per run (its memory is
+  !> per run): the caller runs a run whose message fills them again through simulate.
+  integer, parameter :: message_length = 16384
   !> What simulate_summaries keeps of a run (sweep's columns, in this order).
   character(len=*), parameter :: summary_names(17) = [character(len=15) :: 'x1_end', 'v1_end', &
     'x2_end', 'v2_end', 'ke_end', 'n_impacts', 'n_left', 'n_right', 'n_slot_min', 'n_slot_max', &
@@ -61,7 +65,7 @@ contains
     integer(c_int), intent(out) :: text_codes(text_room, 6)    ! 6: n_text (f2py needs the number)
     integer(c_int), intent(out) :: text_lengths(6)
     integer(c_int), intent(out) :: status
-    character(len=512), intent(out) :: message
+    character(len=16384), intent(out) :: message    ! 16384: message_length (f2py needs the number)
     type(scene_input) :: input
     type(error_type), allocatable :: error
     integer :: k
@@ -108,7 +112,7 @@ contains
     integer(c_int), intent(out) :: n_samples, n_events, steps
     real(c_double), intent(out) :: energy_residual
     integer(c_int), intent(out) :: status
-    character(len=512), intent(out) :: message
+    character(len=16384), intent(out) :: message    ! 16384: message_length (f2py needs the number)
     character(len=1024), intent(out) :: warnings   !< the scene's warnings, one per line
     type(scene_input) :: input
     type(scene_type) :: scene
@@ -116,6 +120,7 @@ contains
     type(memory_sink) :: sink
     type(error_type), allocatable :: error
     integer, allocatable :: columns(:)
+    character(len=:), allocatable :: note
 
     n_samples = 0
     n_events = 0
@@ -145,9 +150,13 @@ contains
     end if
     sink%show_progress = progress /= 0
     sink%events = scene%events
+    sink%max_events = scene%max_events
     call run(scene, sink, stats, error)
     call sink%end_progress()
     if (failed(error, status, message)) return
+    ! A log cut at max_events says so beside the scene's warnings (Result.warnings).
+    call sink%cut_note(note)
+    if (len(note) > 0) warnings = trim(warnings) // repeat(new_line('a'), min(len_trim(warnings), 1)) // note
     n_samples = sink%n_samples
     n_events = sink%n_events
     steps = int(min(stats%steps, int(huge(1_c_int), kind(stats%steps))), c_int)
@@ -177,7 +186,7 @@ contains
     character(len=*), intent(in) :: title, f1_table, f2_table, method, substeps, events
     real(c_double), intent(out) :: summary(n_summary, n_runs)
     integer(c_int), intent(out) :: status(n_runs)
-    integer(c_int), intent(out) :: message_codes(512, n_runs)   ! 512: message_length (f2py needs the number)
+    integer(c_int), intent(out) :: message_codes(512, n_runs)   ! 512 per run: see message_length
     type(scene_input) :: base, input
     type(scene_type) :: scene
     type(run_stats) :: stats
@@ -278,7 +287,7 @@ contains
   logical function field_count_ok(n, status, message)
     integer(c_int), intent(in) :: n
     integer(c_int), intent(out) :: status
-    character(len=512), intent(out) :: message
+    character(len=*), intent(out) :: message
     field_count_ok = n == n_real
     status = status_ok
     message = ''
@@ -291,7 +300,7 @@ contains
   logical function failed(error, status, message)
     type(error_type), allocatable, intent(in) :: error
     integer(c_int), intent(out) :: status
-    character(len=512), intent(out) :: message
+    character(len=*), intent(out) :: message
     failed = allocated(error)
     status = status_ok
     message = ''

@@ -7,6 +7,7 @@
 #include <string.h>
 #include <sys/file.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 
 /* The kinds impact1d_file_kind returns (impact1d_files.f90 names them). */
@@ -71,15 +72,29 @@ int impact1d_write_all(int fd, const char *text, long n)
 
 /* Hold an exclusive lock on a folder until impact1d_unlock_folder: runs that put their
  * outputs in the same folder then do it one after the other. Returns the descriptor to
- * release, or -1 where the file system has no such locks (the caller goes on without). */
-int impact1d_lock_folder(const char *path)
+ * release; -1 where the file system has no such locks (the caller goes on without); -2
+ * when another process has held it for wait_seconds: a holder keeps it only while it
+ * renames two files, so that one is stopped (SIGSTOP, a suspended job) or hung, and
+ * waiting on would hang this run too. */
+int impact1d_lock_folder(const char *path, double wait_seconds)
 {
+    struct timespec start, now, pause = {0, 1000000};  /* 1 ms, doubling up to 100 ms */
     int fd = open(path, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
     if (fd < 0) return -1;
-    while (flock(fd, LOCK_EX) != 0) {
+    clock_gettime(CLOCK_MONOTONIC, &start);
+    while (flock(fd, LOCK_EX | LOCK_NB) != 0) {
         if (errno == EINTR) continue;
-        close(fd);
-        return -1;
+        if (errno != EWOULDBLOCK) {
+            close(fd);
+            return -1;
+        }
+        clock_gettime(CLOCK_MONOTONIC, &now);
+        if ((double)(now.tv_sec - start.tv_sec) + 1e-9 * (double)(now.tv_nsec - start.tv_nsec) >= wait_seconds) {
+            close(fd);
+            return -2;
+        }
+        nanosleep(&pause, NULL);
+        if (pause.tv_nsec < 100000000L) pause.tv_nsec = 2 * pause.tv_nsec;
     }
     return fd;
 }

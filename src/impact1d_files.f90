@@ -3,13 +3,18 @@
 !> written through a symbolic link to one; folders are made with the system's reason when
 !> they cannot be. The system calls are in impact1d_files.c.
 module impact1d_files
-  use, intrinsic :: iso_c_binding, only: c_int, c_long, c_char, c_null_char, c_ptr, c_associated
+  use, intrinsic :: iso_c_binding, only: c_int, c_long, c_char, c_null_char, c_ptr, c_associated, c_double
   use, intrinsic :: iso_fortran_env, only: int64
   use impact1d_error, only: error_type, raise, status_input
   implicit none
   private
   public :: check_input_file, output_target, make_folders, make_temporary, lock_folders, &
-    unlock_folders, resolve, write_stdout
+    unlock_folders, resolve, resolve_output, write_text, lock_timed_out, lock_wait
+
+  !> lock_folders' handle for a lock another process held past lock_wait() seconds.
+  integer, parameter :: lock_timed_out = -2
+  !> How long a run waits for a folder lock (the environment's IMPACT1D_LOCK_WAIT, seconds).
+  real(c_double), parameter :: default_lock_wait = 60.0_c_double
 
   !> impact1d_file_kind's answers (impact1d_files.c).
   integer, parameter :: kind_missing = 0, kind_regular = 1, kind_folder = 2, kind_link = 7, &
@@ -39,9 +44,10 @@ module impact1d_files
       character(kind=c_char), intent(in) :: text(*)
       integer(c_long), value :: n
     end function c_write_all
-    integer(c_int) function c_lock_folder(path) bind(C, name='impact1d_lock_folder')
-      import :: c_int, c_char
+    integer(c_int) function c_lock_folder(path, wait_seconds) bind(C, name='impact1d_lock_folder')
+      import :: c_int, c_char, c_double
       character(kind=c_char), intent(in) :: path(*)
+      real(c_double), value :: wait_seconds
     end function c_lock_folder
     subroutine c_unlock_folder(fd) bind(C, name='impact1d_unlock_folder')
       import :: c_int
@@ -155,6 +161,20 @@ contains
     absolute = buffer(:index(buffer, c_null_char) - 1)
   end subroutine resolve
 
+  !> The absolute path of the file an output at path is or will be: resolve's for an
+  !> existing file, else its folder resolved and its name; '' when the folder does not exist.
+  subroutine resolve_output(path, absolute)
+    character(len=*), intent(in) :: path
+    character(len=:), allocatable, intent(out) :: absolute
+    character(len=:), allocatable :: folder
+    call resolve(path, absolute)
+    if (len(absolute) > 0) return
+    call folder_of(path, folder)
+    call resolve(folder, absolute)
+    if (len(absolute) == 0) return
+    absolute = absolute // '/' // path(index(path, '/', back=.true.) + 1:)
+  end subroutine resolve_output
+
   !> The folder a path is in ('.' for a bare name, '/' for a file at the root).
   subroutine folder_of(path, folder)
     character(len=*), intent(in) :: path
@@ -168,17 +188,18 @@ contains
     end if
   end subroutine folder_of
 
-  !> Write text to stdout (file descriptor 1) as it is; reason is '' when every byte went,
-  !> else why not (a full disk, a closed stdout): unlike a Fortran write, which says
-  !> nothing of either.
-  subroutine write_stdout(text, reason)
+  !> Write text to file descriptor fd (1 stdout, 2 stderr) as it is; reason is '' when every
+  !> byte went, else why not (a full disk, a closed stdout): unlike a Fortran write, which
+  !> says nothing of either.
+  subroutine write_text(fd, text, reason)
+    integer, intent(in) :: fd
     character(len=*), intent(in) :: text
     character(len=:), allocatable, intent(out) :: reason
     integer(c_int) :: number
     reason = ''
-    number = c_write_all(1_c_int, text, int(len(text), c_long))
+    number = c_write_all(int(fd, c_int), text, int(len(text), c_long))
     if (number /= 0) call system_reason(number, reason)
-  end subroutine write_stdout
+  end subroutine write_text
 
   !> The system's text for an error number (strerror).
   subroutine system_reason(number, text)
@@ -215,27 +236,47 @@ contains
   end subroutine make_temporary
 
   !> Lock the folders of two files (one lock when they share it): runs that put outputs in
-  !> the same place then do it one after the other. Taken in the order of the folders'
+  !> the same folder then do it one after the other. Taken in the order of the folders'
   !> absolute names, so two runs never wait for each other's second lock. A handle is -1
-  !> where there is no lock to be had.
+  !> where there is no lock to be had, lock_timed_out where another process held it for
+  !> lock_wait() seconds (then no lock is held: both handles are released or -1 and -2).
   subroutine lock_folders(first, second, handles)
     character(len=*), intent(in) :: first, second
     integer, intent(out) :: handles(2)
     character(len=:), allocatable :: folder, a, b
+    real(c_double) :: wait
     call folder_of(first, folder)
     call resolve(folder, a)
     call folder_of(second, folder)
     call resolve(folder, b)
     handles = -1
     if (len(a) == 0 .or. len(b) == 0) return
+    wait = lock_wait()
     if (llt(b, a)) then
-      handles(2) = c_lock_folder(b // c_null_char)
-      handles(1) = c_lock_folder(a // c_null_char)
+      handles(2) = c_lock_folder(b // c_null_char, wait)
+      if (handles(2) /= lock_timed_out) handles(1) = c_lock_folder(a // c_null_char, wait)
     else
-      handles(1) = c_lock_folder(a // c_null_char)
-      if (b /= a) handles(2) = c_lock_folder(b // c_null_char)
+      handles(1) = c_lock_folder(a // c_null_char, wait)
+      if (b /= a .and. handles(1) /= lock_timed_out) handles(2) = c_lock_folder(b // c_null_char, wait)
+    end if
+    if (any(handles == lock_timed_out)) then
+      call unlock_folders(handles)
+      handles = merge(lock_timed_out, -1, handles == lock_timed_out)
     end if
   end subroutine lock_folders
+
+  !> Seconds to wait for a folder lock: IMPACT1D_LOCK_WAIT when it is a number of 0 or
+  !> more, else 60 (a holder keeps the lock only while it renames two files).
+  function lock_wait() result(seconds)
+    real(c_double) :: seconds
+    character(len=64) :: text
+    integer :: length, status, ios
+    seconds = default_lock_wait
+    call get_environment_variable('IMPACT1D_LOCK_WAIT', text, length, status)
+    if (status /= 0 .or. length == 0) return
+    read(text, *, iostat=ios) seconds
+    if (ios /= 0 .or. .not. (seconds >= 0.0_c_double)) seconds = default_lock_wait
+  end function lock_wait
 
   subroutine unlock_folders(handles)
     integer, intent(in) :: handles(2)

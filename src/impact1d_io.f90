@@ -21,7 +21,7 @@ module impact1d_io
     'title', 'm1, m2, mu1, mu2, mus1, mus2, g', 'x_left, r_left, x_right, r_right', 'd_min, r_min, d_max, r_max', &
     'x1, v1, x2, v2', 'f1, f2, f1_table, f2_table, f1_amp, f1_period, f1_phase, f2_amp, f2_period, f2_phase', &
     'k1, x1_rest, c1, k2, x2_rest, c2, k12, d_rest, c12', &
-    't_end, dt, dt_out, method, zero_vel, max_rows, max_impulses, max_step_events, substeps, events']
+    't_end, dt, dt_out, method, zero_vel, max_rows, max_impulses, max_step_events, substeps, events, max_events']
   !> The tutorial's parameter files list these, in its Table 1 order; g is 10 there.
   integer, parameter :: dat_order(17) = [i_m1, i_m2, i_mu1, i_r_left, i_r_right, i_r_min, &
     i_r_max, i_x_left, i_x_right, i_d_min, i_d_max, i_x1, i_x2, i_v1, i_v2, i_f1, i_f2]

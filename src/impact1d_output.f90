@@ -2,7 +2,7 @@
 !> streams to files (memory constant in run length) while Python collects arrays.
 module impact1d_output
   use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char
-  use, intrinsic :: iso_fortran_env, only: error_unit, int64
+  use, intrinsic :: iso_fortran_env, only: error_unit, output_unit, int64
   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
   use impact1d_kinds, only: wp
   use impact1d_error, only: error_type, raise, status_input, status_simulation, status_interrupted, fmt
@@ -10,7 +10,8 @@ module impact1d_output
   use impact1d_scene, only: scene_input, real_names, n_real, i_title, i_method, i_g, i_dt_out, &
     events_all, events_impacts, events_none, events_kept, n_contacts, &
     i_dt, default_gravity, i_k1, i_k2, i_k12, i_c1, i_c2, i_c12, i_m2
-  use impact1d_files, only: output_target, make_temporary, resolve, lock_folders, unlock_folders
+  use impact1d_files, only: output_target, make_temporary, resolve_output, lock_folders, unlock_folders, write_text, &
+    lock_timed_out, lock_wait
   implicit none
   private
   public :: sink_type, memory_sink, summary_sink, file_sink, n_columns, column_names, n_event_kinds, event_names
@@ -54,6 +55,10 @@ module impact1d_output
     !> What the sink keeps of the event log (&run events: impact1d_scene's events_all,
     !> events_impacts, events_none); the run's counts (run_stats) have every event.
     integer :: events = events_all
+    !> At most max_events of them go into the log (&run max_events); n_logged went in, n_cut
+    !> would have and did not (the log then ends with a note: cut_note).
+    integer :: max_events = huge(1)
+    integer(int64) :: n_logged = 0, n_cut = 0
     integer(int64) :: clock_start = -1, clock_shown = 0
     logical :: progress_shown = .false.
   contains
@@ -62,6 +67,8 @@ module impact1d_output
     procedure :: progress
     procedure :: end_progress
     procedure :: keeps_event
+    procedure :: logs_event
+    procedure :: cut_note
   end type sink_type
 
   abstract interface
@@ -115,6 +122,14 @@ module impact1d_output
   type, extends(sink_type) :: file_sink
     integer :: unit = 0, event_unit = 0
     logical :: is_open = .false.
+    !> The samples go to standard output as they come (-o -): no temporary, nothing to
+    !> rename, and no event log unless an events file was named.
+    logical :: stream = .false.
+    !> A stream's text not yet written (n_pending bytes of pending): it goes out with
+    !> write_text, since the Fortran runtime drops the errors of its writes to stdout (a
+    !> full disk, /dev/full: the rows were lost with exit status 0).
+    character(len=:), allocatable :: pending
+    integer :: n_pending = 0
     !> The names given (for messages), the files they replace (the name, or the file a
     !> symbolic link there leads to: output_target) and this run's own temporary files
     !> beside those (make_temporary), which a signal guard must remove.
@@ -137,6 +152,8 @@ module impact1d_output
     procedure :: close => file_close
     procedure, private :: put_line
     procedure, private :: finish_file
+    procedure, private :: stream_put
+    procedure, private :: stream_flush
   end type file_sink
 
   interface
@@ -240,6 +257,32 @@ contains
     keeps_event = self%events == events_all .or. (self%events == events_impacts .and. &
       kind > event_impact .and. kind <= event_impact + n_contacts)
   end function keeps_event
+
+  !> Whether this event goes into the log: a kind the log keeps, while there is room
+  !> (max_events); every one past the room is counted (n_cut) for the note.
+  logical function logs_event(self, kind)
+    class(sink_type), intent(inout) :: self
+    integer, intent(in) :: kind
+    logs_event = self%keeps_event(kind)
+    if (.not. logs_event) return
+    logs_event = self%n_logged < self%max_events
+    if (logs_event) then
+      self%n_logged = self%n_logged + 1
+    else
+      self%n_cut = self%n_cut + 1
+    end if
+  end function logs_event
+
+  !> '' when the log holds every event it keeps, else why it stops where it does.
+  subroutine cut_note(self, text)
+    class(sink_type), intent(in) :: self
+    character(len=:), allocatable, intent(out) :: text
+    text = ''
+    if (self%n_cut == 0) return
+    text = 'the event log was cut at ' // trim(fmt(self%n_logged)) // ' of ' // &
+      trim(fmt(self%n_logged + self%n_cut)) // ' events (max_events = ' // trim(fmt(self%max_events)) // &
+      '); the run went on to its end and the counts are exact'
+  end subroutine cut_note
 
   !> Every 4096 steps of a run: progress on stderr where it is shown, and an interrupt
   !> (Ctrl-C while Python waits for the run) ends the run within a fraction of a second.
@@ -366,7 +409,7 @@ contains
     real(wp), allocatable :: times(:), velocities(:, :)
     integer, allocatable :: kinds(:)
     integer :: n
-    if (.not. self%keeps_event(kind)) return
+    if (.not. self%logs_event(kind)) return
     n = self%n_events
     if (n == size(self%event_time)) then
       ! Geometric growth: events are rare next to steps, copies are amortised.
@@ -385,46 +428,65 @@ contains
     self%event_v(:, n) = [v_before, v_after]
   end subroutine memory_put_event
 
-  !> Open OUT (and OUT's events file) under temporary names and write the headers.
-  subroutine file_open(self, path, input, error)
+  !> Open OUT (and OUT's events file: event_file when given and not '', else events_path's
+  !> name) under temporary names and write the headers. OUT '-' is standard output (stream):
+  !> the samples are written there as they come, and the event log only to an event_file.
+  subroutine file_open(self, path, input, error, event_file)
     class(file_sink), intent(inout) :: self
     character(len=*), intent(in) :: path
     type(scene_input), intent(in) :: input
     type(error_type), allocatable, intent(out) :: error
+    character(len=*), intent(in), optional :: event_file
     integer :: ios, k
     character(len=512) :: message
     character(len=:), allocatable :: header, samples_file, events_file
+    logical :: named_events
 
+    named_events = .false.
+    if (present(event_file)) named_events = len(event_file) > 0
     self%path = path
+    self%stream = path == '-'
     self%event_path = trim(events_path(path))
+    if (named_events) self%event_path = event_file
     if (path(len(path):) == '/') then
       call raise(error, status_input, 'cannot write output ' // path // ': it is a folder (give a file name)')
       return
     end if
-    call output_target(self%path, self%target, error)
+    self%target = ''
+    self%event_target = ''
+    if (.not. self%stream) call output_target(self%path, self%target, error)
     if (allocated(error)) return
-    call output_target(self%event_path, self%event_target, error)
+    if (named_events .or. .not. self%stream) call output_target(self%event_path, self%event_target, error)
     if (allocated(error)) return
-    ! Two links leading to one file would make the pair one file.
-    call resolve(self%target, samples_file)
-    call resolve(self%event_target, events_file)
+    ! Two links leading to one file would make the pair one file, and so would an events
+    ! file named as the output (--events-file), existing or not.
+    samples_file = ''
+    events_file = ''
+    if (len(self%target) > 0) call resolve_output(self%target, samples_file)     ! (none for a stream)
+    if (len(self%event_target) > 0) call resolve_output(self%event_target, events_file)
     if (len(samples_file) > 0 .and. samples_file == events_file) then
       call raise(error, status_input, 'cannot write output ' // path // ': it and its events file ' // &
         self%event_path // ' are the same file ' // samples_file)
       return
     end if
-    call make_temporary(self%target, self%unit, self%part, ios, message)
+    self%unit = output_unit
+    self%part = ''
+    if (self%stream) allocate(character(len=65536) :: self%pending)
+    self%n_pending = 0
+    ios = 0
+    if (.not. self%stream) call make_temporary(self%target, self%unit, self%part, ios, message)
     if (ios /= 0) then
       call raise(error, status_input, 'cannot write output ' // path // ': ' // trim(reason(message)))
       return
     end if
     self%events = events_kept(input)
+    if (self%stream .and. .not. named_events) self%events = events_none
     self%event_part = ''
     ios = 0
     if (self%events /= events_none) &
       call make_temporary(self%event_target, self%event_unit, self%event_part, ios, message)
     if (ios /= 0) then
-      close(self%unit, status='delete')
+      if (.not. self%stream) close(self%unit, status='delete')
       call raise(error, status_input, 'cannot write output ' // self%event_path // ': ' // trim(reason(message)))
       return
     end if
@@ -467,7 +529,13 @@ contains
     real(wp), intent(in) :: row(n_columns)
     integer :: ios
     character(len=512) :: message
+    character(len=25 * n_columns) :: line
     if (allocated(self%write_failure)) return
+    if (self%stream) then
+      write(line, row_format) row(self%columns)
+      call self%stream_put(trim(line))
+      return
+    end if
     write(self%unit, row_format, iostat=ios, iomsg=message) row(self%columns)
     if (ios /= 0) self%write_failure = self%path // ': ' // trim(reason(message))
     self%bytes(1) = self%bytes(1) + self%sample_bytes
@@ -479,7 +547,8 @@ contains
     integer, intent(in) :: kind
     integer :: ios
     character(len=512) :: message
-    if (allocated(self%write_failure) .or. .not. self%keeps_event(kind)) return
+    if (allocated(self%write_failure)) return
+    if (.not. self%logs_event(kind)) return
     if (self%n_bodies == 2) then
       write(self%event_unit, event_format, iostat=ios, iomsg=message) t, event_names(kind), v_before, v_after
     else
@@ -497,12 +566,41 @@ contains
     integer :: ios
     character(len=512) :: message
     if (allocated(self%write_failure)) return
+    if (self%stream .and. unit == self%unit) then
+      call self%stream_put(text)
+      return
+    end if
     write(unit, '(a)', iostat=ios, iomsg=message) text
     if (ios /= 0 .and. unit == self%unit) self%write_failure = self%path // ': ' // trim(reason(message))
     if (ios /= 0 .and. unit /= self%unit) self%write_failure = self%event_path // ': ' // trim(reason(message))
     if (unit == self%unit) self%bytes(1) = self%bytes(1) + len(text) + 1
     if (unit /= self%unit) self%bytes(2) = self%bytes(2) + len(text) + 1
   end subroutine put_line
+
+  !> A line for a stream (a sample or header line, without its newline).
+  subroutine stream_put(self, text)
+    class(file_sink), intent(inout) :: self
+    character(len=*), intent(in) :: text
+    character(len=:), allocatable :: why
+    if (self%n_pending + len(text) + 1 > len(self%pending)) call self%stream_flush()
+    if (len(text) + 1 > len(self%pending)) then      ! (a header line longer than the buffer)
+      call write_text(1, text // new_line('a'), why)
+      if (len(why) > 0 .and. .not. allocated(self%write_failure)) self%write_failure = 'standard output: ' // why
+      return
+    end if
+    self%pending(self%n_pending + 1:self%n_pending + len(text) + 1) = text // new_line('a')
+    self%n_pending = self%n_pending + len(text) + 1
+  end subroutine stream_put
+
+  !> Write a stream's pending text, noting the first failure.
+  subroutine stream_flush(self)
+    class(file_sink), intent(inout) :: self
+    character(len=:), allocatable :: why
+    if (self%n_pending == 0 .or. allocated(self%write_failure)) return
+    call write_text(1, self%pending(:self%n_pending), why)
+    self%n_pending = 0
+    if (len(why) > 0) self%write_failure = 'standard output: ' // why
+  end subroutine stream_flush
 
   !> Close the files. Only if the run succeeded and every write, flush and close did, the new
   !> pair replaces the previous one (replace_pair); otherwise the temporary files are removed
@@ -512,17 +610,24 @@ contains
     logical, intent(in) :: keep
     type(error_type), allocatable, intent(out) :: error
     integer :: ios
+    character(len=:), allocatable :: note
     call self%end_progress()
     if (.not. self%is_open) return
     self%is_open = .false.
     if (keep) then
       call self%finish_file(self%unit, self%path, self%part)
+      call self%cut_note(note)
+      if (len(note) > 0 .and. self%events /= events_none) call self%put_line(self%event_unit, '# ' // note)
       if (self%events /= events_none) call self%finish_file(self%event_unit, self%event_path, self%event_part)
     else
-      close(self%unit, iostat=ios)
+      ! Standard output stays open (the rows before the failure go out).
+      if (self%stream) call self%stream_flush()
+      if (.not. self%stream) close(self%unit, iostat=ios)
       if (self%events /= events_none) close(self%event_unit, iostat=ios)
     end if
     if (keep .and. .not. allocated(self%write_failure)) then
+      ! A stream without an events file has nothing to put in place.
+      if (self%stream .and. len(self%event_target) == 0) return
       call replace_pair(self, error)
       if (.not. allocated(error)) return
     end if
@@ -541,6 +646,10 @@ contains
     integer :: ios
     integer(int64) :: on_disk, written
     character(len=512) :: message
+    if (self%stream .and. unit == self%unit) then
+      call self%stream_flush()
+      return
+    end if
     if (.not. allocated(self%write_failure)) then
       flush(unit, iostat=ios, iomsg=message)
       if (ios /= 0) self%write_failure = path // ': ' // trim(reason(message))
@@ -597,10 +706,18 @@ contains
     aside(1) = part(1)(:len_trim(part(1)) - len('.part')) // '.previous'
     aside(2) = part(2)(:len_trim(part(2)) - len('.part')) // '.previous'
     if (len_trim(part(2)) == 0) aside(2) = part(1)(:len_trim(part(1)) - len('.part')) // '.events.previous'
+    if (len_trim(final(1)) == 0) final(1) = final(2)      ! a stream: the events file alone
     call lock_folders(trim(final(1)), trim(final(2)), locks)
+    if (any(locks == lock_timed_out)) then
+      call raise(error, status_simulation, 'cannot write output ' // self%path // &
+        ': another process has held the lock on its folder for ' // trim(fmt(real(lock_wait(), wp))) // &
+        ' s (stopped or hung while putting its own output in place? IMPACT1D_LOCK_WAIT sets the wait)')
+      return
+    end if
     kept = .false.
     placed = .false.
     do k = 1, 2
+      if (len_trim(part(k)) == 0 .and. k == 1) cycle       ! (a stream's samples: no file)
       if (.not. exists(trim(final(k)))) cycle
       kept(k) = c_link(trim(final(k)) // c_null_char, trim(aside(k)) // c_null_char) == 0
       if (.not. kept(k)) kept(k) = c_rename(trim(final(k)) // c_null_char, trim(aside(k)) // c_null_char) == 0

@@ -16,19 +16,19 @@ module impact1d_scene
   public :: i_m1, i_m2, i_mu1, i_mu2, i_g, i_x_left, i_r_left, i_x_right, i_r_right, i_d_min, &
     i_r_min, i_d_max, i_r_max, i_x1, i_v1, i_x2, i_v2, i_f1, i_f2, i_f1_amp, i_f1_period, &
     i_f1_phase, i_f2_amp, i_f2_period, i_f2_phase, i_t_end, i_dt, i_dt_out, i_mus1, i_mus2, &
-    i_k1, i_x1_rest, i_c1, i_k2, i_x2_rest, i_c2, i_k12, i_d_rest, i_c12
+    i_k1, i_x1_rest, i_c1, i_k2, i_x2_rest, i_c2, i_k12, i_d_rest, i_c12, i_max_events
   public :: sample_time, set_text, events_kept
   public :: i_title, i_f1_table, i_f2_table, i_method, i_substeps, i_events, default_gravity
   public :: events_all, events_impacts, events_none
 
-  integer, parameter :: n_real = 43, n_text = 6
+  integer, parameter :: n_real = 44, n_text = 6
   !> Names of the real inputs, as in the namelist and in Python's Scene, in this order.
   character(len=*), parameter :: real_names(n_real) = [character(len=15) :: &
     'm1', 'm2', 'mu1', 'mu2', 'g', 'x_left', 'r_left', 'x_right', 'r_right', &
     'd_min', 'r_min', 'd_max', 'r_max', 'x1', 'v1', 'x2', 'v2', 'f1', 'f2', &
     'f1_amp', 'f1_period', 'f1_phase', 'f2_amp', 'f2_period', 'f2_phase', 't_end', 'dt', 'dt_out', &
     'zero_vel', 'max_rows', 'max_impulses', 'max_step_events', 'mus1', 'mus2', &
-    'k1', 'x1_rest', 'c1', 'k2', 'x2_rest', 'c2', 'k12', 'd_rest', 'c12']
+    'k1', 'x1_rest', 'c1', 'k2', 'x2_rest', 'c2', 'k12', 'd_rest', 'c12', 'max_events']
   character(len=*), parameter :: text_names(n_text) = [character(len=8) :: &
     'title', 'f1_table', 'f2_table', 'method', 'substeps', 'events']
   integer, parameter :: i_m1 = 1, i_m2 = 2, i_mu1 = 3, i_mu2 = 4, i_g = 5, i_x_left = 6, &
@@ -38,7 +38,7 @@ module impact1d_scene
     i_f2_phase = 25, i_t_end = 26, i_dt = 27, i_dt_out = 28, i_zero_vel = 29, &
     i_max_rows = 30, i_max_impulses = 31, i_max_step_events = 32, i_mus1 = 33, i_mus2 = 34, &
     i_k1 = 35, i_x1_rest = 36, i_c1 = 37, i_k2 = 38, i_x2_rest = 39, i_c2 = 40, i_k12 = 41, &
-    i_d_rest = 42, i_c12 = 43
+    i_d_rest = 42, i_c12 = 43, i_max_events = 44
   !> What only a second body can have: refused in a one-body scene (no m2).
   integer, parameter :: body2_fields(18) = [i_x2, i_v2, i_mu2, i_mus2, i_f2, i_f2_amp, i_f2_period, &
     i_f2_phase, i_k2, i_x2_rest, i_c2, i_k12, i_d_rest, i_c12, i_d_min, i_r_min, i_d_max, i_r_max]
@@ -70,6 +70,10 @@ module impact1d_scene
   !> within one step's length of simulated time (a run that no longer advances).
   integer, parameter :: max_samples = 10000000
   integer, parameter :: default_max_impulses = 1000000, default_max_step_events = 100000
+  !> Events the log keeps (&run max_events): past it the run goes on and the log ends with a
+  !> note (the counts stay exact). 10^7 lines are about 1.4 GB: a runaway log stops well
+  !> before a disk or memory fills, a long study's (1.48 M events in 1e5 s) fits whole.
+  integer, parameter :: default_max_events = 10000000
   !> A positive gap or limit below this many units of rounding (eps) of its coordinates is
   !> refused: the solver's start-contact tolerance is 16 of them, so 64 leaves a clear margin.
   real(wp), parameter :: min_resolved_ulps = 64.0_wp
@@ -125,6 +129,7 @@ module impact1d_scene
     real(wp) :: t_end, dt, dt_out
     real(wp) :: zero_velocity = default_zero_velocity
     integer :: max_impulses = default_max_impulses, max_step_events = default_max_step_events
+    integer :: max_events = default_max_events
     integer :: n_samples
   end type scene_type
 
@@ -211,6 +216,7 @@ contains
     call count_limit(input, i_max_rows, error)
     call count_limit(input, i_max_impulses, error)
     call count_limit(input, i_max_step_events, error)
+    call count_limit(input, i_max_events, error)
     if (allocated(error)) return
     if (input%given(i_g) .and. input%value(i_g) < 0.0_wp .and. (value_or(input, i_mu1, 0.0_wp) > 0.0_wp &
         .or. value_or(input, i_mu2, 0.0_wp) > 0.0_wp .or. value_or(input, i_mus1, 0.0_wp) > 0.0_wp .or. &
@@ -538,6 +544,7 @@ contains
     scene%events = events_kept(input)
     if (input%given(i_max_impulses)) scene%max_impulses = int(input%value(i_max_impulses))
     if (input%given(i_max_step_events)) scene%max_step_events = int(input%value(i_max_step_events))
+    if (input%given(i_max_events)) scene%max_events = int(input%value(i_max_events))
     ! (validate keeps the count within max_rows, a default integer)
     scene%n_samples = int(row_count(scene%t_end, scene%dt_out))
   end subroutine build_scene

@@ -292,3 +292,27 @@ def test_flat_simulate_says_what_room_it_needs():
     assert present == list(expected.columns)
     for k, name in enumerate(present):
         np.testing.assert_array_equal(samples[:, k], getattr(expected, name))
+
+
+def test_long_messages_come_whole(tmp_path):
+    """A message naming a long path came cut at 512 characters (the flat API's buffer):
+    its end, what went wrong, was lost. Whole from load_scene, simulate and a batch sweep
+    (which keeps 512 characters per run and runs a run whose message filled them alone)."""
+    folder = tmp_path
+    for k in range(5):
+        folder = folder / (f"{k}" * 200)
+    folder.mkdir(parents=True)
+    bad = write_scene(folder, CASE3_NML.replace("m2 = 2.0,", "m2 = 2.0, mass3 = 4.0,"))
+    with pytest.raises(InputError) as caught:
+        impact1d.load_scene(bad)
+    assert len(str(caught.value)) > 1000 and str(bad) in str(caught.value)
+    assert "unknown variable 'mass3'" in str(caught.value)
+    table = folder / "force.dat"
+    table.write_text("# no rows\n")
+    scene = impact1d.load_scene(write_scene(folder, CASE3_NML.replace("f1 = 0.0,", "f1_table = 'force.dat',")))
+    expected = f"{table}: the table has no rows"
+    with pytest.raises(InputError) as caught:
+        impact1d.simulate(scene)
+    assert str(caught.value).endswith(expected)
+    table_rows = impact1d.sweep(scene, {"r_left": [0.5, 0.9]}, workers=1)
+    assert [error.endswith(expected) for error in table_rows["error"]] == [True, True]

@@ -477,3 +477,103 @@ def test_read_only_file_system_is_named(cli, tmp_path, read_only_folder):
     assert proc.returncode == 1
     _assert_fails_naming(proc, "ro/x.dat: Read-only file system")
     assert list(read_only_folder.iterdir()) == []
+
+
+# --- -o -: the samples to standard output (issue 22, item 3) -----------------------------
+
+def _documented_read(text):
+    """docs/formats.md's plain-pandas call, on a text instead of a path."""
+    import io
+
+    import pandas as pd
+
+    names = [line for line in text.splitlines(keepends=True) if line.startswith("#")][-1][1:].split()
+    return pd.read_csv(io.StringIO(text), sep=r"\s+", comment="#", header=None, names=names)
+
+
+def test_dash_streams_the_samples_to_stdout(cli, tmp_path):
+    """`-o -` wrote a file named `-` (and `-.events.dat`). Now the header and rows of the
+    file go to stdout as they come, piped into a reader; the summary goes to stderr; no
+    event log without --events-file (and none is written anywhere)."""
+    case = INPUT / "case5.nml"
+    run_cli(cli, case, "-o", tmp_path / "file.dat", cwd=tmp_path)
+    written = (tmp_path / "file.dat").read_text()
+    streaming = tmp_path / "streaming"
+    streaming.mkdir()
+    writer = subprocess.Popen([cli, str(case), "-o", "-"], cwd=streaming, stdout=subprocess.PIPE,
+                              stderr=subprocess.PIPE, text=True, stdin=subprocess.DEVNULL)
+    text = writer.stdout.read()            # read while it runs: the pipe's buffer is small
+    summary = writer.stderr.read()
+    assert writer.wait(timeout=CLI_TIMEOUT) == 0, summary
+    assert text == written
+    assert list(streaming.iterdir()) == []
+    assert "output    standard output (" in summary and "no event log (-o - writes the samples" in summary
+    assert "left 47 right 47" in summary              # the counts stay exact
+    frame = _documented_read(text)
+    np.testing.assert_array_equal(frame.to_numpy(), np.loadtxt(tmp_path / "file.dat"))
+    # With --events-file the log is the file run's.
+    proc = run_cli(cli, case, "-o", "-", "--events-file", "logs/run.events.dat", cwd=streaming)
+    assert proc.stdout == written
+    assert (streaming / "logs" / "run.events.dat").read_text() == (tmp_path / "file.events.dat").read_text()
+    assert "and logs/run.events.dat (96 events)" in proc.stderr
+    # A reader that stops early (head) ends the writer by SIGPIPE, leaving no temporary file.
+    pipeline = subprocess.run(f"'{cli}' '{case}' -o - --events-file logs/x.dat | head -n 2", shell=True,
+                              cwd=streaming, capture_output=True, text=True, timeout=CLI_TIMEOUT)
+    assert pipeline.stdout.splitlines() == written.splitlines()[:2]
+    assert sorted(p.name for p in (streaming / "logs").iterdir()) == ["run.events.dat"]
+
+
+def test_dev_stdout_streams_too(cli, tmp_path):
+    """`-o /dev/stdout > file` used to replace the file stdout was redirected to through
+    the link (the summary then went to the replaced file and was lost) and write
+    /dev/stdout.events.dat; into a pipe it was refused as a FIFO. It is standard output:
+    a stream, into a redirected file or a pipe."""
+    case = INPUT / "case3.nml"
+    run_cli(cli, case, "-o", tmp_path / "file.dat", cwd=tmp_path)
+    written = (tmp_path / "file.dat").read_text()
+    redirected = tmp_path / "redirected.dat"
+    with open(redirected, "w") as stdout:
+        proc = subprocess.run([cli, str(case), "-o", "/dev/stdout"], cwd=tmp_path, stdout=stdout,
+                              stderr=subprocess.PIPE, text=True, timeout=CLI_TIMEOUT)
+    assert proc.returncode == 0, proc.stderr
+    assert redirected.read_text() == written and "standard output" in proc.stderr
+    assert not os.path.exists("/dev/stdout.events.dat")
+    piped = run_cli(cli, case, "-o", "/dev/stdout", cwd=tmp_path)
+    assert piped.stdout == written
+
+
+@pytest.mark.parametrize("args, message", [
+    (["-o", "-", "--events", "none", "--events-file", "e.dat"], "the scene keeps no event log"),
+    (["-o", "x.dat", "--events-file", "-"], "the event log cannot go to standard output"),
+    (["-o", "-", "--events-file", ""], "--events-file needs a file name"),
+    # Not yet there, the two names were one file: the samples replaced the log.
+    (["-o", "x.dat", "--events-file", "x.dat"], "are the same file"),
+])
+def test_dash_refusals(cli, tmp_path, args, message):
+    proc = run_cli(cli, INPUT / "case3.nml", *args, cwd=tmp_path, check=False)
+    assert proc.returncode == 1 and message in proc.stderr and proc.stdout == ""
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("tool, args", [
+    ("impact1d-plot", ["{run}", "-o", "-"]),
+    ("impact1d-sweep", [str(INPUT / "case3.nml"), "--vary", "r_left=0.5", "-o", "-"]),
+])
+def test_tools_that_write_files_refuse_dash(cli, tmp_path, tool, args):
+    """impact1d-plot wrote `-.png`, impact1d-sweep a table named `-`: refused, naming why."""
+    run_cli(cli, INPUT / "case3.nml", "-o", tmp_path / "run.dat", cwd=tmp_path)
+    before = sorted(tmp_path.iterdir())
+    proc = subprocess.run([find_tool(tool), *(a.format(run=tmp_path / "run.dat") for a in args)],
+                          cwd=tmp_path, capture_output=True, text=True, timeout=CLI_TIMEOUT)
+    assert proc.returncode == 1 and "not to standard output" in proc.stderr
+    assert sorted(tmp_path.iterdir()) == before
+
+
+def test_dash_to_a_full_disk_fails(cli, tmp_path):
+    """The Fortran runtime drops the errors of its writes to stdout: `-o - > /dev/full`
+    lost every row with exit status 0. The stream goes out through write(2): status 2."""
+    with open("/dev/full", "w") as full:
+        proc = subprocess.run([cli, str(INPUT / "case3.nml"), "-o", "-"], cwd=tmp_path, stdout=full,
+                              stderr=subprocess.PIPE, text=True, timeout=CLI_TIMEOUT)
+    assert proc.returncode == 2
+    assert "cannot write output standard output: No space left on device" in proc.stderr

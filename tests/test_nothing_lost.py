@@ -311,3 +311,92 @@ def test_sweep_and_plot_reports_that_cannot_be_written_fail(cli, tmp_path, stdou
     for args in ([tmp_path / "o.dat"], [tmp_path / "t.csv", "--x", "r_left"]):
         done = run_with_stdout([find_tool("impact1d-plot"), *args], stdout)
         assert_one_line_failure(done, "impact1d-plot", 1)
+
+
+def test_a_lock_held_too_long_ends_the_wait(cli, tmp_path):
+    """A run waited for its folder's lock (flock) without end: a holder stopped while
+    putting its output in place (SIGSTOP, a suspended job) hung every later run there.
+    The wait is bounded (IMPACT1D_LOCK_WAIT seconds, default 60): then status 2, one line
+    saying why, no temporary file, the previous pair untouched. Here this test holds the
+    lock as such a holder would."""
+    import fcntl
+
+    before = previous_output(cli, tmp_path)
+    folder = os.open(tmp_path, os.O_RDONLY)
+    try:
+        fcntl.flock(folder, fcntl.LOCK_EX)
+        done = subprocess.run([cli, str(CASE3), "--dt-out", "0.05", "-o", str(tmp_path / "o.dat")], cwd=ROOT,
+                              capture_output=True, text=True, timeout=30, stdin=subprocess.DEVNULL,
+                              env={**os.environ, "IMPACT1D_LOCK_WAIT": "0.5"})
+        assert_refused_and_untouched(done, tmp_path, before)
+        assert "another process has held the lock on its folder for 0.5 s" in done.stderr
+        # A lock released within the wait is waited for, as before.
+        releaser = threading.Timer(0.3, fcntl.flock, (folder, fcntl.LOCK_UN))
+        releaser.start()
+        done = run(cli, CASE3, "--dt-out", "0.05", "-o", tmp_path / "o.dat", cwd=ROOT)
+        releaser.join()
+        assert done.returncode == 0, done.stderr
+        assert snapshot(tmp_path) != before and temporaries(tmp_path) == []
+    finally:
+        os.close(folder)
+
+
+# The sweep's CSV writer, made to receive a signal half-way through its write: the moment
+# a SIGTERM or SIGHUP (a closed terminal, a batch system's end of time) would find it.
+SWEEP_SIGNALLED_IN_WRITE = """
+import os, signal, sys
+import pandas as pd
+import impact1d.sweep_cli as cli
+to_csv = pd.DataFrame.to_csv
+def to_csv_then_signal(self, path, **options):
+    to_csv(self.head(1), path, **options)
+    os.kill(os.getpid(), getattr(signal, sys.argv[1]))
+    to_csv(self, path, **options)
+pd.DataFrame.to_csv = to_csv_then_signal
+sys.exit(cli.main(sys.argv[2:]))
+"""
+
+
+@pytest.mark.parametrize("name", ["SIGTERM", "SIGHUP"])
+def test_sweep_signalled_in_its_write_leaves_no_temporary(tmp_path, name):
+    """SIGTERM or SIGHUP while impact1d-sweep wrote its table killed it with the temporary
+    file (t.PID-N.part.csv) left beside the table. The signal now ends it as before (it
+    dies of that signal), after removing the temporary; the previous table stays."""
+    table = tmp_path / "t.csv"
+    table.write_text("the previous table\n")
+    done = subprocess.run([sys.executable, "-c", SWEEP_SIGNALLED_IN_WRITE, name, str(CASE3), "--vary",
+                           "r_left=0.5,0.9", "-o", str(table)], capture_output=True, text=True,
+                          timeout=RUN_TIMEOUT)
+    assert done.returncode == -getattr(signal, name), (done.returncode, done.stderr)
+    assert table.read_text() == "the previous table\n"
+    assert temporaries(tmp_path) == []
+    assert done.stderr.startswith(f"impact1d-sweep: ended by {name}") and done.stderr.count("\n") == 1
+
+
+PLOT_SIGNALLED_IN_WRITE = """
+import os, signal, sys
+import matplotlib
+matplotlib.use("Agg")
+from matplotlib.figure import Figure
+import impact1d.plot_cli as cli
+savefig = Figure.savefig
+def savefig_then_signal(self, path, **options):
+    with open(path, "wb") as part:
+        part.write(b"half an image")
+    os.kill(os.getpid(), getattr(signal, sys.argv[1]))
+    savefig(self, path, **options)
+Figure.savefig = savefig_then_signal
+sys.exit(cli.main(sys.argv[2:]))
+"""
+
+
+def test_plot_signalled_in_its_write_leaves_no_temporary(cli, tmp_path):
+    """The same for impact1d-plot's image."""
+    previous_output(cli, tmp_path)
+    image = tmp_path / "o.png"
+    image.write_bytes(b"the previous image")
+    done = subprocess.run([sys.executable, "-c", PLOT_SIGNALLED_IN_WRITE, "SIGTERM", str(tmp_path / "o.dat")],
+                          capture_output=True, text=True, timeout=RUN_TIMEOUT)
+    assert done.returncode == -signal.SIGTERM, (done.returncode, done.stderr)
+    assert image.read_bytes() == b"the previous image" and temporaries(tmp_path) == []
+    assert done.stderr == "impact1d-plot: ended by SIGTERM\n"

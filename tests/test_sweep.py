@@ -268,3 +268,79 @@ def test_sweep_rows_carry_the_springs_energy_and_the_dampers_loss():
     assert res.damping_loss[-1] > 0 and res.pe[-1] > 0
     plain = impact1d.sweep(impact1d.load_scene(INPUT / "case3.nml"), [dict(r_left=1.0)], workers=1)
     assert plain.loc[0, "pe_end"] == 0.0 and plain.loc[0, "damping_loss"] == 0.0
+
+
+# --- steady state over [settle, t_end] (issue 22 item 6) ---------------------------------
+
+def _steady_bounds(amplitude, omega, length, h):
+    """impact1d.sweep.steady_state's sampling-error bounds (its docstring derives them):
+    |rms - A/sqrt(2)| <= sqrt(2) A eps, 2 A (1 - (w h)^2 / 8) <= p2p <= 2 A."""
+    eps = math.pi / (4 * omega * length) + (math.pi / (omega * length)) ** 2
+    return math.sqrt(2) * amplitude * eps, 2 * amplitude * (omega * h) ** 2 / 8
+
+
+@pytest.mark.parametrize("settle, dt_out", [(3.3, 1e-3), (0.0, 1e-2), (11.05, 5e-2)])
+def test_steady_state_of_a_free_harmonic_oscillator(settle, dt_out):
+    """x = x_rest + A cos(w t): RMS A/sqrt(2) and peak-to-peak 2A (about the rest position,
+    not 0), v's with A w, within the sampling error; RK4's own error (~1e-12 here) is far
+    below it. A window of a non-whole number of periods, and a coarse dt_out."""
+    amplitude, omega, rest, t_end = 0.2, 2 * math.pi, 0.3, 20.0
+    scene = impact1d.Scene(m1=1.0, k1=omega ** 2, x1_rest=rest, x1=rest + amplitude, v1=0.0,
+                           t_end=t_end, dt=1e-3)
+    row = impact1d.sweep(scene, {"dt_out": [dt_out]}, settle=settle).iloc[0]
+    for name, a in (("x1", amplitude), ("v1", amplitude * omega)):
+        rms_error, p2p_error = _steady_bounds(a, omega, t_end - settle, dt_out)
+        assert abs(row[f"{name}_rms"] - a / math.sqrt(2)) <= rms_error + 1e-9, name
+        assert -p2p_error - 1e-9 <= row[f"{name}_p2p"] - 2 * a <= 1e-9, name
+    assert all(math.isnan(row[c]) for c in ("x2_p2p", "x2_rms", "v2_p2p", "v2_rms", "impacts_per_period"))
+
+
+def test_steady_state_columns_only_when_asked_and_equal_to_the_results():
+    """Without settle the table is as it was; with it each measure is the definition's,
+    computed from the run's samples and events (impacts per period of the forced impact
+    oscillator: impacts with t >= settle times f1_period over the window)."""
+    scene = impact1d.load_scene(INPUT / "impact_oscillator.nml")
+    grid = {"f1_amp": [4.0, 10.0]}
+    plain = impact1d.sweep(scene, grid, workers=1)
+    assert "x1_rms" not in plain.columns
+    table, results = impact1d.sweep(scene, grid, workers=2, settle=12.0, keep="results")
+    assert table[plain.columns].equals(plain)
+    for row, result in zip(table.itertuples(), results):
+        window = result.t >= 12.0
+        x = result.x1[window]
+        assert row.x1_p2p == x.max() - x.min() and row.x1_rms == np.sqrt(np.mean((x - x.mean()) ** 2))
+        hits = np.count_nonzero((result.events["kind"] == "left") & (result.events["t"] >= 12.0))
+        assert hits > 0 and row.impacts_per_period == hits * 2.4 / (20.0 - 12.0)
+
+
+@pytest.mark.parametrize("settle, message", [(-1.0, "must be a time of 0 s or more"),
+                                             (math.nan, "must be a time"),
+                                             (20.0, "settle = 20.0 is not before t_end = 20.0")])
+def test_settle_outside_the_run_is_refused(settle, message):
+    scene = impact1d.load_scene(INPUT / "impact_oscillator.nml")
+    with pytest.raises(impact1d.InputError, match=message):
+        impact1d.sweep(scene, {"f1_amp": [4.0]}, settle=settle)
+
+
+def test_sweep_cli_settle(tmp_path):
+    out = tmp_path / "t.csv"
+    done = subprocess.run([find_tool("impact1d-sweep"), str(INPUT / "impact_oscillator.nml"),
+                           "--vary", "f1_amp=4,10", "--settle", "12", "-o", str(out)],
+                          capture_output=True, text=True, timeout=RUN_TIMEOUT)
+    assert done.returncode == 0, done.stderr
+    table = pd.read_csv(out)
+    scene = impact1d.load_scene(INPUT / "impact_oscillator.nml")
+    expected = impact1d.sweep(scene, {"f1_amp": [4.0, 10.0]}, settle=12.0)
+    np.testing.assert_allclose(table["impacts_per_period"], expected["impacts_per_period"], rtol=1e-15)
+    np.testing.assert_allclose(table["v1_rms"], expected["v1_rms"], rtol=1e-15)
+
+
+def test_steady_state_columns_plot_with_their_units():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    table = impact1d.sweep(impact1d.load_scene(INPUT / "impact_oscillator.nml"), {"f1_amp": [4.0, 10.0]},
+                           settle=12.0)
+    fig = impact1d.plot.sweep(table, "f1_amp", value=["x1_rms", "v2_p2p", "impacts_per_period"])
+    labels = [ax.get_ylabel() for ax in fig.axes]
+    assert labels == ["x1_rms (m)", "v2_p2p (m/s)", "impacts_per_period"]

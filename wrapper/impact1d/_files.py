@@ -6,17 +6,25 @@ truncated or mixed one."""
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import os
 import secrets
+import signal
 import stat
 import sys
+import threading
 
 from ._scene import InputError
 
 _KINDS = ((stat.S_ISDIR, "a folder"), (stat.S_ISFIFO, "a FIFO (named pipe)"),
           (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"),
           (stat.S_ISSOCK, "a socket"))
+
+
+# Names of standard output, as impact1d's -o takes them (it streams the samples there);
+# impact1d-plot and impact1d-sweep write files only, and say so for these.
+STANDARD_OUTPUT = ("-", "/dev/stdout", "/dev/fd/1", "/proc/self/fd/1")
 
 
 def _kind(mode) -> str:
@@ -113,3 +121,40 @@ def print_line(text) -> None:
         os.dup2(null, sys.stdout.fileno())
         os.close(null)
         raise
+
+
+class Ended(BaseException):
+    """A signal that ends a command (SIGTERM, SIGHUP), raised in Python: on its way out
+    write_whole removes its temporary file (it catches BaseException), which the signal's
+    default action, ending the process at once, left behind."""
+
+    def __init__(self, signum):
+        super().__init__(signum)
+        self.signum = signum
+
+
+@contextlib.contextmanager
+def ending_signals_raise():
+    """Within: SIGTERM and SIGHUP raise Ended (a signal the caller ignores, nohup, stays
+    ignored; only the main thread can set handlers). The previous handlers come back."""
+    def handler(signum, frame):
+        raise Ended(signum)
+
+    previous = {}
+    if threading.current_thread() is threading.main_thread():
+        for sig in (signal.SIGTERM, signal.SIGHUP):
+            if signal.getsignal(sig) == signal.SIG_DFL:
+                previous[sig] = signal.signal(sig, handler)
+    try:
+        yield
+    finally:
+        for sig, handler_before in previous.items():
+            signal.signal(sig, handler_before)
+
+
+def die_of(signum, line) -> None:
+    """Say line on stderr, then end by the signal as without a handler (a shell sees
+    128 + signal, a parent the signal)."""
+    print(line, file=sys.stderr, flush=True)
+    signal.signal(signum, signal.SIG_DFL)
+    os.kill(os.getpid(), signum)

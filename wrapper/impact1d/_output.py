@@ -43,11 +43,19 @@ def _read_header(path):
     return fields, last
 
 
-def _read_events(path, one_body=False) -> np.ndarray:
-    rows = []
+# The events file's last line when the log was cut at &run max_events (the core's words).
+_CUT_NOTE = "the event log was cut at "
+
+
+def _read_events(path, one_body=False):
+    """The events of an events file, and its notes (a log cut at max_events says so in a
+    comment line: it becomes a warning of the Result)."""
+    rows, notes = [], []
     dtype = ONE_BODY_EVENT_DTYPE if one_body else EVENT_DTYPE
     with open(path, encoding="utf-8") as handle:
         for number, line in enumerate(handle, 1):
+            if line.startswith("# " + _CUT_NOTE):
+                notes.append(line[2:].strip())
             text = line.split("#", 1)[0].split()
             if not text:
                 continue
@@ -56,7 +64,7 @@ def _read_events(path, one_body=False) -> np.ndarray:
                                  f"({' '.join(dtype.names)})")
             t, kind, *velocities = text
             rows.append((float(t), kind, *map(float, velocities)))
-    return np.array(rows, dtype=dtype)
+    return np.array(rows, dtype=dtype), tuple(notes)
 
 
 def read_output(path, scene=None) -> Result:
@@ -98,13 +106,13 @@ def read_output(path, scene=None) -> Result:
     one_body = "x2" not in names
     if os.path.exists(events_file):
         check_input(events_file, "events file")     # a FIFO there would block the read
-        events = _read_events(events_file, one_body)
+        events, notes = _read_events(events_file, one_body)
     else:
-        events = np.empty(0, dtype=ONE_BODY_EVENT_DTYPE if one_body else EVENT_DTYPE)
+        events, notes = np.empty(0, dtype=ONE_BODY_EVENT_DTYPE if one_body else EVENT_DTYPE), ()
     residual = samples[:, names.index("residual")]
     energy_residual = float(np.max(np.abs(residual))) if residual.size else 0.0
     result = result_from_columns(samples, events, names, energy_residual=energy_residual,
-                                 steps=None, scene=header_scene, forces_known=False)
+                                 steps=None, scene=header_scene, forces_known=False, warnings=notes)
     return result if scene is None else with_forces_of(result, scene, path)
 
 

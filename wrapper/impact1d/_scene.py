@@ -46,6 +46,7 @@ REAL_FIELDS = (
     "f1", "f2", "f1_amp", "f1_period", "f1_phase", "f2_amp", "f2_period", "f2_phase",
     "t_end", "dt", "dt_out", "zero_vel", "max_rows", "max_impulses", "max_step_events",
     "mus1", "mus2", "k1", "x1_rest", "c1", "k2", "x2_rest", "c2", "k12", "d_rest", "c12",
+    "max_events",
 )
 TEXT_FIELDS = ("title", "f1_table", "f2_table", "method", "substeps", "events")
 
@@ -102,6 +103,7 @@ class Scene:
     k12: Optional[float] = None
     d_rest: Optional[float] = None
     c12: Optional[float] = None
+    max_events: Optional[float] = None   # events the log keeps (default 10^7); counts stay exact
     title: Optional[str] = None
     f1_table: Optional[str] = None
     f2_table: Optional[str] = None

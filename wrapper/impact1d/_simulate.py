@@ -9,7 +9,7 @@ from typing import Optional
 
 import numpy as np
 
-from ._scene import (REAL_FIELDS, Scene, InputError, decode, raise_for_status, to_core, _words, _api,
+from ._scene import (REAL_FIELDS, Scene, InputError, SimulationError, decode, raise_for_status, to_core, _words, _api,
                      _STATUS_INTERRUPTED)
 from ._scene import STATUS_TOO_SMALL as _STATUS_TOO_SMALL
 
@@ -67,7 +67,19 @@ def run_summaries(scene: Scene, overrides: list):
         errors[j] = decode(np.asarray(codes[:, j], dtype=np.uint8).tobytes())
         if status[j] == _STATUS_INTERRUPTED:
             raise KeyboardInterrupt(errors[j])     # Ctrl-C ended the batch
+        if codes[-1, j] != ord(" "):               # filled its room: maybe cut, run it alone
+            errors[j] = _whole_message(scene, overrides[j]) or errors[j]
     return dict(zip(_summary_names(), summary)), errors
+
+
+def _whole_message(scene: Scene, overrides: dict) -> str:
+    """A failing run's whole message: the batch keeps 512 characters per run (its memory
+    is per run), simulate's message has room for any (a long path name)."""
+    try:
+        simulate(scene, **overrides)
+    except (InputError, SimulationError) as error:
+        return str(error)
+    return ""
 
 
 @lru_cache(maxsize=None)

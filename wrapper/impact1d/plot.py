@@ -734,6 +734,8 @@ _UNITS = {
     "f2_phase": "rad", "t_end": "s", "dt": "s", "dt_out": "s", "zero_vel": "m/s",
     "k1": "N/m", "k2": "N/m", "k12": "N/m", "x1_rest": "m", "x2_rest": "m", "d_rest": "m",
     "c1": "N s/m", "c2": "N s/m", "c12": "N s/m",
+    # The steady state over [settle, t_end] (sweep's settle=).
+    **{f"{q}{i}_{m}": ("m" if q == "x" else "m/s") for q in "xv" for i in (1, 2) for m in ("p2p", "rms")},
 }
 
 

@@ -11,7 +11,8 @@ they come from --scene, else from the scene file the header names (`# scene = ..
 given to impact1d: relative to the folder impact1d ran in) when its force values are the
 header's; else a note on stderr says why there is no force panel.
 Any error (one that writing the report on stdout meets too) gives a one-line message on
-stderr and exit status 1. Only regular files are read (a FIFO or a device is refused).
+stderr and exit status 1. SIGTERM or SIGHUP removes the image being written (the previous
+one stays) and ends the command by that signal. Only regular files are read (a FIFO or a device is refused).
 """
 
 from __future__ import annotations
@@ -125,11 +126,27 @@ def _say(line):
 
 
 def main(argv=None):
+    from impact1d._files import Ended, die_of, ending_signals_raise
+    import signal
+
+    try:
+        with ending_signals_raise():
+            return _main(argv)
+    except Ended as ended:
+        # SIGTERM, SIGHUP: the temporary image is gone; end by the signal, as impact1d does.
+        die_of(ended.signum, f"{PROG}: ended by {signal.Signals(ended.signum).name}")
+        raise
+
+
+def _main(argv):
     args = _parser().parse_args(argv)
     output = args.output
     from impact1d import InputError
-    from impact1d._files import check_input
+    from impact1d._files import STANDARD_OUTPUT, check_input
 
+    if args.png in STANDARD_OUTPUT:
+        return _fail(f"-o {args.png}: a figure is written to a file (give a PNG name), "
+                     "not to standard output")
     try:
         check_input(output)         # a FIFO or /dev/zero would never end
     except InputError as error:

@@ -23,13 +23,16 @@ import numpy as np
 from ._scene import REAL_FIELDS, InputError, Scene, SimulationError
 from ._simulate import _OVERRIDABLE, run_summaries, simulate
 
-__all__ = ["sweep", "SUMMARY_COLUMNS", "summarize", "run_chunk"]
+__all__ = ["sweep", "SUMMARY_COLUMNS", "STEADY_COLUMNS", "summarize", "steady_state", "run_chunk"]
 
 # Named so that they never clash with a varied field (x1 is a field, x1_end is not).
 SUMMARY_COLUMNS = ("x1_end", "v1_end", "x2_end", "v2_end", "ke_end", "n_impacts",
                    "n_left", "n_right", "n_slot_min", "n_slot_max", "t_rest",
                    "impact_loss", "friction_loss", "energy_residual", "steps", "pe_end",
                    "damping_loss")
+# With settle = T: the steady state over the window [T, t_end] (steady_state).
+STEADY_COLUMNS = ("x1_p2p", "x1_rms", "v1_p2p", "v1_rms", "x2_p2p", "x2_rms", "v2_p2p", "v2_rms",
+                  "impacts_per_period")
 _IMPACT_KINDS = ("left", "right", "slot_min", "slot_max")
 # Below this many runs a sweep stays on one thread unless asked: a pool costs more than
 # it saves on a few milliseconds of work.
@@ -83,14 +86,75 @@ def summarize(result) -> dict:
     return {name: row[name] for name in SUMMARY_COLUMNS}
 
 
-def _failed_row() -> dict:
+# The core's default &run max_events, and its largest (a summary reads the whole log).
+_DEFAULT_MAX_EVENTS, _WHOLE_LOG = 10_000_000, 2**31 - 1
+
+
+def _is_count(value) -> bool:
+    """A max_events the core takes (else it is passed on, for the core's message)."""
+    return value is None or (isinstance(value, (int, float)) and not isinstance(value, bool)
+                             and float(value).is_integer() and 1 <= value <= _WHOLE_LOG)
+
+
+def _cut_log(result, cap: int):
+    """A kept Result's log cut at max_events as the core cuts it, with its warning."""
+    if len(result.events) <= cap:
+        return result
+    note = (f"the event log was cut at {cap} of {len(result.events)} events (max_events = {cap}); "
+            "the run went on to its end and the counts are exact")
+    return dataclasses.replace(result, events=result.events[:cap], warnings=result.warnings + (note,))
+
+
+def steady_state(result, settle: float) -> dict:
+    """The steady-state measures of one Result over the window [settle, t_end]: the samples
+    with t >= settle and the events with t >= settle (NaN for a body the scene does not
+    have, and for every measure when the window holds fewer than two samples).
+
+    - xi_p2p, vi_p2p: peak-to-peak, max - min of body i's sampled position (velocity).
+    - xi_rms, vi_rms: RMS about the window's mean, sqrt(mean((x - mean(x))^2)) (the
+      oscillation's, not its offset's: a spring's rest position or a wall does not enter).
+    - impacts_per_period: impacts (on any contact) in the window times the forcing period
+      over the window's length; the period is f1_period when f1_amp is given and non-zero,
+      else f2_period likewise; NaN for a scene without a sine force.
+
+    Sampling error, for x = A cos(w t + phi) sampled every h (dt_out) over a window of
+    length L = N h (N samples), w h <= pi/2: the sums of exp(i w t_k) and exp(2 i w t_k)
+    are at most 1 / sin(w h / 2) <= pi / (w h) and pi / (2 w h) in size, so the mean is
+    within A pi / (w L) of 0 and the mean of x^2 within (A^2 / 2) pi / (2 w L) of A^2 / 2:
+    with eps = pi / (4 w L) + (pi / (w L))^2, |rms^2 - A^2 / 2| <= A^2 eps and
+    |rms - A / sqrt(2)| <= sqrt(2) A eps. A window of one period and h at least holds a
+    sample within h / 2 of each extreme: 2 A (1 - (w h)^2 / 8) <= p2p <= 2 A. The same for
+    v with A w for A."""
+    t = result.t
+    window = t >= settle
+    row = dict.fromkeys(STEADY_COLUMNS, math.nan)
+    if np.count_nonzero(window) < 2:
+        return row
+    for name in ("x1", "v1", "x2", "v2"):
+        values = getattr(result, name)
+        if values is None:
+            continue
+        part = values[window]
+        row[f"{name}_p2p"] = float(part.max() - part.min())
+        row[f"{name}_rms"] = float(np.sqrt(np.mean((part - part.mean()) ** 2)))
+    scene = result.scene
+    period = next((getattr(scene, f"f{i}_period") for i in (1, 2)
+                   if getattr(scene, f"f{i}_amp") and getattr(scene, f"f{i}_period")), None)
+    if period is not None:
+        events = result.events
+        impacts = np.count_nonzero(np.isin(events["kind"], _IMPACT_KINDS) & (events["t"] >= settle))
+        row["impacts_per_period"] = impacts * float(period) / float(t[-1] - settle)
+    return row
+
+
+def _failed_row(names=SUMMARY_COLUMNS) -> dict:
     """A failed run's summary: nothing measured (its `error` says why)."""
-    return {name: math.nan for name in SUMMARY_COLUMNS}
+    return {name: math.nan for name in names}
 
 
-def _columns(rows: list) -> dict:
+def _columns(rows: list, names=SUMMARY_COLUMNS) -> dict:
     """Summary rows as {column: float64 array} (how chunks travel: arrays, not rows)."""
-    return {name: np.array([row[name] for row in rows], dtype=np.float64) for name in SUMMARY_COLUMNS}
+    return {name: np.array([row[name] for row in rows], dtype=np.float64) for name in names}
 
 
 def _batchable(overrides: list) -> bool:
@@ -104,33 +168,53 @@ def _batchable(overrides: list) -> bool:
                for run in overrides)
 
 
-def run_chunk(scene: Scene, overrides: list, keep_results: bool = False):
+def run_chunk(scene: Scene, overrides: list, keep_results: bool = False, settle: Optional[float] = None):
     """Run the scene once per override dict: ({column: array} of summaries, error
     messages[, Results]). A plain function of plain data, so that a Dask worker can run it
-    and send back a few arrays. Without Results wanted, runs that only change numbers go to
-    the core in one call (no per-run glue)."""
-    if not keep_results and _batchable(overrides):
+    and send back a few arrays. Without Results or steady-state measures (settle) wanted,
+    runs that only change numbers go to the core in one call (no per-run glue); with
+    settle, each run's Result is measured (steady_state) and dropped unless kept."""
+    names = SUMMARY_COLUMNS + (STEADY_COLUMNS if settle is not None else ())
+    if not keep_results and settle is None and _batchable(overrides):
         columns, errors = run_summaries(scene, overrides)
         return {name: np.asarray(columns[name], dtype=np.float64) for name in SUMMARY_COLUMNS}, errors
     rows, errors, results = [], [], []
     for changes in overrides:
         # The summary reads the whole event log (its counts and t_rest are exact whatever
-        # `events` keeps); a kept Result then keeps what `events` asked for.
+        # `events` and `max_events` keep); a kept Result then keeps what they asked for.
         events = changes.get("events", scene.events)
+        cap = changes.get("max_events", scene.max_events)
+        whole = {"events": None, "max_events": _WHOLE_LOG if _is_count(cap) else cap}
         try:
-            result = simulate(scene, **{**changes, "events": None})
+            result = simulate(scene, **{**changes, **whole})
         except (InputError, SimulationError) as error:
-            rows.append(_failed_row())
+            rows.append(_failed_row(names))
             errors.append(str(error))
             results.append(None)
             continue
-        rows.append(summarize(result))
+        rows.append({**summarize(result), **(steady_state(result, settle) if settle is not None else {})})
         errors.append("")
         if keep_results and events is not None and str(events).lower() != "all":
             keep = np.isin(result.events["kind"], _IMPACT_KINDS if str(events).lower() == "impacts" else ())
             result = dataclasses.replace(result, events=result.events[keep])
+        if keep_results:
+            result = _cut_log(result, _DEFAULT_MAX_EVENTS if cap is None else int(cap))
         results.append(result if keep_results else None)
-    return (_columns(rows), errors, results) if keep_results else (_columns(rows), errors)
+    return (_columns(rows, names), errors, results) if keep_results else (_columns(rows, names), errors)
+
+
+def _check_settle(settle, scene: Scene, runs: list) -> None:
+    """settle, when given, is a time from 0 that every run's t_end lies beyond."""
+    if settle is None:
+        return
+    if isinstance(settle, bool) or not isinstance(settle, (int, float, np.floating)) \
+            or not math.isfinite(settle) or settle < 0:
+        raise InputError(f"settle = {settle!r} must be a time of 0 s or more")
+    for run in runs:
+        t_end = run.get("t_end", scene.t_end)
+        if isinstance(t_end, (int, float)) and t_end <= settle:
+            raise InputError(f"settle = {settle} is not before t_end = {t_end}: "
+                             "the window [settle, t_end] would be empty")
 
 
 def _runs(params) -> tuple:
@@ -183,14 +267,18 @@ class _Progress:
 
 
 def sweep(scene: Scene, params, *, workers: Optional[int] = None, client=None,
-          progress: Optional[bool] = None, keep: Optional[str] = None):
+          progress: Optional[bool] = None, keep: Optional[str] = None, settle: Optional[float] = None):
     """Run `scene` over `params` and return a pandas DataFrame, one row per run in order.
 
     params: a dict field -> sequence (the Cartesian grid, the first field varying slowest)
     or a list of override dicts. workers: threads of this machine (default: all cores for
     sweeps of 200 runs or more, else 1). client: a dask.distributed Client to run the chunks
     on instead. progress: a progress bar (default: when stderr is a terminal).
-    keep="results": return (table, list of Result or None for failed runs)."""
+    keep="results": return (table, list of Result or None for failed runs).
+    settle=T: the table gains STEADY_COLUMNS, the steady state over [T, t_end] (peak-to-peak
+    and RMS of each position and velocity, impacts per forcing period: steady_state). Each
+    run's Result is measured and dropped (the batch path keeps no samples, so these runs
+    go one by one)."""
     import pandas as pd
 
     if not isinstance(scene, Scene):
@@ -198,6 +286,7 @@ def sweep(scene: Scene, params, *, workers: Optional[int] = None, client=None,
     if keep not in (None, "results"):
         raise InputError(f"keep must be None or 'results', got {keep!r}")
     names, runs = _runs(params)
+    _check_settle(settle, scene, runs)
     if progress is None:
         progress = sys.stderr.isatty()
     if workers is None:
@@ -217,7 +306,8 @@ def sweep(scene: Scene, params, *, workers: Optional[int] = None, client=None,
             workers_there = max(1, len(client.scheduler_info().get("workers", {})))
             size = max(_CHUNK_MIN, -(-len(runs) // (4 * workers_there)))
             chunks = [runs[i:i + size] for i in range(0, len(runs), size)]
-            futures = client.map(run_chunk, [scene] * len(chunks), chunks, pure=False)
+            futures = client.map(run_chunk, [scene] * len(chunks), chunks, [False] * len(chunks),
+                                 [settle] * len(chunks), pure=False)
             outputs = []
             try:
                 for future, chunk in zip(futures, chunks):
@@ -229,14 +319,14 @@ def sweep(scene: Scene, params, *, workers: Optional[int] = None, client=None,
         elif workers == 1:
             outputs = []
             for chunk in chunks:
-                outputs.append(run_chunk(scene, chunk, keep_results))
+                outputs.append(run_chunk(scene, chunk, keep_results, settle))
                 bar.update(len(chunk))
         else:
             with ThreadPoolExecutor(max_workers=workers) as pool:
                 outputs = []
                 try:
                     for chunk, output in zip(chunks, pool.map(
-                            lambda c: run_chunk(scene, c, keep_results), chunks)):
+                            lambda c: run_chunk(scene, c, keep_results, settle), chunks)):
                         outputs.append(output)
                         bar.update(len(chunk))
                 except KeyboardInterrupt:
@@ -249,8 +339,9 @@ def sweep(scene: Scene, params, *, workers: Optional[int] = None, client=None,
 
     errors = [error for output in outputs for error in output[1]]
     table = pd.DataFrame({name: [run.get(name) for run in runs] for name in names})
+    measured = SUMMARY_COLUMNS + (STEADY_COLUMNS if settle is not None else ())
     summary = pd.DataFrame({name: (np.concatenate([output[0][name] for output in outputs])
-                                   if outputs else np.empty(0)) for name in SUMMARY_COLUMNS})
+                                   if outputs else np.empty(0)) for name in measured})
     table = pd.concat([table, summary], axis=1)
     table["error"] = errors
     # Counts are whole numbers; a failed run's are missing (pandas' nullable integers).

@@ -7,20 +7,22 @@ NAME=a:b:n is n values from a to b (both included); NAME=v1,v2,... lists them. T
 varied fields, the run's summary and its error message (empty when it ran).
 Exit status: 0 done (rows with errors included), 1 bad input, 2 the table (or the line
 saying where it went) could not be written, 130 interrupted (SIGINT, Ctrl-C): the previous
-table is untouched.
+table is untouched. SIGTERM or SIGHUP: one line on stderr, the temporary table removed,
+the previous one untouched, and the command ends by that signal (128 + signal in a shell).
 """
 
 from __future__ import annotations
 
 import argparse
 import os
+import signal
 import sys
 
 import numpy as np
 
 from . import __version__
 from ._scene import InputError, load_scene
-from ._files import output_target, print_line, write_whole
+from ._files import STANDARD_OUTPUT, Ended, die_of, ending_signals_raise, output_target, print_line, write_whole
 from .sweep import sweep
 
 
@@ -71,16 +73,23 @@ def write_table(table, path: str) -> None:
 
 
 def main(argv=None) -> int:
+    state = {}
     try:
-        return _main(argv)
+        with ending_signals_raise():
+            return _main(argv, state)
     except KeyboardInterrupt:
         # One line, as impact1d says it (a shell shows 130 for both): the table is written
         # whole or not at all, so the previous one is as it was.
         print("impact1d-sweep: interrupted; the table was not written", file=sys.stderr)
         return 130
+    except Ended as ended:
+        # SIGTERM, SIGHUP: the temporary file is gone; end by the signal, as impact1d does.
+        table = f"the table {state['written']} is written" if "written" in state else "the table was not written"
+        die_of(ended.signum, f"impact1d-sweep: ended by {signal.Signals(ended.signum).name}; {table}")
+        raise
 
 
-def _main(argv) -> int:
+def _main(argv, state) -> int:
     parser = argparse.ArgumentParser(prog="impact1d-sweep", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("scene", help="a namelist scene (.nml) or VisSim .dat file")
@@ -88,6 +97,9 @@ def _main(argv) -> int:
                         help="a field and its values: a:b:n or v1,v2,... (repeat for a grid)")
     parser.add_argument("--workers", type=int, default=None,
                         help="threads to use (default: all cores for big sweeps)")
+    parser.add_argument("--settle", type=float, default=None, metavar="T",
+                        help="add the steady state over [T, t_end]: peak-to-peak and RMS of each "
+                        "position and velocity, impacts per forcing period (docs/formats.md)")
     parser.add_argument("-o", "--output", default=None,
                         help="table to write (default output/<scene>_sweep.csv)")
     parser.add_argument("--version", action="version", version=f"impact1d-sweep {__version__}")
@@ -97,6 +109,9 @@ def _main(argv) -> int:
             raise InputError("nothing to vary: give at least one --vary NAME=SPEC")
         if args.output is not None and not args.output.strip():
             raise InputError("-o: an empty output name")
+        if args.output in STANDARD_OUTPUT:
+            raise InputError(f"-o {args.output}: the table is written to a file (.csv or .parquet), "
+                             "not to standard output")
         if args.output and args.output.endswith(".parquet"):
             try:
                 import pyarrow  # noqa: F401
@@ -107,7 +122,7 @@ def _main(argv) -> int:
         out = args.output or os.path.join("output", f"{stem}_sweep.csv")
         output_target(out)         # a FIFO or a folder there: refused before the runs
         scene = load_scene(args.scene)
-        table = sweep(scene, parse_vary(args.vary), workers=args.workers)
+        table = sweep(scene, parse_vary(args.vary), workers=args.workers, settle=args.settle)
     except InputError as error:
         print(f"impact1d-sweep: {error}", file=sys.stderr)
         return 1
@@ -116,6 +131,7 @@ def _main(argv) -> int:
     except OSError as error:
         print(f"impact1d-sweep: cannot write {out}: {error.strerror or error}", file=sys.stderr)
         return 2
+    state["written"] = out
     failed = int((table["error"] != "").sum())
     try:
         print_line(f"impact1d-sweep: {len(table)} runs ({failed} failed) -> {out}")
