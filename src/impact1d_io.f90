@@ -508,11 +508,70 @@ contains
     extra = -1
     if (ios == 0) read(text, *, iostat=extra) again, surplus
     status = number_malformed
-    if (ios /= 0 .or. extra == 0) return
+    if (ios /= 0 .or. extra == 0 .or. .not. numbers_well_formed(text)) return
     status = number_null
     if (any(values == huge(1.0_wp) .and. again == -huge(1.0_wp))) return
     status = number_ok
   end subroutine read_numbers
+
+  !> Every item of a line of numbers is written as a Fortran number: digits with at most one
+  !> point, an exponent only after its letter (list-directed input reads '1+1' as 1e+1 =
+  !> 10), or NaN / Inf; a repeat count 'r*' before it, nulls and a '/' ending the line
+  !> are read_numbers' to judge.
+  pure logical function numbers_well_formed(text)
+    character(len=*), intent(in) :: text
+    integer :: k, finish, star
+    numbers_well_formed = .true.
+    k = 1
+    do while (k <= len(text))
+      if (scan(text(k:k), ' ,') > 0) then
+        k = k + 1
+        cycle
+      end if
+      if (text(k:k) == '/') return
+      finish = scan(text(k:) // ' ', ' ,/') + k - 2
+      star = index(text(k:finish), '*')
+      if (star > 0) then
+        if (star < finish - k + 1) numbers_well_formed = numbers_well_formed .and. &
+          well_formed_number(text(k + star:finish))
+      else
+        numbers_well_formed = numbers_well_formed .and. well_formed_number(text(k:finish))
+      end if
+      k = finish + 1
+    end do
+  end function numbers_well_formed
+
+  !> [sign] digits [. digits] | [sign] . digits, then [e|d [sign] digits]; or NaN, Inf,
+  !> Infinity (any letter case, signed).
+  pure logical function well_formed_number(item)
+    character(len=*), intent(in) :: item
+    character(len=*), parameter :: digits = '0123456789'
+    character(len=len(item)) :: low
+    integer :: k, first, mantissa_digits, e
+    low = lower(item)
+    first = 1
+    if (scan(low(1:1), '+-') > 0) first = 2
+    well_formed_number = any(low(first:) == ['nan     ', 'inf     ', 'infinity'])
+    if (well_formed_number .or. first > len(low)) return
+    e = scan(low(first:), 'ed') + first - 1
+    if (e < first) e = len(low) + 1
+    mantissa_digits = 0
+    do k = first, e - 1
+      if (index(digits, low(k:k)) > 0) mantissa_digits = mantissa_digits + 1
+    end do
+    ! The mantissa: digits and at most one point, at least one digit.
+    if (mantissa_digits == 0 .or. verify(low(first:e - 1), digits // '.') > 0 .or. &
+        count([(low(k:k) == '.', k = first, e - 1)]) > 1) return
+    if (e <= len(low)) then
+      k = e + 1
+      if (k <= len(low)) then
+        if (scan(low(k:k), '+-') > 0) k = k + 1
+      end if
+      if (k > len(low)) return
+      if (verify(low(k:), digits) > 0) return
+    end if
+    well_formed_number = .true.
+  end function well_formed_number
 
   !> The tutorial's parameter file: 17 numbers, one per line, '#' starts a comment; an
   !> optional 18th entry names a table added to f1 (the tutorial's triangle.dat button).
