@@ -7,9 +7,9 @@ module impact1d_api
   use, intrinsic :: iso_c_binding, only: c_double, c_int
   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
   use impact1d_kinds, only: wp
-  use impact1d_error, only: error_type, status_ok, status_input, status_interrupted
+  use impact1d_error, only: error_type, status_ok, status_input, status_interrupted, raise
   use impact1d_interrupt, only: catch_interrupts
-  use impact1d_scene, only: scene_input, scene_type, n_real, n_text, real_names, text_names, &
+  use impact1d_scene, only: scene_input, scene_type, is_nbody, nbody_refusal, n_real, n_text, real_names, text_names, &
     i_title, i_f1_table, i_f2_table, i_method, i_substeps, i_events, n_contacts, set_text
   use impact1d_io, only: read_scene_file, prepare_scene
   use impact1d_output, only: memory_sink, summary_sink, column_names_text => column_names, event_names, &
@@ -72,6 +72,8 @@ contains
     text_lengths = 0
     if (.not. field_count_ok(n, status, message)) return
     call read_scene_file(path, input, error)
+    ! (the flat fields carry one or two bodies: an N-body scene's arrays and records would be lost)
+    if (.not. allocated(error) .and. is_nbody(input)) call raise(error, status_input, path // ': ' // nbody_refusal)
     if (failed(error, status, message)) return
     values = real(input%value, c_double)
     given = merge(1_c_int, 0_c_int, input%given)
