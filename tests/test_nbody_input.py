@@ -142,3 +142,12 @@ def test_chain_is_read_checked_and_refused_by_the_cli(tmp_path):
     assert done.returncode == 1
     assert "need the N-body engine (issue 19, stage 2-4)" in done.stderr
     assert not (tmp_path / "out.dat").exists()
+
+
+def test_the_documented_examples_pass_every_check(tmp_path):
+    """docs/formats.md's chain and record examples are scenes that only wait for the engine."""
+    doc = (Path(__file__).resolve().parent.parent / "docs" / "formats.md").read_text()
+    section = doc[doc.index("### Scenes of N bodies"):doc.index("## VisSim-style parameter file")]
+    lines = [line.strip() for line in section.splitlines() if line.startswith("    &")]
+    assert len(lines) == 9
+    refused(tmp_path, "\n".join(lines) + "\n" + RUN, re.escape("need the N-body engine (issue 19, stage 2-4)"))
