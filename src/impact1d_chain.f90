@@ -3,7 +3,7 @@
 !> mean), checked where no engine is needed, and carried to the model as contact and
 !> element records (input_records: the layout of scene_type's records, issue 19 stage 2).
 module impact1d_chain
-  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_value, ieee_quiet_nan
   use impact1d_kinds, only: wp, eps_wp
   use impact1d_error, only: error_type, raise, status_input, fmt
   use impact1d_scene, only: scene_input, real_names, text_names, n_real, n_text, set_text, name_of, value_or, &
@@ -12,10 +12,19 @@ module impact1d_chain
   use impact1d_fields, only: n_arrays, array_names, array_is_link, array_is_text, alias_name, name_len, &
     record_input, a_m, a_mu, a_mus, a_x, a_f_amp, a_f_period, a_f_phase, a_k, a_x_rest, a_c, a_d_min, a_r_min, &
     a_d_max, a_r_max, a_k_link, a_d_rest, a_c_link, r_a, r_b, r_d_min, r_r_min, r_d_max, r_r_max, r_k, r_d_rest, &
-    r_c, contact_fields, spring_fields
+    r_c, contact_fields, spring_fields, r_name, n_contact_fields, n_spring_fields, written_array, text_item, &
+    a_f_table
   implicit none
   private
   public :: settle_chain, validate_chain, input_records, mechanism_records, n_bodies_of
+  public :: id_arrays, id_r_meet, id_contact, id_spring, n_ids, field_name, field_is_text, assign_number, &
+    assign_text, scene_assignments
+
+  !> The input fields' numbering (the namelist reader's and the flat API's): 1..n_real the
+  !> tutorial's scalars, then its texts, the arrays (impact1d_fields' order), r_meet, the
+  !> &contact record fields, the &spring record fields.
+  integer, parameter :: id_arrays = n_real + n_text, id_r_meet = id_arrays + n_arrays + 1, &
+    id_contact = id_r_meet, id_spring = id_contact + n_contact_fields, n_ids = id_spring + n_spring_fields
 
   !> Contacts and elements as records, in the layout of the model's (scene_type, stage 2):
   !> walls, links, then &contact records in file order; ground springs, link springs, then
@@ -378,7 +387,9 @@ contains
     character(len=:), allocatable :: where
     do r = 1, size(records)
       associate (rec => records(r))
+        ! (a record from Python has no line: its place among the records)
         where = trim(merge('&contact', '&spring ', contact)) // ' (line ' // trim(fmt(rec%line)) // '): '
+        if (rec%line == 0) where = trim(merge('&contact', '&spring ', contact)) // ' record ' // trim(fmt(r)) // ': '
         do f = 1, merge(size(contact_fields) - 1, size(spring_fields), contact)
           if (rec%given(f) .and. .not. ieee_is_finite(rec%value(f))) call raise(error, status_input, where // &
             trim(field_of(contact, f)) // ' = ' // trim(fmt(rec%value(f))) // ' is not a finite number')
@@ -711,4 +722,205 @@ contains
       records%element_rest = records%element_rest(:ne)
     end associate
   end subroutine shrink
+
+  !> Name of input field id (the flat API's numbering: the tutorial's scalars, its texts,
+  !> the arrays, r_meet, the &contact and &spring record fields as 'contact.a').
+  pure function field_name(id) result(name)
+    integer, intent(in) :: id
+    character(len=16) :: name     ! blank padded: callers trim
+    name = ''
+    if (id >= 1 .and. id <= n_real) then
+      name = real_names(id)
+    else if (id > n_real .and. id <= id_arrays) then
+      name = text_names(id - n_real)
+    else if (id > id_arrays .and. id < id_r_meet) then
+      name = array_names(id - id_arrays)
+    else if (id == id_r_meet) then
+      name = 'r_meet'
+    else if (id > id_contact .and. id <= id_spring) then
+      name = 'contact.' // contact_fields(id - id_contact)
+    else if (id > id_spring .and. id <= n_ids) then
+      name = 'spring.' // spring_fields(id - id_spring)
+    end if
+  end function field_name
+
+  !> Whether field id holds text (a text scalar, f_table's elements, a contact's name).
+  pure logical function field_is_text(id)
+    integer, intent(in) :: id
+    field_is_text = (id > n_real .and. id <= id_arrays) .or. id == id_arrays + a_f_table .or. &
+      id == id_contact + r_name
+  end function field_is_text
+
+  !> Field id := value: a scalar (index ignored), element index of an array, or the field
+  !> of record index. An array or the records grow to index (elements skipped are NaN, which
+  !> the checks refuse).
+  pure subroutine assign_number(input, id, index, value)
+    type(scene_input), intent(inout) :: input
+    integer, intent(in) :: id, index
+    real(wp), intent(in) :: value
+    if (id >= 1 .and. id <= n_real) then
+      input%value(id) = value
+      input%given(id) = .true.
+    else if (id > id_arrays .and. id < id_r_meet) then
+      call grow_array(input%chain%array(id - id_arrays), index)
+      input%chain%array(id - id_arrays)%v(index) = value
+    else if (id == id_r_meet) then
+      input%chain%r_meet = value
+      input%chain%has_r_meet = .true.
+    else if (id > id_contact .and. id <= id_spring) then
+      call grow_records(input%chain%contacts, index)
+      input%chain%contacts(index)%value(id - id_contact) = value
+      input%chain%contacts(index)%given(id - id_contact) = .true.
+    else if (id > id_spring .and. id <= n_ids) then
+      call grow_records(input%chain%springs, index)
+      input%chain%springs(index)%value(id - id_spring) = value
+      input%chain%springs(index)%given(id - id_spring) = .true.
+    end if
+  end subroutine assign_number
+
+  !> Text field id := text (a text scalar, element index of f_table, record index's name).
+  pure subroutine assign_text(input, id, index, text)
+    type(scene_input), intent(inout) :: input
+    integer, intent(in) :: id, index
+    character(len=*), intent(in) :: text
+    if (id > n_real .and. id <= id_arrays) then
+      call set_text(input, id - n_real, text)
+    else if (id == id_arrays + a_f_table) then
+      call grow_array(input%chain%array(a_f_table), index)
+      input%chain%array(a_f_table)%t(index)%s = text
+    else if (id == id_contact + r_name) then
+      call grow_records(input%chain%contacts, index)
+      input%chain%contacts(index)%name = text
+      input%chain%contacts(index)%given(r_name) = .true.
+    end if
+  end subroutine assign_text
+
+  !> An array holds at least n elements (new numbers NaN, new texts '').
+  pure subroutine grow_array(array, n)
+    type(written_array), intent(inout) :: array
+    integer, intent(in) :: n
+    real(wp), allocatable :: v(:)
+    type(text_item), allocatable :: t(:)
+    integer :: k
+    if (array%n >= n) return
+    allocate(v(n), t(n))
+    v = ieee_value(1.0_wp, ieee_quiet_nan)
+    do k = 1, n
+      t(k)%s = ''
+    end do
+    if (allocated(array%v)) v(:array%n) = array%v(:array%n)
+    if (allocated(array%t)) t(:array%n) = array%t(:array%n)
+    call move_alloc(v, array%v)
+    call move_alloc(t, array%t)
+    array%n = n
+  end subroutine grow_array
+
+  !> At least n records.
+  pure subroutine grow_records(records, n)
+    type(record_input), allocatable, intent(inout) :: records(:)
+    integer, intent(in) :: n
+    type(record_input), allocatable :: more(:)
+    if (.not. allocated(records)) allocate(records(0))
+    if (size(records) >= n) return
+    allocate(more(n - size(records)))
+    records = [records, more]
+  end subroutine grow_records
+
+  !> The scene as assignments (what the flat API's read_scene returns): every scalar given
+  !> (index 0), every array element, r_meet, every record field given (index: the record);
+  !> texts likewise, non-empty ones only. n_numbers and n_texts count them all, whatever
+  !> the room (field(:), texts(:) are filled as far as they go).
+  subroutine scene_assignments(input, field, index, value, n_numbers, text_field, text_index, texts, n_texts)
+    type(scene_input), intent(in) :: input
+    integer, intent(out) :: field(:), index(:), text_field(:), text_index(:)
+    real(wp), intent(out) :: value(:)
+    type(text_item), intent(out) :: texts(:)
+    integer, intent(out) :: n_numbers, n_texts
+    integer :: id, i, last
+    n_numbers = 0
+    n_texts = 0
+    do id = 1, n_ids
+      last = 0
+      if (id > id_arrays .and. id < id_r_meet) last = input%chain%array(id - id_arrays)%n
+      if (id > id_contact .and. id <= id_spring .and. allocated(input%chain%contacts)) last = size(input%chain%contacts)
+      if (id > id_spring .and. allocated(input%chain%springs)) last = size(input%chain%springs)
+      if (id <= id_arrays .or. id == id_r_meet) then
+        call put_field(input, id, 0, field, index, value, n_numbers, text_field, text_index, texts, n_texts)
+      end if
+      do i = 1, last
+        call put_field(input, id, i, field, index, value, n_numbers, text_field, text_index, texts, n_texts)
+      end do
+    end do
+  end subroutine scene_assignments
+
+  !> Field id at index i, if given, as the next number or text.
+  subroutine put_field(input, id, i, field, index, value, n_numbers, text_field, text_index, texts, n_texts)
+    type(scene_input), intent(in) :: input
+    integer, intent(in) :: id, i
+    integer, intent(inout) :: field(:), index(:), text_field(:), text_index(:), n_numbers, n_texts
+    real(wp), intent(inout) :: value(:)
+    type(text_item), intent(inout) :: texts(:)
+    character(len=:), allocatable :: text
+    real(wp) :: number
+    logical :: given
+    call field_value(input, id, i, given, number, text)
+    if (.not. given) return
+    if (field_is_text(id)) then
+      n_texts = n_texts + 1
+      if (n_texts > size(texts)) return
+      text_field(n_texts) = id
+      text_index(n_texts) = i
+      texts(n_texts)%s = text
+    else
+      n_numbers = n_numbers + 1
+      if (n_numbers > size(value)) return
+      field(n_numbers) = id
+      index(n_numbers) = i
+      value(n_numbers) = number
+    end if
+  end subroutine put_field
+
+  !> Field id at index i as the input holds it (given false: absent or an empty text).
+  subroutine field_value(input, id, i, given, number, text)
+    type(scene_input), intent(in) :: input
+    integer, intent(in) :: id, i
+    logical, intent(out) :: given
+    real(wp), intent(out) :: number
+    character(len=:), allocatable, intent(out) :: text
+    number = 0.0_wp
+    text = ''
+    given = .false.
+    if (id <= n_real) then
+      given = input%given(id)
+      number = input%value(id)
+    else if (id <= id_arrays) then
+      text = input%text(id - n_real)%s
+    else if (id == id_arrays + a_f_table) then
+      text = input%chain%array(a_f_table)%t(i)%s
+      given = .true.
+    else if (id < id_r_meet) then
+      number = input%chain%array(id - id_arrays)%v(i)
+      given = .true.
+    else if (id == id_r_meet) then
+      given = input%chain%has_r_meet
+      number = input%chain%r_meet
+    else if (id <= id_spring) then
+      call record_value(input%chain%contacts(i), id - id_contact, given, number, text)
+    else
+      call record_value(input%chain%springs(i), id - id_spring, given, number, text)
+    end if
+    if (field_is_text(id) .and. id /= id_arrays + a_f_table) given = len(text) > 0
+  end subroutine field_value
+
+  !> Field f of a record.
+  subroutine record_value(rec, f, given, number, text)
+    type(record_input), intent(in) :: rec
+    integer, intent(in) :: f
+    logical, intent(out) :: given
+    real(wp), intent(out) :: number
+    character(len=:), allocatable, intent(inout) :: text
+    given = rec%given(f)
+    number = rec%value(f)
+    if (allocated(rec%name) .and. f == r_name) text = rec%name
+  end subroutine record_value
 end module impact1d_chain

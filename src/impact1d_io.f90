@@ -11,7 +11,7 @@ module impact1d_io
   use impact1d_forcing, only: table_type
   use impact1d_fields, only: n_arrays, array_names, array_groups, array_is_text, n_contact_fields, contact_fields, &
     n_spring_fields, spring_fields, r_name, record_input, text_item, name_len
-  use impact1d_chain, only: settle_chain, validate_chain
+  use impact1d_chain, only: settle_chain, validate_chain, id_arrays, id_r_meet, id_contact, id_spring, n_ids
   use impact1d_files, only: check_input_file
   implicit none
   private
@@ -28,11 +28,7 @@ module impact1d_io
     'k1, x1_rest, c1, k2, x2_rest, c2, k12, d_rest, c12', &
     't_end, dt, dt_out, method, zero_vel, max_rows, max_impulses, max_step_events, substeps, events', &
     'a, b, d_min, r_min, d_max, r_max, name', 'a, b, k, d_rest, c']
-  !> Fields beyond the tutorial's scalars and texts (codes after n_real + n_text): the
-  !> arrays, &link r_meet, the &contact and then the &spring record fields.
-  integer, parameter :: code_arrays = n_real + n_text, code_r_meet = code_arrays + n_arrays + 1, &
-    code_contact = code_r_meet, code_spring = code_contact + n_contact_fields, &
-    n_codes = code_spring + n_spring_fields
+
   !> The tutorial's parameter files list these, in its Table 1 order; g is 10 there.
   integer, parameter :: dat_order(17) = [i_m1, i_m2, i_mu1, i_r_left, i_r_right, i_r_min, &
     i_r_max, i_x_left, i_x_right, i_d_min, i_d_max, i_x1, i_x2, i_v1, i_v2, i_f1, i_f2]
@@ -51,7 +47,7 @@ module impact1d_io
     integer, allocatable :: starts(:)
     integer :: open_group = 0
     integer :: group_line(size(known_groups)) = 0
-    integer :: given_line(n_codes) = 0
+    integer :: given_line(n_ids) = 0
   end type namelist_text
 
 contains
@@ -253,7 +249,7 @@ contains
     else if (group == g_contact .or. group == g_spring) then
       ! Each occurrence is a record of its own; "given twice" applies within it.
       call new_record(input, group == g_contact, line)
-      nml%given_line(code_contact + 1:) = 0
+      nml%given_line(id_contact + 1:) = 0
       nml%group_line(group) = line
       nml%open_group = group
     else if (nml%group_line(group) > 0) then
@@ -378,7 +374,7 @@ contains
       if (allocated(error)) return
       input%value(field) = number
       input%given(field) = .true.
-    else if (field <= code_arrays) then
+    else if (field <= id_arrays) then
       call read_text(name, value, text, error)
       if (allocated(error)) return
       if (field - n_real == i_title) then
@@ -386,13 +382,13 @@ contains
       else
         call set_text(input, field - n_real, trim(resolved_text(path, field - n_real, text)))
       end if
-    else if (field < code_r_meet) then
-      call take_array(path, field - code_arrays, name, value, input, error)
-    else if (field == code_r_meet) then
+    else if (field < id_r_meet) then
+      call take_array(path, field - id_arrays, name, value, input, error)
+    else if (field == id_r_meet) then
       call read_scalar(name, value, input%chain%r_meet, error)
       input%chain%has_r_meet = .true.
     else
-      j = field - code_contact
+      j = field - id_contact
       if (j > n_contact_fields) then
         call take_record_field(name, value, j - n_contact_fields, input%chain%springs, error)
       else
@@ -674,7 +670,7 @@ contains
   end function name_end
 
   !> Variable `name` of group `group`: 1..n_real a real field, n_real + i text field i, then
-  !> the arrays, r_meet and the record fields (code_*); 0 when the group has no such variable.
+  !> the arrays, r_meet and the record fields (impact1d_chain's id_*); 0 when the group has no such variable.
   pure integer function field_index(name, group)
     character(len=*), intent(in) :: name
     integer, intent(in) :: group
@@ -683,8 +679,8 @@ contains
     if (len(name) == 0) return
     if (group == g_contact .or. group == g_spring) then
       do k = 1, merge(n_contact_fields, n_spring_fields, group == g_contact)
-        if (group == g_contact .and. contact_fields(k) == name) field_index = code_contact + k
-        if (group == g_spring .and. spring_fields(k) == name) field_index = code_spring + k
+        if (group == g_contact .and. contact_fields(k) == name) field_index = id_contact + k
+        if (group == g_spring .and. spring_fields(k) == name) field_index = id_spring + k
       end do
       return
     end if
@@ -696,10 +692,10 @@ contains
         if (text_names(k) == name) field_index = n_real + k
       end do
     else if (name == 'r_meet' .and. known_groups(group) == 'link') then
-      field_index = code_r_meet
+      field_index = id_r_meet
     else
       do k = 1, n_arrays
-        if (array_names(k) == name .and. array_groups(k) == known_groups(group)) field_index = code_arrays + k
+        if (array_names(k) == name .and. array_groups(k) == known_groups(group)) field_index = id_arrays + k
       end do
     end if
   end function field_index

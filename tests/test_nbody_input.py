@@ -31,8 +31,9 @@ def scene_file(tmp_path, text, name="scene.nml"):
 
 
 def refused(tmp_path, text, match):
+    """Refused when read, or (a scene that needs the N-body engine) when run."""
     with pytest.raises(impact1d.InputError, match=match) as caught:
-        impact1d.load_scene(scene_file(tmp_path, text))
+        impact1d.simulate(impact1d.load_scene(scene_file(tmp_path, text)))
     assert "\n" not in str(caught.value)
     return str(caught.value)
 
@@ -151,3 +152,62 @@ def test_the_documented_examples_pass_every_check(tmp_path):
     lines = [line.strip() for line in section.splitlines() if line.startswith("    &")]
     assert len(lines) == 9
     refused(tmp_path, "\n".join(lines) + "\n" + RUN, re.escape("need the N-body engine (issue 19, stage 2-4)"))
+
+
+# --- Python: Scene arrays and records, through the core's assignments ------------------
+
+def test_scene_arrays_run_as_the_tutorial_names():
+    by_arrays = impact1d.Scene(m=[1.0, 2.0], mu=[0.1, 0.2], x=[1.0, 2.5], v=[-9.0, 1.0], f=[1.0, -1.0],
+                               x_left=0.0, r_left=0.5, x_right=10.0, d_min=1.0, d_max=2.0, r_max=0.5,
+                               k=[3.0, 0.0], x_rest=[1.0, 0.0], c_link=[0.25], t_end=0.5, dt=1e-3)
+    by_names = impact1d.Scene(m1=1.0, m2=2.0, mu1=0.1, mu2=0.2, x1=1.0, x2=2.5, v1=-9.0, v2=1.0, f1=1.0,
+                              f2=-1.0, x_left=0.0, r_left=0.5, x_right=10.0, d_min=1.0, d_max=2.0, r_max=0.5,
+                              k1=3.0, x1_rest=1.0, k2=0.0, x2_rest=0.0, c12=0.25, t_end=0.5, dt=1e-3)
+    a, b = impact1d.simulate(by_arrays), impact1d.simulate(by_names)
+    assert np.array_equal(a.samples, b.samples) and np.array_equal(a.events, b.events)
+    assert a.columns == b.columns
+    # sweeps and overrides by name work on it too
+    table = impact1d.sweep(by_arrays, {"x_left": [0.0, -1.0]})
+    assert list(table["error"]) == ["", ""] and table["x1_end"][0] == a.x1[-1]
+    assert impact1d.simulate(dataclasses.replace(by_arrays, r_left=1.0)).events.size > 0
+
+
+def test_load_scene_of_a_chain_gives_arrays_and_records(tmp_path):
+    scene = impact1d.load_scene(scene_file(tmp_path, CHAIN))
+    assert scene.m == [1.0] * 5 and scene.x == [0.0, 0.3, 0.6, 0.9, 1.2] and scene.d_min == [0.25] * 4
+    assert scene.m1 is None and scene.g == 9.81 and scene.x_left == -1.0
+    assert scene.contacts == [{"a": 0, "b": 3, "d_min": -1.0, "r_min": 0.8, "name": "stop3"},
+                              {"a": 2, "b": 5, "d_min": 0.1, "r_min": 0.5, "d_max": 1.0, "r_max": 0.0}]
+    assert scene.springs == [{"a": 1, "b": 3, "k": 40.0, "d_rest": 0.5, "c": 0.1}]
+    with pytest.raises(impact1d.InputError, match=re.escape("need the N-body engine (issue 19, stage 2-4)")):
+        impact1d.simulate(scene)
+    # The same checks as a file's, on what Python changed.
+    bad = dataclasses.replace(scene, contacts=scene.contacts + [{"a": 1, "b": 6, "d_min": 0.0}])
+    with pytest.raises(impact1d.InputError, match=re.escape("&contact record 3: b = 6.0 is not a body")):
+        impact1d.simulate(bad)
+    with pytest.raises(impact1d.InputError, match=re.escape("m(4) = 0.0 must be positive")):
+        impact1d.simulate(dataclasses.replace(scene, m=[1.0, 1.0, 1.0, 0.0, 1.0]))
+
+
+@pytest.mark.parametrize("fields, match", [
+    ({"m": 2.0}, "m must be a list"),
+    ({"m": [1.0, "a"]}, re.escape("m[1] must be a number, got 'a'")),
+    ({"contacts": [{"a": 1, "q": 2}]}, "contacts\\[0\\] has no field 'q'"),
+    ({"contacts": {"a": 1}}, "contacts must be a list of dicts"),
+    ({"m": [1.0, 1.0], "m1": 2.0}, re.escape("m1 is given and so is m (m1 is m(1))")),
+])
+def test_scene_nbody_field_faults(fields, match):
+    scene = impact1d.Scene(**{"m": [1.0, 1.0], "x": [0.0, 1.0], "t_end": 0.1, "dt": 1e-3, **fields})
+    with pytest.raises(impact1d.InputError, match=match):
+        impact1d.simulate(scene)
+
+
+def test_load_scene_of_a_long_chain_takes_the_room_it_needs(tmp_path):
+    """More numbers and texts than load_scene's first guess (64, 16): the core says how many."""
+    n = 40
+    text = (f"&bodies m = {n}*1.0 /\n&initial x = " + ", ".join(str(i) for i in range(n)) + " /\n"
+            + f"&forces f_table = {n}*'' /\n"
+            + "".join(f"&contact a = {i}, b = {i + 1}, d_max = 2, name = 'c{i}' /\n" for i in range(1, 20)) + RUN)
+    scene = impact1d.load_scene(scene_file(tmp_path, text))
+    assert scene.m == [1.0] * n and scene.x == [float(i) for i in range(n)] and scene.f_table == [None] * n
+    assert [c["name"] for c in scene.contacts] == [f"c{i}" for i in range(1, 20)]
