@@ -3,6 +3,7 @@ namelist arrays with repeat counts, repeatable &contact and &spring groups, and 
 that need no engine."""
 import dataclasses
 import re
+import subprocess
 from pathlib import Path
 
 import numpy as np
@@ -137,7 +138,6 @@ def test_records_on_two_bodies_wait_for_the_engine(tmp_path, extra):
 
 def test_chain_is_read_checked_and_refused_by_the_cli(tmp_path):
     cli = find_tool("impact1d")
-    import subprocess
     done = subprocess.run([cli, str(scene_file(tmp_path, CHAIN)), "-o", str(tmp_path / "out.dat")],
                           capture_output=True, text=True, timeout=60)
     assert done.returncode == 1
@@ -211,3 +211,26 @@ def test_load_scene_of_a_long_chain_takes_the_room_it_needs(tmp_path):
     scene = impact1d.load_scene(scene_file(tmp_path, text))
     assert scene.m == [1.0] * n and scene.x == [float(i) for i in range(n)] and scene.f_table == [None] * n
     assert [c["name"] for c in scene.contacts] == [f"c{i}" for i in range(1, 20)]
+
+
+def test_result_scene_of_arrays_is_the_scene_run():
+    """The plots read the tutorial's names from Result.scene (a force f=[...] was drawn as 0)."""
+    scene = impact1d.Scene(m=[1.0, 2.0], x=[0.0, 1.0], f=[1.0, -2.0], f_amp=[0.5, 0.0], f_period=[1.0, 1.0],
+                           t_end=0.2, dt=1e-3)
+    result = impact1d.simulate(scene)
+    assert (result.scene.m1, result.scene.m2, result.scene.f1, result.scene.f2) == (1.0, 2.0, 1.0, -2.0)
+    assert result.scene.m is None and scene.m == [1.0, 2.0]
+    forces = impact1d.plot.applied_forces(result)
+    assert np.allclose(forces["f1"], 1.0 + 0.5 * np.sin(2 * np.pi * result.t)) and np.all(forces["f2"] == -2.0)
+
+
+def test_read_output_takes_the_forces_of_a_scene_written_with_arrays(tmp_path):
+    (tmp_path / "t.dat").write_text("0 0\n1 3\n")
+    text = ("&bodies m = 1.0, 2.0 / &initial x = 0.0, 1.0 / &forces f = 1.0, -2.0, f_table = 't.dat', '' /\n"
+            "&run t_end = 0.2, dt = 1e-3 /\n")
+    path = scene_file(tmp_path, text)
+    subprocess.run([find_tool("impact1d"), str(path), "-o", str(tmp_path / "out.dat")], check=True,
+                   capture_output=True, timeout=60)
+    scene = impact1d.Scene(m=[1.0, 2.0], x=[0.0, 1.0], f=[1.0, -2.0], f_table=[str(tmp_path / "t.dat"), None])
+    result = impact1d.read_output(tmp_path / "out.dat", scene=scene)
+    assert result.forces_known and result.scene.f1_table == str(tmp_path / "t.dat")

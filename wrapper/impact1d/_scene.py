@@ -309,6 +309,15 @@ def _settled(scene: Scene):
     return (np.asarray(values_out, dtype=np.float64), np.asarray(given, dtype=np.int32), *out)
 
 
+def from_core(values, given, *texts, source=None) -> Scene:
+    """to_core's flat fields -> the Scene in the tutorial's names (how a scene written with
+    arrays of one or two bodies runs: the Result's scene, which the plots read)."""
+    fields = {name: (float(values[i]) if given[i] else None) for i, name in enumerate(REAL_FIELDS)}
+    fields.update((name, text.decode("utf-8", errors="surrogateescape") or None)
+                  for name, text in zip(TEXT_FIELDS, texts))
+    return Scene(**fields, source=source)
+
+
 # The api's status for a run that an interrupt (SIGINT) ended.
 _STATUS_INTERRUPTED = 4
 
