@@ -395,6 +395,10 @@ contains
             trim(field_of(contact, f)) // ' = ' // trim(fmt(rec%value(f))) // ' is not a finite number')
         end do
         if (.not. allocated(error)) call check_ends(rec, n_bodies_of(input), where, error)
+        if (allocated(rec%name) .and. .not. allocated(error)) then
+          if (len(rec%name) > name_len) call raise(error, status_input, where // "name = '" // rec%name // &
+            "' is longer than " // trim(fmt(name_len)) // ' characters')
+        end if
         if (contact .and. .not. allocated(error)) then
           call contact_limits(rec, where, error)
         else if (.not. allocated(error)) then

@@ -10,7 +10,7 @@ module impact1d_io
     i_substeps, i_events
   use impact1d_forcing, only: table_type
   use impact1d_fields, only: n_arrays, array_names, array_groups, array_is_text, n_contact_fields, contact_fields, &
-    n_spring_fields, spring_fields, r_name, record_input, text_item, name_len
+    n_spring_fields, spring_fields, r_name, record_input, text_item
   use impact1d_chain, only: settle_chain, validate_chain, id_arrays, id_r_meet, id_contact, id_spring, n_ids
   use impact1d_files, only: check_input_file
   implicit none
@@ -495,11 +495,6 @@ contains
       if (f == r_name .and. name == 'name') then
         call read_text(name, value, text, error)
         if (allocated(error)) return
-        if (len(text) > name_len) then
-          call raise(error, status_input, "name = '" // text // "' is longer than " // trim(fmt(name_len)) // &
-            ' characters')
-          return
-        end if
         rec%name = text
         rec%given(f) = .true.
       else

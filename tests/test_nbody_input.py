@@ -119,6 +119,7 @@ def test_chain_faults(tmp_path, text, match):
     ("&spring a = 1, b = 3, k = 1 /", "k is given but d_rest is not"),
     ("&spring a = 1, b = 3, c = -1 /", re.escape("c = -1.0 must not be negative")),
     ("&spring a = 1, b = 3 /", "a spring needs k or c"),
+    ("&contact a = 1, b = 3, d_min = 0, name = '" + "n" * 33 + "' /", "is longer than 32 characters"),
 ])
 def test_record_faults(tmp_path, record, match):
     refused(tmp_path, "&bodies m = 3*1.0 / &initial x = 0, 1, 2 /\n" + record + "\n" + RUN, match)
@@ -194,6 +195,8 @@ def test_load_scene_of_a_chain_gives_arrays_and_records(tmp_path):
     ({"m": [1.0, "a"]}, re.escape("m[1] must be a number, got 'a'")),
     ({"contacts": [{"a": 1, "q": 2}]}, "contacts\\[0\\] has no field 'q'"),
     ({"contacts": {"a": 1}}, "contacts must be a list of dicts"),
+    ({"contacts": [{"a": 1, "b": 2, "d_min": 0.0, "name": "n" * 33}]},
+     re.escape("&contact record 1: name = '" + "n" * 33 + "' is longer than 32 characters")),
     ({"m": [1.0, 1.0], "m1": 2.0}, re.escape("m1 is given and so is m (m1 is m(1))")),
 ])
 def test_scene_nbody_field_faults(fields, match):
