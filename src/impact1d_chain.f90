@@ -13,7 +13,7 @@ module impact1d_chain
     record_input, a_m, a_mu, a_mus, a_x, a_f_amp, a_f_period, a_f_phase, a_k, a_x_rest, a_c, a_d_min, a_r_min, &
     a_d_max, a_r_max, a_k_link, a_d_rest, a_c_link, r_a, r_b, r_d_min, r_r_min, r_d_max, r_r_max, r_k, r_d_rest, &
     r_c, contact_fields, spring_fields, r_name, n_contact_fields, n_spring_fields, written_array, text_item, &
-    a_f_table
+    a_f_table, mechanism_records
   implicit none
   private
   public :: settle_chain, validate_chain, input_records, mechanism_records, n_bodies_of
@@ -26,20 +26,6 @@ module impact1d_chain
   integer, parameter :: id_arrays = n_real + n_text, id_r_meet = id_arrays + n_arrays + 1, &
     id_contact = id_r_meet, id_spring = id_contact + n_contact_fields, n_ids = id_spring + n_spring_fields
 
-  !> Contacts and elements as records, in the layout of the model's (scene_type, stage 2):
-  !> walls, links, then &contact records in file order; ground springs, link springs, then
-  !> &spring records in file order. An end 0 is the ground (always the first end, a).
-  type :: mechanism_records
-    integer :: n_contacts = 0
-    integer, allocatable :: contact_body(:, :)           !< (2, nc) ends a, b; 0 = ground; acts on x_b - x_a
-    logical, allocatable :: contact_has(:, :)            !< (2, nc) lower / upper limit present
-    real(wp), allocatable :: contact_limit(:, :)         !< (2, nc) d_min, d_max on x_b - x_a (walls: positions)
-    real(wp), allocatable :: contact_restitution(:, :)   !< (2, nc) r at the lower, upper limit
-    character(len=name_len), allocatable :: contact_name(:)   !< (nc) 'left' 'right' 'slot' 'link3' ...
-    integer :: n_elements = 0
-    integer, allocatable :: element_body(:, :)           !< (2, ne) ends; elongation (x_b - x_a) - rest
-    real(wp), allocatable :: element_k(:), element_c(:), element_rest(:)   !< (ne)
-  end type mechanism_records
 
   !> Arrays whose elements must not be negative.
   integer, parameter :: nonnegative_arrays(6) = [a_mu, a_mus, a_k, a_c, a_k_link, a_c_link]

@@ -12,7 +12,7 @@ module impact1d_fields
   public :: a_d_min, a_r_min, a_d_max, a_r_max, a_k_link, a_d_rest, a_c_link, a_f_table
   public :: n_contact_fields, contact_fields, n_spring_fields, spring_fields
   public :: r_a, r_b, r_d_min, r_r_min, r_d_max, r_r_max, r_name, r_k, r_d_rest, r_c
-  public :: name_len, text_item, written_array, record_input, chain_input, alias_name
+  public :: name_len, text_item, written_array, record_input, chain_input, alias_name, mechanism_records
 
   !> Longest contact name a record may carry (names of events: '<name>', 'rest_<name>', ...).
   integer, parameter :: name_len = 32
@@ -78,6 +78,23 @@ module impact1d_fields
     logical :: has_r_meet = .false.
     type(record_input), allocatable :: contacts(:), springs(:)
   end type chain_input
+
+  !> Contacts and elements as records, in the layout of the model's (scene_type, stage 2;
+  !> here, below impact1d_scene, so that build_scene can take them: impact1d_chain's
+  !> input_records makes them):
+  !> walls, links, then &contact records in file order; ground springs, link springs, then
+  !> &spring records in file order. An end 0 is the ground (always the first end, a).
+  type :: mechanism_records
+    integer :: n_contacts = 0
+    integer, allocatable :: contact_body(:, :)           !< (2, nc) ends a, b; 0 = ground; acts on x_b - x_a
+    logical, allocatable :: contact_has(:, :)            !< (2, nc) lower / upper limit present
+    real(wp), allocatable :: contact_limit(:, :)         !< (2, nc) d_min, d_max on x_b - x_a (walls: positions)
+    real(wp), allocatable :: contact_restitution(:, :)   !< (2, nc) r at the lower, upper limit
+    character(len=name_len), allocatable :: contact_name(:)   !< (nc) 'left' 'right' 'slot' 'link3' ...
+    integer :: n_elements = 0
+    integer, allocatable :: element_body(:, :)           !< (2, ne) ends; elongation (x_b - x_a) - rest
+    real(wp), allocatable :: element_k(:), element_c(:), element_rest(:)   !< (ne)
+  end type mechanism_records
 
 contains
 
