@@ -7,18 +7,21 @@ module impact1d_api
   use, intrinsic :: iso_c_binding, only: c_double, c_int
   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
   use impact1d_kinds, only: wp
-  use impact1d_error, only: error_type, status_ok, status_input, status_interrupted
+  use impact1d_error, only: error_type, status_ok, status_input, status_interrupted, raise
   use impact1d_interrupt, only: catch_interrupts
-  use impact1d_scene, only: scene_input, scene_type, n_real, n_text, real_names, text_names, &
+  use impact1d_scene, only: scene_input, scene_type, validate, is_nbody, nbody_refusal, n_real, n_text, real_names, text_names, &
     i_title, i_f1_table, i_f2_table, i_method, i_substeps, i_events, n_contacts, set_text
   use impact1d_io, only: read_scene_file, prepare_scene
+  use impact1d_chain, only: settle_chain, validate_chain, n_ids, id_arrays, id_r_meet, field_name, assign_number, &
+    assign_text, scene_assignments
+  use impact1d_fields, only: text_item
   use impact1d_output, only: memory_sink, summary_sink, column_names_text => column_names, event_names, &
     n_columns, event_impact, present_columns, i_impact_loss, i_friction_loss, i_pe, i_damping_loss
   use impact1d_solver, only: run, run_stats
   implicit none
   private
   public :: field_names, column_names, event_kind_names, read_scene, simulate, simulate_summaries, &
-    summary_column_names
+    summary_column_names, input_field_names, settle_scene
 
   integer(c_int), parameter :: status_too_small = 3   !< arrays too small: sizes needed returned
   !> Room for a message: whole for any message the core builds from the paths and texts it
@@ -52,14 +55,78 @@ contains
     names = joined(event_names)
   end subroutine event_kind_names
 
-  !> Read and check a scene file ('.dat': VisSim-style parameters; else a namelist). The
-  !> texts (title, f1_table, f2_table, method, substeps, events), kept whole whatever their length, come back
-  !> as character codes: text_codes(:text_lengths(k), k). When one is longer than
-  !> text_room, status is 3 and text_lengths say the room needed: call again with it.
-  subroutine read_scene(path, n, text_room, values, given, text_codes, text_lengths, status, message)
+  !> Names of every input field, space separated: field id k is the k-th word (the
+  !> tutorial's scalars, its texts, the arrays, r_meet, 'contact.a' ..., 'spring.a' ...:
+  !> impact1d_chain's numbering).
+  subroutine input_field_names(names)
+    character(len=2048), intent(out) :: names
+    character(len=16) :: words(n_ids)
+    integer :: id
+    do id = 1, n_ids
+      words(id) = field_name(id)
+    end do
+    names = joined(words)
+  end subroutine input_field_names
+
+  !> Read and check a scene file ('.dat': VisSim-style parameters; else a namelist) and give
+  !> it back as assignments: number k sets field(k) (input_field_names' numbering) at index(k)
+  !> (0 for a scalar, the element of an array, the record of a record field) to value(k);
+  !> text k sets text_field(k) at text_index(k) to text_codes(:text_lengths(k), k). A scene
+  !> of one or two bodies comes back in the tutorial's scalars. When there are more numbers
+  !> or texts than max_numbers, max_texts, or a text longer than text_room, status is 3 and
+  !> n_numbers, n_texts, text_lengths say the room needed: call again with it.
+  subroutine read_scene(path, max_numbers, max_texts, text_room, field, index, value, text_field, text_index, &
+      text_codes, text_lengths, n_numbers, n_texts, status, message)
     !f2py threadsafe
     character(len=*), intent(in) :: path
-    integer(c_int), intent(in) :: n, text_room
+    integer(c_int), intent(in) :: max_numbers, max_texts, text_room
+    integer(c_int), intent(out) :: field(max_numbers), index(max_numbers), text_field(max_texts), &
+      text_index(max_texts), text_codes(text_room, max_texts), text_lengths(max_texts)
+    real(c_double), intent(out) :: value(max_numbers)
+    integer(c_int), intent(out) :: n_numbers, n_texts, status
+    character(len=512), intent(out) :: message
+    type(scene_input) :: input
+    type(error_type), allocatable :: error
+    type(text_item) :: texts(max_texts)
+    integer :: fields(max_numbers), indices(max_numbers), k
+    real(wp) :: values(max_numbers)
+
+    field = 0; index = 0; value = 0.0_c_double; text_field = 0; text_index = 0
+    text_codes = ichar(' '); text_lengths = 0; n_numbers = 0; n_texts = 0
+    call read_scene_file(path, input, error)
+    if (failed(error, status, message)) return
+    call scene_assignments(input, fields, indices, values, k, text_field, text_index, texts, n_texts)
+    n_numbers = k
+    k = min(n_numbers, max_numbers)
+    field(:k) = fields(:k)
+    index(:k) = indices(:k)
+    value(:k) = real(values(:k), c_double)
+    do k = 1, min(n_texts, max_texts)
+      text_lengths(k) = len(texts(k)%s)
+      call put_codes(texts(k)%s, text_codes(:, k))
+    end do
+    if (n_numbers > max_numbers .or. n_texts > max_texts .or. any(text_lengths > text_room)) then
+      status = status_too_small
+      message = 'internal: the assignment arrays are too small'
+    end if
+  end subroutine read_scene
+
+  !> A scene given as assignments (read_scene's form; texts as one blob, text k ending at
+  !> text_end(k)), checked as a file's is, in the tutorial's flat fields (simulate's): values,
+  !> given and the texts (text_codes(:text_lengths(k), k), in field_names' order) of a scene
+  !> of one or two bodies without records.
+  !> Arrays of one or two bodies fold into the tutorial's fields; a scene that needs the
+  !> N-body engine is an input error (status 1) until the engine has records.
+  subroutine settle_scene(n_numbers, n_texts, number_room, field, index, value, text_room_in, text_field, &
+      text_index, text_end, text_blob, n, text_room, values, given, text_codes, text_lengths, status, message)
+    !f2py threadsafe
+    ! (the arrays are number_room, text_room_in >= 1 long, the counts given apart: f2py
+    ! refuses arrays of no element)
+    integer(c_int), intent(in) :: n_numbers, n_texts, number_room, text_room_in, n, text_room
+    integer(c_int), intent(in) :: field(number_room), index(number_room), text_field(text_room_in), &
+      text_index(text_room_in), text_end(text_room_in)
+    real(c_double), intent(in) :: value(number_room)
+    character(len=*), intent(in) :: text_blob
     real(c_double), intent(out) :: values(n)
     integer(c_int), intent(out) :: given(n)
     integer(c_int), intent(out) :: text_codes(text_room, 6)    ! 6: n_text (f2py needs the number)
@@ -68,14 +135,43 @@ contains
     character(len=16384), intent(out) :: message    ! 16384: message_length (f2py needs the number)
     type(scene_input) :: input
     type(error_type), allocatable :: error
-    integer :: k
+    integer :: k, start
 
     values = 0.0_c_double
     given = 0
     text_codes = ichar(' ')
     text_lengths = 0
     if (.not. field_count_ok(n, status, message)) return
-    call read_scene_file(path, input, error)
+    if (n_numbers > number_room .or. n_texts > text_room_in) then
+      status = status_input
+      message = 'internal: more assignments counted than given'
+      return
+    end if
+    ! (an array's element or a record is counted from 1; a scalar's index is 0)
+    if (any(field(:n_numbers) < 1 .or. field(:n_numbers) > n_ids .or. index(:n_numbers) < 0 .or. &
+        (field(:n_numbers) > id_arrays .and. field(:n_numbers) /= id_r_meet .and. index(:n_numbers) < 1)) .or. &
+        any(text_field(:n_texts) < 1 .or. text_field(:n_texts) > n_ids .or. &
+        (text_field(:n_texts) > id_arrays .and. text_index(:n_texts) < 1)) .or. &
+        any(text_end(:n_texts) < 0 .or. text_end(:n_texts) > len(text_blob))) then
+      status = status_input
+      message = 'internal: a field id, index or text end out of range'
+      return
+    end if
+    do k = 1, n_text
+      call set_text(input, k, '')
+    end do
+    do k = 1, n_numbers
+      call assign_number(input, field(k), index(k), real(value(k), wp))
+    end do
+    start = 1
+    do k = 1, n_texts
+      call assign_text(input, text_field(k), text_index(k), text_blob(start:text_end(k)))
+      start = text_end(k) + 1
+    end do
+    call settle_chain(input, error)
+    if (.not. allocated(error)) call validate(input, .false., error)
+    if (.not. allocated(error)) call validate_chain(input, error)
+    if (.not. allocated(error) .and. is_nbody(input)) call raise(error, status_input, nbody_refusal)
     if (failed(error, status, message)) return
     values = real(input%value, c_double)
     given = merge(1_c_int, 0_c_int, input%given)
@@ -87,7 +183,7 @@ contains
       status = status_too_small
       message = 'internal: the text buffers are too small'
     end if
-  end subroutine read_scene
+  end subroutine settle_scene
 
   !> Check and run a scene given as flat fields. The samples fill samples(:n_samples, :) and
   !> the events the event arrays up to n_events; when either needs more room than the caller

@@ -9,19 +9,26 @@ module impact1d_io
     i_d_min, i_d_max, i_x1, i_x2, i_v1, i_v2, i_f1, i_f2, i_title, i_f1_table, i_f2_table, i_method, &
     i_substeps, i_events
   use impact1d_forcing, only: table_type
+  use impact1d_fields, only: n_arrays, array_names, array_groups, array_is_text, n_contact_fields, contact_fields, &
+    n_spring_fields, spring_fields, r_name, record_input, text_item
+  use impact1d_chain, only: settle_chain, validate_chain, id_arrays, id_r_meet, id_contact, id_spring, n_ids
   use impact1d_files, only: check_input_file
   implicit none
   private
   public :: read_scene_file, prepare_scene, read_table, lower
 
-  character(len=*), parameter :: known_groups(8) = [character(len=7) :: &
-    'scene', 'bodies', 'walls', 'link', 'initial', 'forces', 'springs', 'run']
+  character(len=*), parameter :: known_groups(10) = [character(len=7) :: &
+    'scene', 'bodies', 'walls', 'link', 'initial', 'forces', 'springs', 'run', 'contact', 'spring']
+  !> The groups that may be given any number of times, each occurrence a record.
+  integer, parameter :: g_contact = 9, g_spring = 10
   !> Each group's variables: which group a name belongs to, and the message about a misspelt one.
   character(len=*), parameter :: group_variables(size(known_groups)) = [character(len=112) :: &
     'title', 'm1, m2, mu1, mu2, mus1, mus2, g', 'x_left, r_left, x_right, r_right', 'd_min, r_min, d_max, r_max', &
     'x1, v1, x2, v2', 'f1, f2, f1_table, f2_table, f1_amp, f1_period, f1_phase, f2_amp, f2_period, f2_phase', &
     'k1, x1_rest, c1, k2, x2_rest, c2, k12, d_rest, c12', &
-    't_end, dt, dt_out, method, zero_vel, max_rows, max_impulses, max_step_events, substeps, events, max_events']
+    't_end, dt, dt_out, method, zero_vel, max_rows, max_impulses, max_step_events, substeps, events, max_events', &
+    'a, b, d_min, r_min, d_max, r_max, name', 'a, b, k, d_rest, c']
+
   !> The tutorial's parameter files list these, in its Table 1 order; g is 10 there.
   integer, parameter :: dat_order(17) = [i_m1, i_m2, i_mu1, i_r_left, i_r_right, i_r_min, &
     i_r_max, i_x_left, i_x_right, i_d_min, i_d_max, i_x1, i_x2, i_v1, i_v2, i_f1, i_f2]
@@ -30,6 +37,8 @@ module impact1d_io
   character(len=*), parameter :: name_chars = letters // '0123456789_'
   !> What read_numbers found: every number, text that is not numbers, or a value missing.
   integer, parameter :: number_ok = 0, number_malformed = 1, number_null = 2
+  !> The largest repeat count of a list ('r*c'): no scene has a million bodies.
+  integer, parameter :: max_repeat = 1000000
 
   !> A namelist file while it is parsed: its text (join_lines) and where each line starts,
   !> the group open (0: none), the line of each group and of each variable given (0: none).
@@ -38,7 +47,7 @@ module impact1d_io
     integer, allocatable :: starts(:)
     integer :: open_group = 0
     integer :: group_line(size(known_groups)) = 0
-    integer :: given_line(n_real + n_text) = 0
+    integer :: given_line(n_ids) = 0
   end type namelist_text
 
 contains
@@ -69,7 +78,9 @@ contains
     end if
     if (allocated(error)) return
     input%source = trim(path)
-    call validate(input, .false., error)
+    call settle_chain(input, error)
+    if (.not. allocated(error)) call validate(input, .false., error)
+    if (.not. allocated(error)) call validate_chain(input, error)
     if (allocated(error)) error%message = trim(path) // ': ' // error%message
   end subroutine read_scene_file
 
@@ -192,7 +203,7 @@ contains
     end if
     j = j + k - 1
     if (nml%flat(j:j) == '&' .or. nml%flat(j:j) == '$') then
-      call group_mark(nml, j, error)
+      call group_mark(nml, j, input, error)
     else if (nml%open_group == 0) then
       line = line_at(nml, j)
       call raise(error, status_input, nml%path // ':' // trim(fmt(line)) // ': text outside any group: ''' // &
@@ -206,9 +217,10 @@ contains
   end subroutine next_item
 
   !> '&name' (or '$name') at j: a group opens, or '&end' closes the open one.
-  subroutine group_mark(nml, j, error)
+  subroutine group_mark(nml, j, input, error)
     type(namelist_text), intent(inout) :: nml
     integer, intent(inout) :: j
+    type(scene_input), intent(inout) :: input
     type(error_type), allocatable, intent(inout) :: error
     character(len=:), allocatable :: name
     integer :: finish, group, k, line
@@ -232,7 +244,14 @@ contains
     end do
     if (group == 0) then
       call raise(error, status_input, nml%path // ':' // trim(fmt(line)) // ': unknown group &' // name // &
-        ' (groups: &scene &bodies &walls &link &initial &forces &springs &run)')
+        ' (groups: &scene &bodies &walls &link &initial &forces &springs &run, and as often as wanted ' // &
+        '&contact &spring)')
+    else if (group == g_contact .or. group == g_spring) then
+      ! Each occurrence is a record of its own; "given twice" applies within it.
+      call new_record(input, group == g_contact, line)
+      nml%given_line(id_contact + 1:) = 0
+      nml%group_line(group) = line
+      nml%open_group = group
     else if (nml%group_line(group) > 0) then
       call raise(error, status_input, nml%path // ':' // trim(fmt(line)) // ': the group &' // name // &
         ' is given twice (lines ' // trim(fmt(nml%group_line(group))) // ' and ' // trim(fmt(line)) // ')')
@@ -259,7 +278,8 @@ contains
     if (field == 0) then
       k = scan(nml%flat(j:) // ' ', ' ,;=/')
       call raise(error, status_input, context // 'unknown variable ''' // nml%flat(j:j + k - 2) // ''' (&' // &
-        trim(known_groups(nml%open_group)) // ' has: ' // trim(group_variables(nml%open_group)) // ')')
+        trim(known_groups(nml%open_group)) // ' has: ' // trim(group_variables(nml%open_group)) // ')' // &
+        trim(arrays_of(nml%open_group)))
       return
     end if
     k = verify(nml%flat(finish + 1:) // '=', ' ') + finish
@@ -313,10 +333,11 @@ contains
         if (index(letters, flat(e + 1:e + 1)) > 0) return
       end if
       if (boundary .and. index(letters, c) > 0) then
-        if (after_comma) return
         finish = name_end(flat, e)
         next = verify(flat(finish + 1:) // '=', ' ') + finish
         if (is_at(flat, next, '=')) return
+        ! (an array's NaN or Inf after a comma is one of its items, not a name)
+        if (after_comma .and. .not. any(lower(flat(e:finish)) == ['nan     ', 'inf     ', 'infinity'])) return
         if (field_index(lower(flat(e:finish)), group) > 0) return
       end if
       if (c == '''' .or. c == '"') quote = c
@@ -330,52 +351,269 @@ contains
     e = len(flat) + 1
   end function value_end
 
-  !> Put one variable's value into the input: a real must be one number, a text quoted.
+  !> Put one variable's value into the input: a real must be one number, a text quoted,
+  !> an array a list of them (repeat counts 'r*c' allowed, nulls not), a record's field
+  !> into the record open.
   subroutine take_value(path, field, name, value, input, error)
     character(len=*), intent(in) :: path, name, value
     integer, intent(in) :: field
     type(scene_input), intent(inout) :: input
     type(error_type), allocatable, intent(inout) :: error
     character(len=:), allocatable :: text
-    real(wp) :: number(1)
-    integer :: status
-    logical :: ok
-    ! In a namelist a comma always separates: '0,5' is not one number.
-    status = number_malformed
-    if (field <= n_real .and. scan(value, ',;') == 0) call read_numbers(value, number, status)
+    real(wp) :: number
+    integer :: j
     if (len(value) == 0) then
       call raise(error, status_input, name // ' has no value (write ' // name // ' = ...)')
-    else if (status == number_null .or. (value(len(value):) == '*' .and. &
-        verify(value(:len(value) - 1), '0123456789') == 0)) then
+    else if (value(len(value):) == '*' .and. verify(value(:len(value) - 1), '0123456789') == 0) then
       ! 'r*' alone, a repeat count of nothing, is a null.
       call raise(error, status_input, name // ' = ' // value // ' has no value (a null: write ' // name // ' = ...)')
-    else if (field <= n_real .and. (value == '+' .or. value == '-')) then
-      call raise(error, status_input, '''' // name // ' = ' // value // ''' has no number after its sign')
-    else if (status == number_malformed .and. field <= n_real) then
-      if (decimal_comma(value)) then
-        call raise(error, status_input, name // ' = ''' // value // ''' is not a number (a decimal comma? ' // &
-          'write a point)')
-      else
-        call raise(error, status_input, name // ' = ''' // value // ''' is not a number')
-      end if
+    else if (field <= n_real .and. shared_array(name) > 0 .and. several(value)) then
+      call take_array(path, shared_array(name), name, value, input, error)
     else if (field <= n_real) then
-      input%value(field) = number(1)
+      call read_scalar(name, value, number, error)
+      if (allocated(error)) return
+      input%value(field) = number
       input%given(field) = .true.
-    else
-      call unquote(value, text, ok)
-      if (.not. ok) then
-        call raise(error, status_input, name // ' = ' // value // ' is not one quoted text (write ' // name // &
-          ' = ''...'')')
-      else if (any(field - n_real == [i_method, i_substeps, i_events])) then
-        ! Keywords, in any letter case.
-        call set_text(input, field - n_real, lower(text))
-      else if (field - n_real == i_title) then
+    else if (field <= id_arrays) then
+      call read_text(name, value, text, error)
+      if (allocated(error)) return
+      if (field - n_real == i_title) then
         call set_text(input, i_title, text)
       else
-        call set_text(input, field - n_real, trim(beside(path, text)))
+        call set_text(input, field - n_real, trim(resolved_text(path, field - n_real, text)))
+      end if
+    else if (field < id_r_meet) then
+      call take_array(path, field - id_arrays, name, value, input, error)
+    else if (field == id_r_meet) then
+      call read_scalar(name, value, input%chain%r_meet, error)
+      input%chain%has_r_meet = .true.
+    else
+      j = field - id_contact
+      if (j > n_contact_fields) then
+        call take_record_field(name, value, j - n_contact_fields, input%chain%springs, error)
+      else
+        call take_record_field(name, value, j, input%chain%contacts, error)
       end if
     end if
   end subroutine take_value
+
+  !> One number: 'name = 'value' is not a number' (with a hint for a decimal comma) else.
+  subroutine read_scalar(name, value, number, error)
+    character(len=*), intent(in) :: name, value
+    real(wp), intent(out) :: number
+    type(error_type), allocatable, intent(inout) :: error
+    real(wp) :: numbers(1)
+    integer :: status
+    ! In a namelist a comma always separates: '0,5' is not one number.
+    status = number_malformed
+    number = 0.0_wp
+    if (scan(value, ',;') == 0) call read_numbers(value, numbers, status)
+    if (status == number_null) then
+      call raise(error, status_input, name // ' = ' // value // ' has no value (a null: write ' // name // ' = ...)')
+    else if (value == '+' .or. value == '-') then
+      call raise(error, status_input, '''' // name // ' = ' // value // ''' has no number after its sign')
+    else if (status == number_malformed .and. decimal_comma(value)) then
+      call raise(error, status_input, name // ' = ''' // value // ''' is not a number (a decimal comma? ' // &
+        'write a point)')
+    else if (status == number_malformed) then
+      call raise(error, status_input, name // ' = ''' // value // ''' is not a number')
+    else
+      number = numbers(1)
+    end if
+  end subroutine read_scalar
+
+  !> One quoted text.
+  subroutine read_text(name, value, text, error)
+    character(len=*), intent(in) :: name, value
+    character(len=:), allocatable, intent(out) :: text
+    type(error_type), allocatable, intent(inout) :: error
+    logical :: ok
+    call unquote(value, text, ok)
+    if (.not. ok) call raise(error, status_input, name // ' = ' // value // ' is not one quoted text (write ' // &
+      name // ' = ''...'')')
+  end subroutine read_text
+
+  !> Text field i (not the title) as kept: keywords in lower case (any letter case is read),
+  !> paths relative to the scene file's folder.
+  pure function resolved_text(path, i, text) result(kept)
+    character(len=*), intent(in) :: path, text
+    integer, intent(in) :: i
+    character(len=len(path) + len(text)) :: kept     ! blank padded: callers trim
+    if (any(i == [i_method, i_substeps, i_events])) then
+      kept = lower(text)
+    else
+      kept = beside(path, text)
+    end if
+  end function resolved_text
+
+  !> An array's value: a list of numbers or quoted texts (r*c: c repeated r times), no null.
+  subroutine take_array(path, j, name, value, input, error)
+    character(len=*), intent(in) :: path, name, value
+    integer, intent(in) :: j
+    type(scene_input), intent(inout) :: input
+    type(error_type), allocatable, intent(inout) :: error
+    type(text_item), allocatable :: items(:)
+    character(len=:), allocatable :: text
+    character(len=32) :: spelled
+    integer :: k
+    logical :: null
+    call split_items(value, items, null)
+    if (null) then
+      call raise(error, status_input, name // ' = ' // value // ' has a null (an empty item or ''r*'' with ' // &
+        'no value): write every value')
+      return
+    end if
+    associate (array => input%chain%array(j))
+      array%n = size(items)
+      if (array_is_text(j)) then
+        allocate(array%t(size(items)))
+      else
+        allocate(array%v(size(items)))
+      end if
+      do k = 1, size(items)
+        ! (an item's error names it as name(k))
+        write(spelled, '(a, "(", i0, ")")') name, k
+        if (array_is_text(j)) then
+          call read_text(trim(spelled), items(k)%s, text, error)
+          if (.not. allocated(error)) array%t(k)%s = trim(resolved_text(path, i_f1_table, text))
+        else
+          call read_scalar(trim(spelled), items(k)%s, array%v(k), error)
+        end if
+        if (allocated(error)) return
+      end do
+    end associate
+  end subroutine take_array
+
+  !> Field f of the record open (the last of records): a number, or the contact's name.
+  subroutine take_record_field(name, value, f, records, error)
+    character(len=*), intent(in) :: name, value
+    integer, intent(in) :: f
+    type(record_input), intent(inout) :: records(:)
+    type(error_type), allocatable, intent(inout) :: error
+    character(len=:), allocatable :: text
+    associate (rec => records(size(records)))
+      if (f == r_name .and. name == 'name') then
+        call read_text(name, value, text, error)
+        if (allocated(error)) return
+        rec%name = text
+        rec%given(f) = .true.
+      else
+        call read_scalar(name, value, rec%value(f), error)
+        rec%given(f) = .not. allocated(error)
+      end if
+    end associate
+  end subroutine take_record_field
+
+  !> A &contact (contact true) or &spring record opens at line.
+  pure subroutine new_record(input, contact, line)
+    type(scene_input), intent(inout) :: input
+    logical, intent(in) :: contact
+    integer, intent(in) :: line
+    type(record_input) :: rec
+    rec%line = line
+    if (contact) then
+      if (.not. allocated(input%chain%contacts)) allocate(input%chain%contacts(0))
+      input%chain%contacts = [input%chain%contacts, rec]
+    else
+      if (.not. allocated(input%chain%springs)) allocate(input%chain%springs(0))
+      input%chain%springs = [input%chain%springs, rec]
+    end if
+  end subroutine new_record
+
+  !> The items of a list: apart by commas, semicolons or blanks, outside quotes; 'r*c' is
+  !> c r times. null: an empty item (two commas, a comma first or last) or 'r*' alone.
+  pure subroutine split_items(value, items, null)
+    character(len=*), intent(in) :: value
+    type(text_item), allocatable, intent(out) :: items(:)
+    logical, intent(out) :: null
+    integer :: k, finish, star, repeat, ios, r
+    logical :: expect
+    allocate(items(0))
+    null = .false.
+    expect = .true.
+    k = 1
+    do while (k <= len(value))
+      if (value(k:k) == ' ') then
+        k = k + 1
+      else if (scan(value(k:k), ',;') > 0) then
+        null = null .or. expect
+        expect = .true.
+        k = k + 1
+      else
+        finish = item_end(value, k)
+        star = index(value(k:finish), '*')
+        repeat = 1
+        if (star > 1 .and. verify(value(k:k + star - 2), '0123456789') == 0) then
+          ! (a count beyond max_repeat stays in the item, which is then not a number)
+          read(value(k:k + star - 2), '(i20)', iostat=ios) repeat
+          if (ios == 0 .and. repeat >= 1 .and. repeat <= max_repeat) then
+            null = null .or. k + star > finish
+            k = k + star
+          else
+            repeat = 1
+          end if
+        end if
+        do r = 1, repeat
+          items = [items, text_item(value(k:finish))]
+        end do
+        expect = .false.
+        k = finish + 1
+      end if
+    end do
+    null = null .or. (expect .and. size(items) > 0) .or. size(items) == 0
+  end subroutine split_items
+
+  !> The last position of the item that starts at k: before the next blank, comma or
+  !> semicolon outside quotes.
+  pure integer function item_end(value, k)
+    character(len=*), intent(in) :: value
+    integer, intent(in) :: k
+    character :: quote
+    quote = ' '
+    do item_end = k, len(value)
+      if (quote /= ' ') then
+        if (value(item_end:item_end) == quote) quote = ' '
+      else if (scan(value(item_end:item_end), ' ,;') > 0) then
+        exit
+      else if (scan(value(item_end:item_end), '''"') > 0) then
+        quote = value(item_end:item_end)
+      end if
+    end do
+    item_end = item_end - 1
+  end function item_end
+
+  !> Whether a value is a list (more than one item, or a repeat count) rather than a scalar.
+  pure logical function several(value)
+    character(len=*), intent(in) :: value
+    several = item_end(value, 1) < len(value) .or. index(value, '*') > 0
+  end function several
+
+  !> The array a tutorial name of &link or &springs also names (d_min is d_min(1)), else 0.
+  pure integer function shared_array(name)
+    character(len=*), intent(in) :: name
+    integer :: j
+    shared_array = 0
+    do j = 1, n_arrays
+      if (array_names(j) == name) shared_array = j
+    end do
+  end function shared_array
+
+  !> ' or, for N bodies, the arrays m, mu, mus' for a group that has arrays (for messages).
+  pure function arrays_of(group) result(text)
+    integer, intent(in) :: group
+    character(len=128) :: text     ! blank padded: callers trim
+    integer :: j
+    text = ''
+    do j = 1, n_arrays
+      if (array_groups(j) /= known_groups(group)) cycle
+      if (len_trim(text) == 0) then
+        text = ' or, for N bodies, the arrays ' // array_names(j)
+      else
+        text = trim(text) // ', ' // array_names(j)
+      end if
+    end do
+    if (known_groups(group) == 'link') text = trim(text) // ', r_meet'
+  end function arrays_of
 
   !> Every line of a file, as the records of an internal file (blank-padded to the longest).
   subroutine read_all_lines(path, lines, error)
@@ -426,21 +664,35 @@ contains
     name_end = verify(text(j:) // ' ', name_chars) + j - 2
   end function name_end
 
-  !> Variable `name` of group `group`: 1..n_real a real field, n_real + i text field i; 0
-  !> when the group has no such variable.
+  !> Variable `name` of group `group`: 1..n_real a real field, n_real + i text field i, then
+  !> the arrays, r_meet and the record fields (impact1d_chain's id_*); 0 when the group has no such variable.
   pure integer function field_index(name, group)
     character(len=*), intent(in) :: name
     integer, intent(in) :: group
     integer :: k
     field_index = 0
     if (len(name) == 0) return
-    if (index(', ' // trim(group_variables(group)) // ',', ', ' // name // ',') == 0) return
-    do k = 1, n_real
-      if (real_names(k) == name) field_index = k
-    end do
-    do k = 1, n_text
-      if (text_names(k) == name) field_index = n_real + k
-    end do
+    if (group == g_contact .or. group == g_spring) then
+      do k = 1, merge(n_contact_fields, n_spring_fields, group == g_contact)
+        if (group == g_contact .and. contact_fields(k) == name) field_index = id_contact + k
+        if (group == g_spring .and. spring_fields(k) == name) field_index = id_spring + k
+      end do
+      return
+    end if
+    if (index(', ' // trim(group_variables(group)) // ',', ', ' // name // ',') > 0) then
+      do k = 1, n_real
+        if (real_names(k) == name) field_index = k
+      end do
+      do k = 1, n_text
+        if (text_names(k) == name) field_index = n_real + k
+      end do
+    else if (name == 'r_meet' .and. known_groups(group) == 'link') then
+      field_index = id_r_meet
+    else
+      do k = 1, n_arrays
+        if (array_names(k) == name .and. array_groups(k) == known_groups(group)) field_index = id_arrays + k
+      end do
+    end if
   end function field_index
 
   !> The text inside one quoted string ('...' or "..."), a doubled quote read as one; ok is
@@ -508,11 +760,70 @@ contains
     extra = -1
     if (ios == 0) read(text, *, iostat=extra) again, surplus
     status = number_malformed
-    if (ios /= 0 .or. extra == 0) return
+    if (ios /= 0 .or. extra == 0 .or. .not. numbers_well_formed(text)) return
     status = number_null
     if (any(values == huge(1.0_wp) .and. again == -huge(1.0_wp))) return
     status = number_ok
   end subroutine read_numbers
+
+  !> Every item of a line of numbers is written as a Fortran number: digits with at most one
+  !> point, an exponent only after its letter (list-directed input reads '1+1' as 1e+1 =
+  !> 10), or NaN / Inf; a repeat count 'r*' before it, nulls and a '/' ending the line
+  !> are read_numbers' to judge.
+  pure logical function numbers_well_formed(text)
+    character(len=*), intent(in) :: text
+    integer :: k, finish, star
+    numbers_well_formed = .true.
+    k = 1
+    do while (k <= len(text))
+      if (scan(text(k:k), ' ,') > 0) then
+        k = k + 1
+        cycle
+      end if
+      if (text(k:k) == '/') return
+      finish = scan(text(k:) // ' ', ' ,/') + k - 2
+      star = index(text(k:finish), '*')
+      if (star > 0) then
+        if (star < finish - k + 1) numbers_well_formed = numbers_well_formed .and. &
+          well_formed_number(text(k + star:finish))
+      else
+        numbers_well_formed = numbers_well_formed .and. well_formed_number(text(k:finish))
+      end if
+      k = finish + 1
+    end do
+  end function numbers_well_formed
+
+  !> [sign] digits [. digits] | [sign] . digits, then [e|d [sign] digits]; or NaN, Inf,
+  !> Infinity (any letter case, signed).
+  pure logical function well_formed_number(item)
+    character(len=*), intent(in) :: item
+    character(len=*), parameter :: digits = '0123456789'
+    character(len=len(item)) :: low
+    integer :: k, first, mantissa_digits, e
+    low = lower(item)
+    first = 1
+    if (scan(low(1:1), '+-') > 0) first = 2
+    well_formed_number = any(low(first:) == ['nan     ', 'inf     ', 'infinity'])
+    if (well_formed_number .or. first > len(low)) return
+    e = scan(low(first:), 'ed') + first - 1
+    if (e < first) e = len(low) + 1
+    mantissa_digits = 0
+    do k = first, e - 1
+      if (index(digits, low(k:k)) > 0) mantissa_digits = mantissa_digits + 1
+    end do
+    ! The mantissa: digits and at most one point, at least one digit.
+    if (mantissa_digits == 0 .or. verify(low(first:e - 1), digits // '.') > 0 .or. &
+        count([(low(k:k) == '.', k = first, e - 1)]) > 1) return
+    if (e <= len(low)) then
+      k = e + 1
+      if (k <= len(low)) then
+        if (scan(low(k:k), '+-') > 0) k = k + 1
+      end if
+      if (k > len(low)) return
+      if (verify(low(k:), digits) > 0) return
+    end if
+    well_formed_number = .true.
+  end function well_formed_number
 
   !> The tutorial's parameter file: 17 numbers, one per line, '#' starts a comment; an
   !> optional 18th entry names a table added to f1 (the tutorial's triangle.dat button).

@@ -8,6 +8,7 @@ module impact1d_scene
   use impact1d_forcing, only: forcing_type, table_type
   use impact1d_springs, only: springs_type, n_elements
   use impact1d_modes, only: pair_type
+  use impact1d_fields, only: chain_input
   use impact1d_stability, only: linear_modes, stable_step, mode_error, coarse_rate
   implicit none
   private
@@ -17,7 +18,8 @@ module impact1d_scene
     i_r_min, i_d_max, i_r_max, i_x1, i_v1, i_x2, i_v2, i_f1, i_f2, i_f1_amp, i_f1_period, &
     i_f1_phase, i_f2_amp, i_f2_period, i_f2_phase, i_t_end, i_dt, i_dt_out, i_mus1, i_mus2, &
     i_k1, i_x1_rest, i_c1, i_k2, i_x2_rest, i_c2, i_k12, i_d_rest, i_c12, i_max_events
-  public :: sample_time, set_text, events_kept
+  public :: sample_time, set_text, events_kept, name_of, is_nbody, value_or, nbody_refusal
+  public :: positive_value, nonnegative_value, unit_interval, resolvable
   public :: i_title, i_f1_table, i_f2_table, i_method, i_substeps, i_events, default_gravity
   public :: events_all, events_impacts, events_none
 
@@ -62,6 +64,9 @@ module impact1d_scene
     [1.0_wp, 0.0_wp, -1.0_wp, 0.0_wp, -1.0_wp, 1.0_wp, 1.0_wp, -1.0_wp], [2, n_contacts])
 
   real(wp), parameter :: default_gravity = 9.80665_wp
+  !> What a scene that needs the N-body engine gets until the engine has records (is_nbody).
+  character(len=*), parameter :: nbody_refusal = 'scenes of more than two bodies, and &contact or &spring ' // &
+    'records, need the N-body engine (issue 19, stage 2-4): this build reads and checks them but cannot run them yet'
   !> The tutorial's zero-velocity threshold, used by the vissim method only.
   real(wp), parameter :: default_zero_velocity = 0.005_wp
   !> Output rows a run may produce: beyond this the user almost surely meant a larger dt_out.
@@ -94,6 +99,10 @@ module impact1d_scene
     logical :: given(n_real) = .false.
     type(scene_text) :: text(n_text)
     character(len=:), allocatable :: source
+    !> The name written for value i when it is not real_names(i): 'm(2)' from 'm = 1.0, 2.0'.
+    character(len=16) :: spelled(n_real) = ''
+    !> Arrays of more than two bodies and &contact / &spring records (impact1d_fields).
+    type(chain_input) :: chain
   end type scene_input
 
   !> The checked model: the constant part of a run (what changes is impact1d_state's), as
@@ -142,7 +151,6 @@ contains
     logical, intent(in) :: require_run
     type(error_type), allocatable, intent(out) :: error
     integer :: k
-    real(wp) :: gap, scale, nrm(2, n_contacts), rows, limit
 
     do k = 1, n_text
       if (.not. allocated(input%text(k)%s)) then
@@ -152,11 +160,34 @@ contains
     end do
     do k = 1, n_real
       if (input%given(k) .and. .not. ieee_is_finite(input%value(k))) then
-        call raise(error, status_input, trim(real_names(k)) // ' = ' // trim(fmt(input%value(k))) // &
+        call raise(error, status_input, trim(name_of(input, k)) // ' = ' // trim(fmt(input%value(k))) // &
           ' is not a finite number')
         return
       end if
     end do
+    if (input%chain%n_bodies > 2) then
+      ! The bodies and links are impact1d_chain's to check (validate_chain), as are the
+      ! records of any scene.
+      if (require_run) call require(input, [i_t_end, i_dt], error)
+      call nonnegative(input, i_zero_vel, error)
+      call run_limits(input, error)
+      call restitution(input, i_r_left, i_x_left, error); call restitution(input, i_r_right, i_x_right, error)
+      call walls_ordered(input, error)
+    else
+      call validate_bodies(input, require_run, error)
+    end if
+    if (allocated(error)) return
+    call validate_run(input, error)
+  end subroutine validate
+
+  !> The checks of a one- or two-body scene written with the tutorial's names.
+  subroutine validate_bodies(input, require_run, error)
+    type(scene_input), intent(in) :: input
+    logical, intent(in) :: require_run
+    type(error_type), allocatable, intent(inout) :: error
+    integer :: k
+    real(wp) :: gap, scale, nrm(2, n_contacts)
+
     ! Without m2 the scene has one body, and nothing may name the second.
     call require(input, [i_m1, i_x1], error)
     if (allocated(error)) return
@@ -165,7 +196,7 @@ contains
     else
       do k = 1, size(body2_fields)
         if (input%given(body2_fields(k))) then
-          call raise(error, status_input, trim(real_names(body2_fields(k))) // ' is given but m2 is not: ' // &
+          call raise(error, status_input, trim(name_of(input, body2_fields(k))) // ' is given but m2 is not: ' // &
             'a scene without m2 has one body (give m2 for a second one)')
           return
         end if
@@ -193,9 +224,9 @@ contains
     if (allocated(error)) return
     do k = 0, 1
       if (input%given(i_mus1 + k) .and. input%value(i_mus1 + k) < value_or(input, i_mu1 + k, 0.0_wp)) then
-        call raise(error, status_input, trim(real_names(i_mus1 + k)) // ' = ' // &
+        call raise(error, status_input, trim(name_of(input, i_mus1 + k)) // ' = ' // &
           trim(fmt(input%value(i_mus1 + k))) // &
-          ' is below ' // trim(real_names(i_mu1 + k)) // ' = ' // trim(fmt(value_or(input, i_mu1 + k, 0.0_wp))) // &
+          ' is below ' // trim(name_of(input, i_mu1 + k)) // ' = ' // trim(fmt(value_or(input, i_mu1 + k, 0.0_wp))) // &
           ': static friction is at least the sliding friction')
         return
       end if
@@ -204,19 +235,16 @@ contains
     do k = 1, n_elements
       if (input%given(spring_index(k)) .neqv. input%given(spring_index(k) + 1)) then
         if (input%given(spring_index(k))) then
-          call raise(error, status_input, trim(real_names(spring_index(k))) // ' is given but ' // &
-            trim(real_names(spring_index(k) + 1)) // ' is not: a spring needs its rest position')
+          call raise(error, status_input, trim(name_of(input, spring_index(k))) // ' is given but ' // &
+            trim(name_of(input, spring_index(k) + 1)) // ' is not: a spring needs its rest position')
         else
-          call raise(error, status_input, trim(real_names(spring_index(k) + 1)) // ' is given but ' // &
-            trim(real_names(spring_index(k))) // ' is not: a rest position needs its spring')
+          call raise(error, status_input, trim(name_of(input, spring_index(k) + 1)) // ' is given but ' // &
+            trim(name_of(input, spring_index(k))) // ' is not: a rest position needs its spring')
         end if
         return
       end if
     end do
-    call count_limit(input, i_max_rows, error)
-    call count_limit(input, i_max_impulses, error)
-    call count_limit(input, i_max_step_events, error)
-    call count_limit(input, i_max_events, error)
+    call run_limits(input, error)
     if (allocated(error)) return
     if (input%given(i_g) .and. input%value(i_g) < 0.0_wp .and. (value_or(input, i_mu1, 0.0_wp) > 0.0_wp &
         .or. value_or(input, i_mu2, 0.0_wp) > 0.0_wp .or. value_or(input, i_mus1, 0.0_wp) > 0.0_wp .or. &
@@ -227,14 +255,8 @@ contains
     end if
     call restitution(input, i_r_left, i_x_left, error); call restitution(input, i_r_right, i_x_right, error)
     call restitution(input, i_r_min, i_d_min, error); call restitution(input, i_r_max, i_d_max, error)
+    call walls_ordered(input, error)
     if (allocated(error)) return
-    if (input%given(i_x_left) .and. input%given(i_x_right)) then
-      if (input%value(i_x_left) >= input%value(i_x_right)) then
-        call raise(error, status_input, 'x_left = ' // trim(fmt(input%value(i_x_left))) // &
-          ' must be less than x_right = ' // trim(fmt(input%value(i_x_right))))
-        return
-      end if
-    end if
     if (input%given(i_d_max) .and. .not. input%given(i_d_min) .and. input%value(i_d_max) < 0.0_wp) then
       call raise(error, status_input, 'd_max = ' // trim(fmt(input%value(i_d_max))) // ' is negative, but ' // &
         'without d_min the bodies meet at x2 = x1 (d_min = 0): give d_min to let them pass')
@@ -265,7 +287,7 @@ contains
         if (input%given(limit_index(k))) then
           call raise(error, status_input, 'the initial state ' // trim(initial_positions(input)) // &
             ' violates the ' // &
-            trim(contact_names(k)) // ' constraint (' // trim(real_names(limit_index(k))) // ' = ' // &
+            trim(contact_names(k)) // ' constraint (' // trim(name_of(input, limit_index(k))) // ' = ' // &
             trim(fmt(limit_value(input, k))) // ')')
         else
           call raise(error, status_input, 'the initial state ' // trim(initial_positions(input)) // &
@@ -297,12 +319,19 @@ contains
         if (.not. input%given(i)) cycle
         if (input%value(i) * input%value(i_m1 + mod(k, 2)) * abs(value_or(input, i_g, default_gravity)) > &
             huge(1.0_wp)) then
-          call raise(error, status_input, trim(real_names(i)) // ' = ' // trim(fmt(input%value(i))) // &
+          call raise(error, status_input, trim(name_of(input, i)) // ' = ' // trim(fmt(input%value(i))) // &
             ': the friction bound mu m g overflows')
           return
         end if
       end associate
     end do
+  end subroutine validate_bodies
+
+  !> The checks of &run (and of overrides of its values).
+  subroutine validate_run(input, error)
+    type(scene_input), intent(in) :: input
+    type(error_type), allocatable, intent(inout) :: error
+    real(wp) :: rows, limit
 
     if (input%given(i_t_end)) then
       if (input%value(i_t_end) <= 0.0_wp) then
@@ -354,7 +383,45 @@ contains
         return
       end if
     end if
-  end subroutine validate
+  end subroutine validate_run
+
+  !> The work limits of &run, each when given.
+  subroutine run_limits(input, error)
+    type(scene_input), intent(in) :: input
+    type(error_type), allocatable, intent(inout) :: error
+    call count_limit(input, i_max_rows, error)
+    call count_limit(input, i_max_impulses, error)
+    call count_limit(input, i_max_step_events, error)
+    call count_limit(input, i_max_events, error)
+  end subroutine run_limits
+
+  !> The left wall is left of the right one.
+  subroutine walls_ordered(input, error)
+    type(scene_input), intent(in) :: input
+    type(error_type), allocatable, intent(inout) :: error
+    if (allocated(error) .or. .not. (input%given(i_x_left) .and. input%given(i_x_right))) return
+    if (input%value(i_x_left) >= input%value(i_x_right)) call raise(error, status_input, 'x_left = ' // &
+      trim(fmt(input%value(i_x_left))) // ' must be less than x_right = ' // trim(fmt(input%value(i_x_right))))
+  end subroutine walls_ordered
+
+  !> The name the user wrote for value i: the tutorial's ('m2'), or the array element a
+  !> chain written for one or two bodies put there ('m(2)').
+  pure function name_of(input, i) result(name)
+    type(scene_input), intent(in) :: input
+    integer, intent(in) :: i
+    character(len=16) :: name     ! blank padded: callers trim
+    name = real_names(i)
+    if (len_trim(input%spelled(i)) > 0) name = input%spelled(i)
+  end function name_of
+
+  !> Whether the scene needs the N-body engine: more than two bodies (written as arrays),
+  !> or &contact / &spring records.
+  pure logical function is_nbody(input)
+    type(scene_input), intent(in) :: input
+    is_nbody = input%chain%n_bodies > 2
+    if (allocated(input%chain%contacts)) is_nbody = is_nbody .or. size(input%chain%contacts) > 0
+    if (allocated(input%chain%springs)) is_nbody = is_nbody .or. size(input%chain%springs) > 0
+  end function is_nbody
 
   !> What the event log of a run of this input keeps (&run events; all by default).
   pure integer function events_kept(input)
@@ -390,7 +457,7 @@ contains
     integer :: j
     do j = 1, size(indices)
       if (.not. input%given(indices(j))) then
-        call raise(error, status_input, trim(real_names(indices(j))) // ' is required but not given')
+        call raise(error, status_input, trim(name_of(input, indices(j))) // ' is required but not given')
         return
       end if
     end do
@@ -401,10 +468,17 @@ contains
     type(scene_input), intent(in) :: input
     type(error_type), allocatable, intent(inout) :: error
     integer, intent(in) :: i
-    if (allocated(error)) return
-    if (input%value(i) <= 0.0_wp) call raise(error, status_input, trim(real_names(i)) // ' = ' // &
-      trim(fmt(input%value(i))) // ' must be positive')
+    call positive_value(trim(name_of(input, i)), input%value(i), error)
   end subroutine positive
+
+  !> 'name = value must be positive' unless value > 0 (or an earlier check failed).
+  subroutine positive_value(name, value, error)
+    character(len=*), intent(in) :: name
+    real(wp), intent(in) :: value
+    type(error_type), allocatable, intent(inout) :: error
+    if (allocated(error)) return
+    if (value <= 0.0_wp) call raise(error, status_input, name // ' = ' // trim(fmt(value)) // ' must be positive')
+  end subroutine positive_value
 
   !> A work limit: a whole number from 1 to the largest default integer.
   subroutine count_limit(input, i, error)
@@ -413,7 +487,7 @@ contains
     integer, intent(in) :: i
     if (allocated(error) .or. .not. input%given(i)) return
     if (input%value(i) < 1.0_wp .or. input%value(i) > real(huge(1), wp) .or. &
-        input%value(i) /= aint(input%value(i))) call raise(error, status_input, trim(real_names(i)) // &
+        input%value(i) /= aint(input%value(i))) call raise(error, status_input, trim(name_of(input, i)) // &
       ' = ' // trim(fmt(input%value(i))) // ' must be a whole number from 1 to ' // trim(fmt(huge(1))))
   end subroutine count_limit
 
@@ -422,10 +496,27 @@ contains
     type(scene_input), intent(in) :: input
     type(error_type), allocatable, intent(inout) :: error
     integer, intent(in) :: i
-    if (allocated(error) .or. .not. input%given(i)) return
-    if (input%value(i) < 0.0_wp) call raise(error, status_input, trim(real_names(i)) // ' = ' // &
-      trim(fmt(input%value(i))) // ' must not be negative')
+    if (input%given(i)) call nonnegative_value(trim(name_of(input, i)), input%value(i), error)
   end subroutine nonnegative
+
+  !> 'name = value must not be negative' unless value >= 0 (or an earlier check failed).
+  subroutine nonnegative_value(name, value, error)
+    character(len=*), intent(in) :: name
+    real(wp), intent(in) :: value
+    type(error_type), allocatable, intent(inout) :: error
+    if (allocated(error)) return
+    if (value < 0.0_wp) call raise(error, status_input, name // ' = ' // trim(fmt(value)) // ' must not be negative')
+  end subroutine nonnegative_value
+
+  !> A restitution 'name = value' is in [0, 1] (unless an earlier check failed).
+  subroutine unit_interval(name, value, error)
+    character(len=*), intent(in) :: name
+    real(wp), intent(in) :: value
+    type(error_type), allocatable, intent(inout) :: error
+    if (allocated(error)) return
+    if (value < 0.0_wp .or. value > 1.0_wp) call raise(error, status_input, name // ' = ' // &
+      trim(fmt(value)) // ' is outside [0, 1]')
+  end subroutine unit_interval
 
   !> Restitution i, when given, is in [0, 1] and has its constraint (owner).
   subroutine restitution(input, i, owner, error)
@@ -433,13 +524,12 @@ contains
     type(error_type), allocatable, intent(inout) :: error
     integer, intent(in) :: i, owner
     if (allocated(error) .or. .not. input%given(i)) return
-    if (input%value(i) < 0.0_wp .or. input%value(i) > 1.0_wp) then
-      call raise(error, status_input, trim(real_names(i)) // ' = ' // trim(fmt(input%value(i))) // &
-        ' is outside [0, 1]')
-    else if (.not. input%given(owner) .and. i /= i_r_min) then
+    call unit_interval(trim(name_of(input, i)), input%value(i), error)
+    if (allocated(error)) return
+    if (.not. input%given(owner) .and. i /= i_r_min) then
       ! (r_min alone is the restitution of the bodies meeting: d_min = 0 by default.)
-      call raise(error, status_input, trim(real_names(i)) // ' is given but ' // &
-        trim(real_names(owner)) // ' is not: a restitution needs its constraint')
+      call raise(error, status_input, trim(name_of(input, i)) // ' is given but ' // &
+        trim(name_of(input, owner)) // ' is not: a restitution needs its constraint')
     end if
   end subroutine restitution
 
@@ -450,13 +540,13 @@ contains
     integer, intent(in) :: i_amp, i_period, i_phase
     if (allocated(error)) return
     if (input%given(i_amp) .neqv. input%given(i_period)) then
-      call raise(error, status_input, trim(real_names(i_amp)) // ' and ' // trim(real_names(i_period)) // &
+      call raise(error, status_input, trim(name_of(input, i_amp)) // ' and ' // trim(name_of(input, i_period)) // &
         ' go together: a sine force needs both')
     else if (input%given(i_phase) .and. .not. input%given(i_amp)) then
-      call raise(error, status_input, trim(real_names(i_phase)) // ' is given but ' // &
-        trim(real_names(i_amp)) // ' is not')
+      call raise(error, status_input, trim(name_of(input, i_phase)) // ' is given but ' // &
+        trim(name_of(input, i_amp)) // ' is not')
     else if (input%given(i_period)) then
-      if (input%value(i_period) <= 0.0_wp) call raise(error, status_input, trim(real_names(i_period)) // &
+      if (input%value(i_period) <= 0.0_wp) call raise(error, status_input, trim(name_of(input, i_period)) // &
         ' = ' // trim(fmt(input%value(i_period))) // ' must be positive')
     end if
   end subroutine sine_terms
@@ -508,6 +598,11 @@ contains
 
     call validate(input, .true., error)
     if (allocated(error)) return
+    ! The records of such a scene (impact1d_chain's input_records) wait for the engine's.
+    if (is_nbody(input)) then
+      call raise(error, status_input, nbody_refusal)
+      return
+    end if
 
     scene%title = trim(input%text(i_title)%s)
     scene%method = 'event'

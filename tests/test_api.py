@@ -67,8 +67,14 @@ def test_plot_is_reexported_lazily():
 def test_scene_fields_follow_the_core():
     reals, texts = impact1d._scene._api.field_names()
     names = [f.name for f in dataclasses.fields(impact1d.Scene)]
-    assert names == (impact1d._scene.decode(reals).split()
-                     + impact1d._scene.decode(texts).split() + ["source"])
+    # The tutorial's fields, source, then the N-body ones (arrays not already scalars,
+    # r_meet, the records), each an input field of the core's.
+    tutorial = impact1d._scene.decode(reals).split() + impact1d._scene.decode(texts).split()
+    assert names[:len(tutorial) + 1] == tutorial + ["source"]
+    inputs = impact1d._scene.decode(impact1d._scene._api.input_field_names()).split()
+    assert inputs[:len(tutorial)] == tutorial and tuple(inputs) == impact1d._scene.INPUT_FIELDS
+    assert set(names[len(tutorial) + 1:]) == (set(inputs[len(tutorial):]) - set(tutorial)
+                                              - {n for n in inputs if "." in n}) | {"contacts", "springs"}
     assert impact1d._scene.REAL_FIELDS[:28] == tuple(
         "m1 m2 mu1 mu2 g x_left r_left x_right r_right d_min r_min d_max r_max x1 v1 x2 v2 "
         "f1 f2 f1_amp f1_period f1_phase f2_amp f2_period f2_phase t_end dt dt_out".split())

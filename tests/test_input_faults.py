@@ -440,6 +440,37 @@ def test_decimal_comma_is_suggested(tmp_path):
             re.escape("in &bodies: m2 = '0,5' is not a number (a decimal comma?"))
 
 
+# --- numbers list-directed input took wrongly -------------------------------------------
+
+@pytest.mark.parametrize("value", ["1+1", "1.0.0", "2e", "1.5d", "1e+", "1-2"])
+def test_malformed_number_is_refused(tmp_path, value):
+    """'1+1' was read as 1e+1 = 10.0 (list-directed input takes a sign as the exponent)."""
+    refused(tmp_path, CASE3.replace("m1 = 1.0", "m1 = " + value),
+            re.escape(f"in &bodies: m1 = '{value}' is not a number"))
+
+
+def test_decimal_comma_in_a_scalar_is_still_suggested(tmp_path):
+    refused(tmp_path, CASE3.replace("m1 = 1.0", "m1 = 1,5"), re.escape("m1 = '1,5' is not a number (a decimal comma?"))
+
+
+def test_malformed_number_in_a_table_row(tmp_path):
+    """A table row '1+1 2' was the corner t = 10."""
+    (tmp_path / "t.dat").write_text("0 1\n1+1 2\n")
+    text = CASE3.replace("&forces  f1 = 0.0", "&forces  f1_table = 't.dat', f1 = 0.0")
+    with pytest.raises(impact1d.InputError, match=r"t\.dat:2: malformed row '1\+1 2'"):
+        impact1d.simulate(impact1d.load_scene(scene_file(tmp_path, text)), t_end=0.1, dt=1e-3)
+
+
+@pytest.mark.parametrize("value", ["1.0", "-9", "1.0e-3", "1.0d-3", "+.5", "5.", "1E+03", "NaN", "-Inf"])
+def test_well_formed_numbers_are_read(tmp_path, value):
+    text = CASE3.replace("&forces  f1 = 0.0", "&forces  f1 = " + value)
+    scene = impact1d.load_scene(scene_file(tmp_path, text)) if value[-1] not in "Nf" else None
+    if scene is not None:
+        assert scene.f1 == float(value.replace("d", "e"))
+    else:
+        refused(tmp_path, text, "is not a finite number")
+
+
 @pytest.mark.parametrize("row", [", 5", "0.5 ,", "1*", "0.5 /"])
 def test_malformed_table_row_is_named(tmp_path, row):
     """', 5' took the row before's time: "time 0.0 does not increase"."""

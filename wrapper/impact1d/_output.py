@@ -7,7 +7,7 @@ import os
 
 import numpy as np
 
-from ._scene import REAL_FIELDS, TEXT_FIELDS, Scene, InputError, load_scene
+from ._scene import REAL_FIELDS, TEXT_FIELDS, Scene, InputError, load_scene, is_nbody_form, from_core, to_core
 from ._files import check_input
 from ._simulate import (COLUMNS, OPTIONAL_COLUMNS, EVENT_DTYPE, ONE_BODY_EVENT_DTYPE, Result,
                         result_from_columns)
@@ -121,6 +121,9 @@ def with_forces_of(result: Result, scene, path) -> Result:
     or a scene file), whose force values must be the header's."""
     if not isinstance(scene, Scene):
         scene = load_scene(scene)
+    if is_nbody_form(scene):
+        # (written with arrays of one or two bodies: compared in the tutorial's names)
+        scene = from_core(*to_core(scene), source=scene.source)
     for name in FORCE_FIELDS:
         mine, theirs = getattr(result.scene, name), getattr(scene, name)
         if mine != theirs:

@@ -9,7 +9,7 @@ from __future__ import annotations
 import dataclasses
 import os
 from dataclasses import dataclass
-from typing import Optional
+from typing import Optional, Sequence
 
 import numpy as np
 
@@ -19,7 +19,7 @@ from . import _core
 _api = getattr(_core, "impact1d_api", _core)
 
 __all__ = ["Scene", "InputError", "SimulationError", "load_scene",
-           "REAL_FIELDS", "TEXT_FIELDS"]
+           "REAL_FIELDS", "TEXT_FIELDS", "ARRAY_FIELDS", "CONTACT_FIELDS", "SPRING_FIELDS"]
 
 
 class InputError(ValueError):
@@ -49,6 +49,16 @@ REAL_FIELDS = (
     "max_events",
 )
 TEXT_FIELDS = ("title", "f1_table", "f2_table", "method", "substeps", "events")
+# The N-body scene (DESIGN "Mechanisms as data"): arrays (body i's value at i; the &link
+# ones and k_link, d_rest, c_link one per neighbour pair), &link r_meet, and the fields of
+# the &contact and &spring records. Checked against _api.input_field_names() at import.
+ARRAY_FIELDS = ("m", "mu", "mus", "x", "v", "f", "f_amp", "f_period", "f_phase", "k", "x_rest", "c",
+                "d_min", "r_min", "d_max", "r_max", "k_link", "d_rest", "c_link", "f_table")
+CONTACT_FIELDS = ("a", "b", "d_min", "r_min", "d_max", "r_max", "name")
+SPRING_FIELDS = ("a", "b", "k", "d_rest", "c")
+# Array fields that are also the tutorial's scalars (d_min is d_min(1)): a sequence given
+# for one of these is the array.
+_SHARED_FIELDS = ("d_min", "r_min", "d_max", "r_max", "d_rest")
 
 
 @dataclass
@@ -58,6 +68,12 @@ class Scene:
     Absent constraints do not exist; absent optional values take the engine's
     defaults (docs/formats.md).  `source` is the file the scene came from (for titles).
     Table paths from load_scene are already resolved against the scene's folder.
+
+    N bodies (docs/formats.md, "Scenes of N bodies"): the arrays (`m=[...]`, `x=[...]`,
+    ..., and `d_min`, `r_min`, `d_max`, `r_max`, `d_rest` given as sequences), `r_meet`,
+    and `contacts` / `springs`: lists of dicts with the &contact / &spring fields
+    (`{"a": 0, "b": 3, "d_min": -1.0, "name": "stop3"}`). One or two bodies given so run
+    as the tutorial's names; more, or any record, wait for the N-body engine (InputError).
     """
 
     m1: Optional[float] = None
@@ -111,6 +127,24 @@ class Scene:
     substeps: Optional[str] = None     # 'auto': dt divided for springs coarse at dt
     events: Optional[str] = None       # 'all' (default), 'impacts' or 'none': what the log keeps
     source: Optional[str] = None
+    m: Optional[Sequence[float]] = None
+    mu: Optional[Sequence[float]] = None
+    mus: Optional[Sequence[float]] = None
+    x: Optional[Sequence[float]] = None
+    v: Optional[Sequence[float]] = None
+    f: Optional[Sequence[float]] = None
+    f_amp: Optional[Sequence[float]] = None
+    f_period: Optional[Sequence[float]] = None
+    f_phase: Optional[Sequence[float]] = None
+    k: Optional[Sequence[float]] = None
+    x_rest: Optional[Sequence[float]] = None
+    c: Optional[Sequence[float]] = None
+    k_link: Optional[Sequence[float]] = None
+    c_link: Optional[Sequence[float]] = None
+    f_table: Optional[Sequence[Optional[str]]] = None
+    r_meet: Optional[float] = None
+    contacts: Optional[Sequence[dict]] = None
+    springs: Optional[Sequence[dict]] = None
 
 
 def decode(text) -> str:
@@ -126,17 +160,29 @@ def _words(text) -> tuple:
     return tuple(decode(text).split())
 
 
+# Every input field as the core numbers them (id k: the k-th name).
+INPUT_FIELDS = REAL_FIELDS + TEXT_FIELDS + ARRAY_FIELDS + ("r_meet",) + \
+    tuple("contact." + name for name in CONTACT_FIELDS) + tuple("spring." + name for name in SPRING_FIELDS)
+
+
 def _check_field_order() -> None:
     reals, texts = _api.field_names()
-    if _words(reals) != REAL_FIELDS or _words(texts) != TEXT_FIELDS:
+    if _words(reals) != REAL_FIELDS or _words(texts) != TEXT_FIELDS or \
+            _words(_api.input_field_names()) != INPUT_FIELDS:
         raise ImportError(
             "impact1d._core field names do not match impact1d.Scene: "
-            f"core has {_words(reals)} / {_words(texts)}")
+            f"core has {_words(reals)} / {_words(texts)} / {_words(_api.input_field_names())}")
 
 
 _check_field_order()
 _SCENE_FIELDS = tuple(f.name for f in dataclasses.fields(Scene))
-assert _SCENE_FIELDS == REAL_FIELDS + TEXT_FIELDS + ("source",)
+# (the N-body fields after source: positional Scene(...) calls keep their meaning)
+_NBODY_FIELDS = tuple(name for name in ARRAY_FIELDS if name not in _SHARED_FIELDS) + \
+    ("r_meet", "contacts", "springs")
+assert _SCENE_FIELDS == REAL_FIELDS + TEXT_FIELDS + ("source",) + _NBODY_FIELDS
+# Field ids: the scalars' and texts' by name, the arrays' apart (d_min is both).
+_ID = {name: k + 1 for k, name in reversed(list(enumerate(INPUT_FIELDS)))}
+_ARRAY_ID = {name: len(REAL_FIELDS + TEXT_FIELDS) + k + 1 for k, name in enumerate(ARRAY_FIELDS)}
 
 
 def _fortran_text(value) -> bytes:
@@ -146,8 +192,23 @@ def _fortran_text(value) -> bytes:
         else str(value).encode("utf-8", errors="surrogateescape")
 
 
+def _is_sequence(value) -> bool:
+    return isinstance(value, (list, tuple, np.ndarray))
+
+
+def is_nbody_form(scene: Scene) -> bool:
+    """Whether the scene is written with arrays or records (DESIGN's N-body form)."""
+    fields = vars(scene)
+    return any(fields.get(name) is not None for name in _NBODY_FIELDS) or \
+        any(_is_sequence(fields.get(name)) for name in _SHARED_FIELDS)
+
+
 def to_core(scene: Scene):
-    """Scene -> (values, given, *texts in TEXT_FIELDS order) for the api."""
+    """Scene -> (values, given, *texts in TEXT_FIELDS order) for the api. A scene written
+    with arrays or records is settled by the core first (settle_scene): one or two bodies
+    come back in the tutorial's fields, anything else is its InputError."""
+    if is_nbody_form(scene):
+        return _settled(scene)
     fields = vars(scene)
     reals = [fields[name] for name in REAL_FIELDS]
     given = np.array([value is not None for value in reals], dtype=np.int32)
@@ -175,6 +236,90 @@ def to_core(scene: Scene):
     return (values, given, *texts)
 
 
+def _number(name, value) -> float:
+    try:
+        number = float(value)
+    except OverflowError:
+        raise InputError(f"{name} = {value!r:.40} is too large for a double (largest 1.8e308)") from None
+    except (TypeError, ValueError):
+        raise InputError(f"{name} must be a number, got {value!r}") from None
+    return number
+
+
+def _text(name, value) -> bytes:
+    if value is not None and not isinstance(value, (str, os.PathLike)):
+        raise InputError(f"{name} must be text, got {value!r}")
+    return _fortran_text(value)
+
+
+def _records(name, records, fields):
+    if not _is_sequence(records) or not all(isinstance(r, dict) for r in records):
+        raise InputError(f"{name} must be a list of dicts with the fields {', '.join(fields)}, got {records!r:.80}")
+    for j, record in enumerate(records, start=1):
+        unknown = [key for key in record if key not in fields]
+        if unknown:
+            raise InputError(f"{name}[{j - 1}] has no field {unknown[0]!r} (fields: {', '.join(fields)})")
+        yield j, record
+
+
+def to_assignments(scene: Scene):
+    """Scene -> the core's assignments: (field ids, indices, values), (text ids, indices,
+    texts) in the numbering of INPUT_FIELDS (index 0 a scalar, else the element or record)."""
+    numbers, texts = [], []
+    for name, value in vars(scene).items():
+        if value is None or name in ("source", "contacts", "springs"):
+            continue
+        if name in ARRAY_FIELDS and (_is_sequence(value) or name not in _SHARED_FIELDS):
+            if not _is_sequence(value):
+                raise InputError(f"{name} must be a list (one value per body or link), got {value!r:.80}")
+            for i, item in enumerate(value, start=1):
+                if name == "f_table":
+                    texts.append((_ARRAY_ID[name], i, _text(f"{name}[{i - 1}]", item)))
+                else:
+                    numbers.append((_ARRAY_ID[name], i, _number(f"{name}[{i - 1}]", item)))
+        elif name in TEXT_FIELDS:
+            texts.append((_ID[name], 0, _text(name, value)))
+        else:
+            numbers.append((_ID[name], 0, _number(name, value)))
+    for group, fields in (("contacts", CONTACT_FIELDS), ("springs", SPRING_FIELDS)):
+        prefix = "contact." if group == "contacts" else "spring."
+        for j, record in _records(group, getattr(scene, group) or [], fields):
+            for key, value in record.items():
+                if value is None:
+                    continue
+                if key == "name":
+                    texts.append((_ID[prefix + key], j, _text(f"{group}[{j - 1}].name", value)))
+                else:
+                    numbers.append((_ID[prefix + key], j, _number(f"{group}[{j - 1}].{key}", value)))
+    return numbers, texts
+
+
+def _settled(scene: Scene):
+    """The core's settle_scene: the scene as the tutorial's flat fields, or its InputError."""
+    numbers, texts = to_assignments(scene)
+    # (one unused row at the end: f2py refuses arrays of no element)
+    ids, index, values = (np.array(column + (0,), dtype=dtype) for column, dtype in
+                          zip(tuple(zip(*numbers)) or ((), (), ()), (np.int32, np.int32, np.float64)))
+    text_ids, text_index, blobs = tuple(zip(*texts)) or ((), (), ())
+    ends = np.array(np.cumsum([len(b) for b in blobs], dtype=np.int64).tolist() + [0], dtype=np.int32)
+    room = max([len(b) for b in blobs] + [1])
+    values_out, given, codes, lengths, status, message = _api.settle_scene(
+        len(numbers), len(texts), ids, index, values, np.array(text_ids + (0,), dtype=np.int32),
+        np.array(text_index + (0,), dtype=np.int32), ends, b"".join(blobs) or b" ", len(REAL_FIELDS), room)
+    raise_for_status(status, message)
+    out = [bytes(np.asarray(codes[:lengths[k], k], dtype=np.uint8)) for k in range(len(TEXT_FIELDS))]
+    return (np.asarray(values_out, dtype=np.float64), np.asarray(given, dtype=np.int32), *out)
+
+
+def from_core(values, given, *texts, source=None) -> Scene:
+    """to_core's flat fields -> the Scene in the tutorial's names (how a scene written with
+    arrays of one or two bodies runs: the Result's scene, which the plots read)."""
+    fields = {name: (float(values[i]) if given[i] else None) for i, name in enumerate(REAL_FIELDS)}
+    fields.update((name, text.decode("utf-8", errors="surrogateescape") or None)
+                  for name, text in zip(TEXT_FIELDS, texts))
+    return Scene(**fields, source=source)
+
+
 # The api's status for a run that an interrupt (SIGINT) ended.
 _STATUS_INTERRUPTED = 4
 
@@ -200,16 +345,36 @@ def load_scene(path) -> Scene:
 
     path = os.fspath(path)
     check_input(path, "scene file")
-    room = TEXT_ROOM
+    room, numbers, texts = TEXT_ROOM, 64, 16
     while True:
-        (values, given, codes, lengths,
-         status, message) = _api.read_scene(os.fsencode(path), len(REAL_FIELDS), room)
-        if int(status) != STATUS_TOO_SMALL or int(max(lengths)) <= room:
+        (ids, index, values, text_ids, text_index, codes, lengths, n_numbers, n_texts,
+         status, message) = _api.read_scene(os.fsencode(path), numbers, texts, room)
+        if int(status) != STATUS_TOO_SMALL or (n_numbers <= numbers and n_texts <= texts
+                                               and int(max(lengths, default=0)) <= room):
             break
-        room = int(max(lengths))        # a text longer than the room: again, with its length
+        # More than the room given: again, with what the core says it needs.
+        numbers, texts = max(numbers, int(n_numbers)), max(texts, int(n_texts))
+        room = max(room, int(max(lengths, default=0)))
     raise_for_status(status, message)
-    kwargs = {name: (float(values[i]) if given[i] else None)
-              for i, name in enumerate(REAL_FIELDS)}
-    for k, name in enumerate(TEXT_FIELDS):
-        kwargs[name] = decode(np.asarray(codes[:lengths[k], k], dtype=np.uint8).tobytes()) or None
+    kwargs = {}
+    for k in range(int(n_numbers)):
+        _put(kwargs, INPUT_FIELDS[ids[k] - 1], int(index[k]), float(values[k]))
+    for k in range(int(n_texts)):
+        text = decode(np.asarray(codes[:lengths[k], k], dtype=np.uint8).tobytes())
+        _put(kwargs, INPUT_FIELDS[text_ids[k] - 1], int(text_index[k]), text or None)
     return Scene(**kwargs, source=path)
+
+
+def _put(kwargs: dict, name: str, index: int, value) -> None:
+    """One assignment from the core into Scene keyword arguments."""
+    if index == 0:
+        kwargs[name] = value
+    elif "." in name:
+        group, key = name.split(".")
+        records = kwargs.setdefault(group + "s", [])
+        records.extend({} for _ in range(index - len(records)))
+        records[index - 1][key] = int(value) if key in ("a", "b") else value
+    else:
+        array = kwargs.setdefault(name, [])
+        array.extend(None for _ in range(index - len(array)))
+        array[index - 1] = value

@@ -10,6 +10,7 @@ from typing import Optional
 import numpy as np
 
 from ._scene import (REAL_FIELDS, Scene, InputError, SimulationError, decode, raise_for_status, to_core, _words, _api,
+                     from_core, is_nbody_form,
                      _STATUS_INTERRUPTED)
 from ._scene import STATUS_TOO_SMALL as _STATUS_TOO_SMALL
 
@@ -221,6 +222,9 @@ def simulate(scene: Scene, *, progress: bool = False, **overrides) -> Result:
                          f"(known: {', '.join(_OVERRIDABLE)})")
     scene = _with_overrides(scene, overrides)
     values, given, *texts = to_core(scene)
+    if is_nbody_form(scene):
+        # (written with arrays: the Result's scene is the one run, in the tutorial's names)
+        scene = from_core(values, given, *texts, source=scene.source)
 
     # The core fills arrays made for this call (no state is kept between calls, so threads
     # may run at once); when a guess at their size is short it says what is needed.

@@ -1,0 +1,916 @@
+!> Scenes of any number of bodies, as written (impact1d_fields): settled after reading (a
+!> chain of one or two bodies folds into the tutorial's scalars, so it means what they
+!> mean), checked where no engine is needed, and carried to the model as contact and
+!> element records (input_records: the layout of scene_type's records, issue 19 stage 2).
+module impact1d_chain
+  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_value, ieee_quiet_nan
+  use impact1d_kinds, only: wp, eps_wp
+  use impact1d_error, only: error_type, raise, status_input, fmt
+  use impact1d_scene, only: scene_input, real_names, text_names, n_real, n_text, set_text, name_of, value_or, &
+    positive_value, nonnegative_value, unit_interval, i_m1, i_m2, i_x_left, i_r_left, i_x_right, i_r_right, &
+    i_r_min, i_d_min, i_g, default_gravity
+  use impact1d_fields, only: n_arrays, array_names, array_is_link, array_is_text, alias_name, name_len, &
+    record_input, a_m, a_mu, a_mus, a_x, a_f_amp, a_f_period, a_f_phase, a_k, a_x_rest, a_c, a_d_min, a_r_min, &
+    a_d_max, a_r_max, a_k_link, a_d_rest, a_c_link, r_a, r_b, r_d_min, r_r_min, r_d_max, r_r_max, r_k, r_d_rest, &
+    r_c, contact_fields, spring_fields, r_name, n_contact_fields, n_spring_fields, written_array, text_item, &
+    a_f_table, mechanism_records
+  implicit none
+  private
+  public :: settle_chain, validate_chain, input_records, mechanism_records, n_bodies_of
+  public :: id_arrays, id_r_meet, id_contact, id_spring, n_ids, field_name, field_is_text, assign_number, &
+    assign_text, scene_assignments
+
+  !> The input fields' numbering (the namelist reader's and the flat API's): 1..n_real the
+  !> tutorial's scalars, then its texts, the arrays (impact1d_fields' order), r_meet, the
+  !> &contact record fields, the &spring record fields.
+  integer, parameter :: id_arrays = n_real + n_text, id_r_meet = id_arrays + n_arrays + 1, &
+    id_contact = id_r_meet, id_spring = id_contact + n_contact_fields, n_ids = id_spring + n_spring_fields
+
+
+  !> Arrays whose elements must not be negative.
+  integer, parameter :: nonnegative_arrays(6) = [a_mu, a_mus, a_k, a_c, a_k_link, a_c_link]
+
+contains
+
+  !> After reading: N (the length of m, else the tutorial's m1/m2), every array of the right
+  !> length, no element given twice (as m1 and in m), and a chain of one or two bodies
+  !> folded into the tutorial's scalars (its elements spelled 'm(2)' in messages).
+  subroutine settle_chain(input, error)
+    type(scene_input), intent(inout) :: input
+    type(error_type), allocatable, intent(out) :: error
+    integer :: n, j
+    n = merge(2, 1, input%given(i_m2))
+    if (input%chain%array(a_m)%n > 0) n = input%chain%array(a_m)%n
+    do j = 1, n_arrays
+      call check_length(input, j, n, error)
+      if (allocated(error)) return
+    end do
+    if (n > 2) then
+      call refuse_two_body_names(input, n, error)
+      input%chain%n_bodies = n
+      return
+    end if
+    do j = 1, n_arrays
+      call fold(input, j, error)
+      if (allocated(error)) return
+    end do
+    if (input%chain%has_r_meet) call fold_meeting(input, n, error)
+  end subroutine settle_chain
+
+  !> Array j holds N values (a body array) or N - 1 (a link array) when written.
+  subroutine check_length(input, j, n, error)
+    type(scene_input), intent(in) :: input
+    integer, intent(in) :: j, n
+    type(error_type), allocatable, intent(inout) :: error
+    integer :: wanted
+    associate (written => input%chain%array(j)%n)
+      wanted = merge(n - 1, n, array_is_link(j))
+      if (written == 0 .or. written == wanted) return
+      if (array_is_link(j)) then
+        call raise(error, status_input, trim(array_names(j)) // ' has ' // trim(fmt(written)) // &
+          ' values, but &link arrays hold one per link, N - 1 = ' // trim(fmt(wanted)) // ' (' // &
+          trim(bodies_text(input, n)) // ')')
+      else
+        call raise(error, status_input, trim(array_names(j)) // ' has ' // trim(fmt(written)) // &
+          ' values, but body arrays hold one per body, N = ' // trim(fmt(n)) // ' (' // &
+          trim(bodies_text(input, n)) // ')')
+      end if
+    end associate
+  end subroutine check_length
+
+  !> How the scene's N came about, for messages.
+  pure function bodies_text(input, n) result(text)
+    type(scene_input), intent(in) :: input
+    integer, intent(in) :: n
+    character(len=48) :: text     ! blank padded: callers trim
+    if (input%chain%array(a_m)%n > 0) then
+      text = 'm has ' // trim(fmt(n)) // ' values'
+    else
+      text = trim(merge('m1 and m2 given', 'm1 alone       ', n == 2))
+    end if
+  end function bodies_text
+
+  !> In a scene of N > 2 bodies the tutorial's numbered names (x1, k12, d_min alone) have no
+  !> meaning: each array is written whole.
+  subroutine refuse_two_body_names(input, n, error)
+    type(scene_input), intent(in) :: input
+    integer, intent(in) :: n
+    type(error_type), allocatable, intent(inout) :: error
+    integer :: j, i, slot
+    do j = 1, n_arrays
+      do i = 1, 2
+        slot = slot_of(alias_name(j, i))
+        if (slot == 0) cycle
+        if (.not. given_slot(input, slot)) cycle
+        call raise(error, status_input, trim(alias_name(j, i)) // ' is a name of a one- or two-body scene, ' // &
+          'but this one has N = ' // trim(fmt(n)) // ' bodies (m has ' // trim(fmt(n)) // ' values): write ' // &
+          trim(array_names(j)) // ' as an array of ' // trim(fmt(merge(n - 1, n, array_is_link(j)))) // ' values')
+        return
+      end do
+    end do
+  end subroutine refuse_two_body_names
+
+  !> Array j of a one- or two-body chain into the tutorial's scalars, element i spelled
+  !> '<name>(i)'; refused when the scalar is given too.
+  subroutine fold(input, j, error)
+    type(scene_input), intent(inout) :: input
+    integer, intent(in) :: j
+    type(error_type), allocatable, intent(inout) :: error
+    integer :: i, slot
+    character(len=16) :: spelled
+    do i = 1, input%chain%array(j)%n
+      slot = slot_of(alias_name(j, i))
+      write(spelled, '(a, "(", i0, ")")') trim(array_names(j)), i
+      if (given_slot(input, slot)) then
+        call raise(error, status_input, trim(alias_name(j, i)) // ' is given and so is ' // trim(array_names(j)) // &
+          ' (' // trim(alias_name(j, i)) // ' is ' // trim(spelled) // '): give one of them')
+        return
+      end if
+      if (array_is_text(j)) then
+        call set_text(input, slot - n_real, input%chain%array(j)%t(i)%s)
+      else
+        input%value(slot) = input%chain%array(j)%v(i)
+        input%given(slot) = .true.
+        input%spelled(slot) = spelled
+      end if
+    end do
+    input%chain%array(j)%n = 0
+  end subroutine fold
+
+  !> r_meet of a two-body scene is r_min without d_min, the restitution of the bodies' meeting.
+  subroutine fold_meeting(input, n, error)
+    type(scene_input), intent(inout) :: input
+    integer, intent(in) :: n
+    type(error_type), allocatable, intent(inout) :: error
+    if (n == 1) then
+      call raise(error, status_input, 'r_meet is given but m2 is not: a scene without m2 has one body ' // &
+        '(give m2 for a second one)')
+    else if (input%given(i_r_min) .and. .not. input%given(i_d_min)) then
+      call raise(error, status_input, 'r_meet and ' // trim(name_of(input, i_r_min)) // ' both give the ' // &
+        'restitution of the bodies'' meeting: give one of them')
+    else if (.not. input%given(i_d_min)) then
+      input%value(i_r_min) = input%chain%r_meet
+      input%given(i_r_min) = .true.
+      input%spelled(i_r_min) = 'r_meet'
+    end if
+    input%chain%has_r_meet = .false.
+  end subroutine fold_meeting
+
+  !> Scalar slot (1..n_real) or text slot (n_real + 1..) of a tutorial name; 0 if none.
+  pure integer function slot_of(name)
+    character(len=*), intent(in) :: name
+    integer :: k
+    slot_of = 0
+    if (len_trim(name) == 0) return
+    do k = 1, n_real
+      if (real_names(k) == name) slot_of = k
+    end do
+    do k = 1, n_text
+      if (text_names(k) == name) slot_of = n_real + k
+    end do
+  end function slot_of
+
+  !> Whether slot k (a scalar, or n_real + a text) is given.
+  pure logical function given_slot(input, k)
+    type(scene_input), intent(in) :: input
+    integer, intent(in) :: k
+    given_slot = .false.
+    if (k >= 1 .and. k <= n_real) given_slot = input%given(k)
+    if (k > n_real) given_slot = len_trim(input%text(k - n_real)%s) > 0
+  end function given_slot
+
+  !> N: the length of m in an N-body scene, else 2 with m2, 1 without.
+  pure integer function n_bodies_of(input)
+    type(scene_input), intent(in) :: input
+    n_bodies_of = merge(2, 1, input%given(i_m2))
+    if (input%chain%n_bodies > 2) n_bodies_of = input%chain%n_bodies
+  end function n_bodies_of
+
+  !> Element i of array j as the scene gives it (given false: absent, value 0).
+  pure subroutine element(input, j, i, value, given)
+    type(scene_input), intent(in) :: input
+    integer, intent(in) :: j, i
+    real(wp), intent(out) :: value
+    logical, intent(out) :: given
+    integer :: slot
+    value = 0.0_wp
+    given = .false.
+    if (input%chain%n_bodies > 2) then
+      given = input%chain%array(j)%n >= i
+      if (given) value = input%chain%array(j)%v(i)
+    else
+      slot = slot_of(alias_name(j, i))
+      if (slot < 1 .or. slot > n_real) return
+      given = input%given(slot)
+      value = input%value(slot)
+    end if
+  end subroutine element
+
+  !> Element i of array j, or default when absent.
+  pure real(wp) function element_or(input, j, i, default)
+    type(scene_input), intent(in) :: input
+    integer, intent(in) :: j, i
+    real(wp), intent(in) :: default
+    logical :: given
+    call element(input, j, i, element_or, given)
+    if (.not. given) element_or = default
+  end function element_or
+
+  !> Whether element i of array j is given.
+  pure logical function has_element(input, j, i)
+    type(scene_input), intent(in) :: input
+    integer, intent(in) :: j, i
+    real(wp) :: value
+    call element(input, j, i, value, has_element)
+  end function has_element
+
+  !> 'm(3)' (N > 2) or the tutorial's spelling, for messages.
+  pure function element_name(input, j, i) result(name)
+    type(scene_input), intent(in) :: input
+    integer, intent(in) :: j, i
+    character(len=16) :: name     ! blank padded: callers trim
+    if (input%chain%n_bodies > 2) then
+      write(name, '(a, "(", i0, ")")') trim(array_names(j)), i
+    else
+      name = name_of(input, slot_of(alias_name(j, i)))
+    end if
+  end function element_name
+
+  !> What needs no engine, after validate: an N-body scene's arrays element by element, the
+  !> records (ends, limits, names) and the initial state inside every contact.
+  subroutine validate_chain(input, error)
+    type(scene_input), intent(in) :: input
+    type(error_type), allocatable, intent(out) :: error
+    type(mechanism_records) :: records
+    if (input%chain%n_bodies > 2) call check_arrays(input, error)
+    if (allocated(error)) return
+    if (allocated(input%chain%contacts)) call check_records(input, input%chain%contacts, .true., error)
+    if (allocated(error)) return
+    if (allocated(input%chain%springs)) call check_records(input, input%chain%springs, .false., error)
+    if (allocated(error)) return
+    call input_records(input, records)
+    call check_names(records, error)
+    if (allocated(error)) return
+    call check_start(input, records, error)
+  end subroutine validate_chain
+
+  !> An N-body scene's arrays: finite, x given, masses positive, coefficients not negative,
+  !> static friction at least sliding, pairs that go together, slot limits in order.
+  subroutine check_arrays(input, error)
+    type(scene_input), intent(in) :: input
+    type(error_type), allocatable, intent(inout) :: error
+    integer :: j, i, n
+    n = input%chain%n_bodies
+    do j = 1, n_arrays
+      if (array_is_text(j) .or. input%chain%array(j)%n == 0) cycle
+      do i = 1, input%chain%array(j)%n
+        if (.not. ieee_is_finite(input%chain%array(j)%v(i))) then
+          call raise(error, status_input, trim(element_name(input, j, i)) // ' = ' // &
+            trim(fmt(input%chain%array(j)%v(i))) // ' is not a finite number')
+          return
+        end if
+      end do
+    end do
+    if (input%chain%array(a_x)%n == 0) then
+      call raise(error, status_input, 'x is required but not given (one initial position per body)')
+      return
+    end if
+    do i = 1, n
+      call positive_value(trim(element_name(input, a_m, i)), element_or(input, a_m, i, 1.0_wp), error)
+      do j = 1, size(nonnegative_arrays)
+        if (has_element(input, nonnegative_arrays(j), i)) call nonnegative_value( &
+          trim(element_name(input, nonnegative_arrays(j), i)), element_or(input, nonnegative_arrays(j), i, 0.0_wp), error)
+      end do
+      if (element_or(input, a_mus, i, huge(1.0_wp)) < element_or(input, a_mu, i, 0.0_wp)) call raise(error, &
+        status_input, trim(element_name(input, a_mus, i)) // ' = ' // trim(fmt(element_or(input, a_mus, i, 0.0_wp))) // &
+        ' is below ' // trim(element_name(input, a_mu, i)) // ' = ' // trim(fmt(element_or(input, a_mu, i, 0.0_wp))) // &
+        ': static friction is at least the sliding friction')
+      if (allocated(error)) return
+    end do
+    call together(input, a_k, a_x_rest, .true., 'a spring needs its rest position', error)
+    call together(input, a_k_link, a_d_rest, .true., 'a spring needs its rest length', error)
+    call together(input, a_f_amp, a_f_period, .true., 'a sine force needs both', error)
+    call together(input, a_f_phase, a_f_amp, .false., 'a phase needs its sine', error)
+    call together(input, a_r_max, a_d_max, .false., 'a restitution needs its limit', error)
+    if (allocated(error)) return
+    call check_link_arrays(input, n, error)
+  end subroutine check_arrays
+
+  !> Array j1 (say k) needs j2 (x_rest); and j2 needs j1 when both_ways.
+  subroutine together(input, j1, j2, both_ways, why, error)
+    type(scene_input), intent(in) :: input
+    integer, intent(in) :: j1, j2
+    logical, intent(in) :: both_ways
+    character(len=*), intent(in) :: why
+    type(error_type), allocatable, intent(inout) :: error
+    if (allocated(error)) return
+    if ((input%chain%array(j1)%n > 0) .eqv. (input%chain%array(j2)%n > 0)) return
+    if (input%chain%array(j1)%n > 0) then
+      call raise(error, status_input, trim(array_names(j1)) // ' is given but ' // trim(array_names(j2)) // &
+        ' is not: ' // why)
+    else if (both_ways) then
+      call raise(error, status_input, trim(array_names(j2)) // ' is given but ' // trim(array_names(j1)) // &
+        ' is not: ' // why)
+    end if
+  end subroutine together
+
+  !> Periods positive, restitutions in [0, 1], each link's limits in order, g not pulling
+  !> bodies with friction off the surface.
+  subroutine check_link_arrays(input, n, error)
+    type(scene_input), intent(in) :: input
+    integer, intent(in) :: n
+    type(error_type), allocatable, intent(inout) :: error
+    integer :: i
+    do i = 1, n
+      if (has_element(input, a_f_period, i)) call positive_value(trim(element_name(input, a_f_period, i)), &
+        element_or(input, a_f_period, i, 0.0_wp), error)
+      if (element_or(input, a_mu, i, 0.0_wp) > 0.0_wp .or. element_or(input, a_mus, i, 0.0_wp) > 0.0_wp) then
+        if (value_or(input, i_g, default_gravity) < 0.0_wp) call raise(error, status_input, 'g = ' // &
+          trim(fmt(input%value(i_g))) // ' is negative with friction: the normal force m g must not pull ' // &
+          'the bodies off the surface')
+      end if
+      if (allocated(error)) return
+    end do
+    if (input%chain%has_r_meet) call unit_interval('r_meet', input%chain%r_meet, error)
+    do i = 1, n - 1
+      if (has_element(input, a_r_min, i)) call unit_interval(trim(element_name(input, a_r_min, i)), &
+        element_or(input, a_r_min, i, 0.0_wp), error)
+      if (has_element(input, a_r_max, i)) call unit_interval(trim(element_name(input, a_r_max, i)), &
+        element_or(input, a_r_max, i, 0.0_wp), error)
+      if (allocated(error)) return
+      call limits_in_order(trim(element_name(input, a_d_min, i)), trim(element_name(input, a_d_max, i)), &
+        has_element(input, a_d_min, i), element_or(input, a_d_min, i, 0.0_wp), &
+        has_element(input, a_d_max, i), element_or(input, a_d_max, i, 0.0_wp), .true., error)
+      if (allocated(error)) return
+    end do
+  end subroutine check_link_arrays
+
+  !> d_min <= d_max; a negative d_max without d_min when the bodies meet (d_min = 0).
+  subroutine limits_in_order(lower_name, upper_name, has_lower, lower, has_upper, upper, meet, error)
+    character(len=*), intent(in) :: lower_name, upper_name
+    logical, intent(in) :: has_lower, has_upper, meet
+    real(wp), intent(in) :: lower, upper
+    type(error_type), allocatable, intent(inout) :: error
+    if (allocated(error) .or. .not. has_upper) return
+    if (has_lower .and. lower > upper) then
+      call raise(error, status_input, lower_name // ' = ' // trim(fmt(lower)) // ' must not exceed ' // &
+        upper_name // ' = ' // trim(fmt(upper)))
+    else if (.not. has_lower .and. meet .and. upper < 0.0_wp) then
+      call raise(error, status_input, upper_name // ' = ' // trim(fmt(upper)) // ' is negative, but without ' // &
+        lower_name // ' the bodies meet (' // lower_name // ' = 0): give ' // lower_name // ' to let them pass')
+    end if
+  end subroutine limits_in_order
+
+  !> Each record: its ends body numbers 0..N, not equal; a contact with a limit, a spring
+  !> with an element; values finite, restitutions in [0, 1] beside their limits,
+  !> stiffness and damping not negative, a spring with its rest length.
+  subroutine check_records(input, records, contact, error)
+    type(scene_input), intent(in) :: input
+    type(record_input), intent(in) :: records(:)
+    logical, intent(in) :: contact
+    type(error_type), allocatable, intent(inout) :: error
+    integer :: r, f
+    character(len=:), allocatable :: where
+    do r = 1, size(records)
+      associate (rec => records(r))
+        ! (a record from Python has no line: its place among the records)
+        where = trim(merge('&contact', '&spring ', contact)) // ' (line ' // trim(fmt(rec%line)) // '): '
+        if (rec%line == 0) where = trim(merge('&contact', '&spring ', contact)) // ' record ' // trim(fmt(r)) // ': '
+        do f = 1, merge(size(contact_fields) - 1, size(spring_fields), contact)
+          if (rec%given(f) .and. .not. ieee_is_finite(rec%value(f))) call raise(error, status_input, where // &
+            trim(field_of(contact, f)) // ' = ' // trim(fmt(rec%value(f))) // ' is not a finite number')
+        end do
+        if (.not. allocated(error)) call check_ends(rec, n_bodies_of(input), where, error)
+        if (allocated(rec%name) .and. .not. allocated(error)) then
+          if (len(rec%name) > name_len) call raise(error, status_input, where // "name = '" // rec%name // &
+            "' is longer than " // trim(fmt(name_len)) // ' characters')
+        end if
+        if (contact .and. .not. allocated(error)) then
+          call contact_limits(rec, where, error)
+        else if (.not. allocated(error)) then
+          call spring_values(rec, where, error)
+        end if
+        if (allocated(error)) return
+      end associate
+    end do
+  end subroutine check_records
+
+  !> Name of field f of a &contact (contact true) or &spring record.
+  pure function field_of(contact, f) result(name)
+    logical, intent(in) :: contact
+    integer, intent(in) :: f
+    character(len=8) :: name     ! blank padded: callers trim
+    if (contact) then
+      name = contact_fields(f)
+    else
+      name = spring_fields(f)
+    end if
+  end function field_of
+
+  !> a and b given, whole numbers from 0 (the ground) to N, and different.
+  subroutine check_ends(rec, n, where, error)
+    type(record_input), intent(in) :: rec
+    integer, intent(in) :: n
+    character(len=*), intent(in) :: where
+    type(error_type), allocatable, intent(inout) :: error
+    integer :: f
+    do f = r_a, r_b
+      if (.not. rec%given(f)) then
+        call raise(error, status_input, where // trim(contact_fields(f)) // ' is required but not given ' // &
+          '(a body number, 0 for the ground)')
+      else if (rec%value(f) /= aint(rec%value(f)) .or. rec%value(f) < 0.0_wp .or. rec%value(f) > n) then
+        call raise(error, status_input, where // trim(contact_fields(f)) // ' = ' // trim(fmt(rec%value(f))) // &
+          ' is not a body: the ends are 1 to N = ' // trim(fmt(n)) // ', or 0 for the ground')
+      end if
+      if (allocated(error)) return
+    end do
+    if (rec%value(r_a) == rec%value(r_b)) call raise(error, status_input, where // 'a = b = ' // &
+      trim(fmt(nint(rec%value(r_a)))) // ': a record joins two different ends')
+  end subroutine check_ends
+
+  !> A contact has a limit; each restitution its limit and in [0, 1]; d_min <= d_max.
+  subroutine contact_limits(rec, where, error)
+    type(record_input), intent(in) :: rec
+    character(len=*), intent(in) :: where
+    type(error_type), allocatable, intent(inout) :: error
+    integer :: f
+    if (.not. (rec%given(r_d_min) .or. rec%given(r_d_max))) then
+      call raise(error, status_input, where // 'a contact needs d_min or d_max (or both)')
+      return
+    end if
+    do f = r_r_min, r_r_max, r_r_max - r_r_min
+      if (.not. rec%given(f)) cycle
+      if (.not. rec%given(f - 1)) then
+        call raise(error, status_input, where // trim(contact_fields(f)) // ' is given but ' // &
+          trim(contact_fields(f - 1)) // ' is not: a restitution needs its limit')
+        return
+      end if
+      call unit_interval(where // trim(contact_fields(f)), rec%value(f), error)
+      if (allocated(error)) return
+    end do
+    call limits_in_order(where // 'd_min', 'd_max', rec%given(r_d_min), rec%value(r_d_min), &
+      rec%given(r_d_max), rec%value(r_d_max), .false., error)
+  end subroutine contact_limits
+
+  !> A spring has k or c (not negative); k and d_rest go together.
+  subroutine spring_values(rec, where, error)
+    type(record_input), intent(in) :: rec
+    character(len=*), intent(in) :: where
+    type(error_type), allocatable, intent(inout) :: error
+    if (.not. (rec%given(r_k) .or. rec%given(r_c))) then
+      call raise(error, status_input, where // 'a spring needs k or c (or both)')
+    else if (rec%given(r_k) .and. .not. rec%given(r_d_rest)) then
+      call raise(error, status_input, where // 'k is given but d_rest is not: a spring needs its rest length')
+    else if (rec%given(r_d_rest) .and. .not. rec%given(r_k)) then
+      call raise(error, status_input, where // 'd_rest is given but k is not: a rest length needs its spring')
+    else
+      if (rec%given(r_k)) call nonnegative_value(where // 'k', rec%value(r_k), error)
+      if (rec%given(r_c)) call nonnegative_value(where // 'c', rec%value(r_c), error)
+    end if
+  end subroutine spring_values
+
+  !> Contact names are unique and none starts as an event kind does (rest_, release_,
+  !> stick, slip): a kind is read back as an impact on the contact of its name otherwise.
+  subroutine check_names(records, error)
+    type(mechanism_records), intent(in) :: records
+    type(error_type), allocatable, intent(inout) :: error
+    character(len=*), parameter :: reserved(4) = [character(len=8) :: 'rest_', 'release_', 'stick', 'slip']
+    integer :: k, j
+    do k = 1, records%n_contacts
+      associate (name => records%contact_name(k))
+        do j = 1, size(reserved)
+          if (index(name, trim(reserved(j))) == 1) then
+            call raise(error, status_input, 'the contact name ''' // trim(name) // ''' starts with ''' // &
+              trim(reserved(j)) // ''', as event kinds do (rest_, release_, stick, slip): choose another')
+            return
+          end if
+        end do
+        if (any(records%contact_name(:k - 1) == name)) then
+          call raise(error, status_input, 'the contact name ''' // trim(name) // ''' is used twice ' // &
+            '(walls are ''left'' and ''right'', the two-body link ''slot'', chain links ''link<i>'')')
+          return
+        end if
+      end associate
+    end do
+  end subroutine check_names
+
+  !> The initial positions satisfy every contact's limits (within the rounding of the
+  !> numbers the gap is made of, as for the tutorial's contacts).
+  subroutine check_start(input, records, error)
+    type(scene_input), intent(in) :: input
+    type(mechanism_records), intent(in) :: records
+    type(error_type), allocatable, intent(inout) :: error
+    real(wp) :: x(0:n_bodies_of(input)), d, limit, scale
+    integer :: k, side
+    character(len=:), allocatable :: what
+    x(0) = 0.0_wp
+    do k = 1, size(x) - 1
+      x(k) = element_or(input, a_x, k, 0.0_wp)
+    end do
+    do k = 1, records%n_contacts
+      associate (a => records%contact_body(1, k), b => records%contact_body(2, k))
+        d = x(b) - x(a)
+        what = 'x' // trim(fmt(b))
+        if (a > 0) what = what // ' - x' // trim(fmt(a))
+        do side = 1, 2
+          if (.not. records%contact_has(side, k)) cycle
+          limit = records%contact_limit(side, k)
+          scale = max(abs(x(a)), abs(x(b)), abs(limit))
+          if (merge(d - limit, limit - d, side == 1) >= -16.0_wp * eps_wp * scale) cycle
+          call raise(error, status_input, 'the initial state violates the contact ''' // &
+            trim(records%contact_name(k)) // ''': ' // what // ' = ' // trim(fmt(d)) // ' is ' // &
+            trim(merge('below', 'above', side == 1)) // ' its ' // trim(merge('lower', 'upper', side == 1)) // &
+            ' limit ' // trim(fmt(limit)))
+          return
+        end do
+      end associate
+    end do
+  end subroutine check_start
+
+  !> The scene's contacts and springs as records (the chain shorthand expanded): the walls
+  !> ('left' on body 1's position, 'right' on body N's), link i ('slot' with two bodies,
+  !> 'link<i>' beyond) on x(i+1) - x(i) with the bodies' meeting (d_min = 0, restitution
+  !> r_meet, default 1) unless the link gives its own d_min or a &contact joins the pair,
+  !> then the &contact records in file order (unnamed: 'contact<j>'); springs to the ground
+  !> (k, x_rest, c: k1 k2), between neighbours (k_link, d_rest, c_link: k12), then the
+  !> &spring records in file order. A record written with b = 0 is turned round (a = 0).
+  subroutine input_records(input, records)
+    type(scene_input), intent(in) :: input
+    type(mechanism_records), intent(out) :: records
+    integer :: n, nc, ne
+    n = n_bodies_of(input)
+    nc = 2 + (n - 1)
+    ne = n + (n - 1)
+    if (allocated(input%chain%contacts)) nc = nc + size(input%chain%contacts)
+    if (allocated(input%chain%springs)) ne = ne + size(input%chain%springs)
+    allocate(records%contact_body(2, nc), records%contact_has(2, nc), records%contact_limit(2, nc), &
+      records%contact_restitution(2, nc), records%contact_name(nc))
+    allocate(records%element_body(2, ne), records%element_k(ne), records%element_c(ne), records%element_rest(ne))
+    records%contact_has = .false.
+    records%contact_limit = 0.0_wp
+    records%contact_restitution = 1.0_wp
+    call wall_records(input, n, records)
+    call link_records(input, n, records)
+    call contact_records(input, records)
+    call element_records(input, n, records)
+    call shrink(records)
+  end subroutine input_records
+
+  !> 'left' (0, 1) with lower limit x_left; 'right' (0, N) with upper limit x_right.
+  subroutine wall_records(input, n, records)
+    type(scene_input), intent(in) :: input
+    integer, intent(in) :: n
+    type(mechanism_records), intent(inout) :: records
+    if (input%given(i_x_left)) call add_contact(records, 'left', 0, 1, 1, input%value(i_x_left), &
+      value_or(input, i_r_left, 1.0_wp))
+    if (input%given(i_x_right)) call add_contact(records, 'right', 0, n, 2, input%value(i_x_right), &
+      value_or(input, i_r_right, 1.0_wp))
+  end subroutine wall_records
+
+  !> Link i between bodies i and i+1, as its &link elements and the meeting make it.
+  subroutine link_records(input, n, records)
+    type(scene_input), intent(in) :: input
+    integer, intent(in) :: n
+    type(mechanism_records), intent(inout) :: records
+    character(len=name_len) :: name
+    integer :: i, first
+    do i = 1, n - 1
+      name = 'slot'
+      if (n > 2) write(name, '("link", i0)') i
+      first = records%n_contacts + 1
+      if (has_element(input, a_d_min, i)) then
+        call add_contact(records, name, i, i + 1, 1, element_or(input, a_d_min, i, 0.0_wp), &
+          element_or(input, a_r_min, i, 1.0_wp))
+      else if (.not. contact_joins(input, i, i + 1)) then
+        call add_contact(records, name, i, i + 1, 1, 0.0_wp, &
+          element_or(input, a_r_min, i, merge(input%chain%r_meet, 1.0_wp, input%chain%has_r_meet)))
+      end if
+      if (has_element(input, a_d_max, i)) then
+        if (records%n_contacts < first) call add_contact(records, name, i, i + 1, 2, 0.0_wp, 1.0_wp)
+        records%contact_has(2, first) = .true.
+        records%contact_limit(2, first) = element_or(input, a_d_max, i, 0.0_wp)
+        records%contact_restitution(2, first) = element_or(input, a_r_max, i, 1.0_wp)
+      end if
+    end do
+  end subroutine link_records
+
+  !> Whether a &contact record joins bodies i and j (either way round).
+  pure logical function contact_joins(input, i, j)
+    type(scene_input), intent(in) :: input
+    integer, intent(in) :: i, j
+    integer :: r
+    contact_joins = .false.
+    if (.not. allocated(input%chain%contacts)) return
+    do r = 1, size(input%chain%contacts)
+      associate (ends => nint(input%chain%contacts(r)%value([r_a, r_b])))
+        contact_joins = contact_joins .or. (minval(ends) == i .and. maxval(ends) == j)
+      end associate
+    end do
+  end function contact_joins
+
+  !> The &contact records in file order, a record with b = 0 turned round: on x_a - x_b
+  !> = -(x_b - x_a), so its limits negate and swap.
+  subroutine contact_records(input, records)
+    type(scene_input), intent(in) :: input
+    type(mechanism_records), intent(inout) :: records
+    character(len=name_len) :: name
+    integer :: r, k, ends(2)
+    if (.not. allocated(input%chain%contacts)) return
+    do r = 1, size(input%chain%contacts)
+      associate (rec => input%chain%contacts(r))
+        write(name, '("contact", i0)') r
+        if (allocated(rec%name)) then
+          if (len_trim(rec%name) > 0) name = rec%name
+        end if
+        ends = nint(rec%value([r_a, r_b]))
+        k = records%n_contacts + 1
+        call add_contact(records, name, ends(1), ends(2), 1, rec%value(r_d_min), 1.0_wp)
+        records%contact_has(:, k) = rec%given([r_d_min, r_d_max])
+        records%contact_limit(:, k) = merge(rec%value([r_d_min, r_d_max]), 0.0_wp, rec%given([r_d_min, r_d_max]))
+        records%contact_restitution(:, k) = merge(rec%value([r_r_min, r_r_max]), 1.0_wp, rec%given([r_r_min, r_r_max]))
+        if (ends(2) == 0) then
+          records%contact_body(:, k) = [0, ends(1)]
+          records%contact_has(:, k) = records%contact_has([2, 1], k)
+          records%contact_limit(:, k) = -records%contact_limit([2, 1], k) + 0.0_wp
+          records%contact_restitution(:, k) = records%contact_restitution([2, 1], k)
+        end if
+      end associate
+    end do
+  end subroutine contact_records
+
+  !> One more contact on x_b - x_a with one limit (side 1 lower, 2 upper).
+  pure subroutine add_contact(records, name, a, b, side, limit, restitution)
+    type(mechanism_records), intent(inout) :: records
+    character(len=*), intent(in) :: name
+    integer, intent(in) :: a, b, side
+    real(wp), intent(in) :: limit, restitution
+    integer :: k
+    records%n_contacts = records%n_contacts + 1
+    k = records%n_contacts
+    records%contact_name(k) = name
+    records%contact_body(:, k) = [a, b]
+    records%contact_has(side, k) = .true.
+    records%contact_limit(side, k) = limit
+    records%contact_restitution(side, k) = restitution
+  end subroutine add_contact
+
+  !> Springs and dampers: to the ground (body arrays k, x_rest, c), between neighbours
+  !> (k_link, d_rest, c_link), then the &spring records (b = 0 turned round: rest negates).
+  subroutine element_records(input, n, records)
+    type(scene_input), intent(in) :: input
+    integer, intent(in) :: n
+    type(mechanism_records), intent(inout) :: records
+    integer :: i, r, ends(2)
+    do i = 1, n
+      if (has_element(input, a_k, i) .or. has_element(input, a_c, i)) call add_element(records, 0, i, &
+        element_or(input, a_k, i, 0.0_wp), element_or(input, a_x_rest, i, 0.0_wp), element_or(input, a_c, i, 0.0_wp))
+    end do
+    do i = 1, n - 1
+      if (has_element(input, a_k_link, i) .or. has_element(input, a_c_link, i)) call add_element(records, i, &
+        i + 1, element_or(input, a_k_link, i, 0.0_wp), element_or(input, a_d_rest, i, 0.0_wp), &
+        element_or(input, a_c_link, i, 0.0_wp))
+    end do
+    if (.not. allocated(input%chain%springs)) return
+    do r = 1, size(input%chain%springs)
+      associate (rec => input%chain%springs(r))
+        ends = nint(rec%value([r_a, r_b]))
+        if (ends(2) == 0) then
+          call add_element(records, 0, ends(1), rec%value(r_k), -rec%value(r_d_rest) + 0.0_wp, rec%value(r_c))
+        else
+          call add_element(records, ends(1), ends(2), rec%value(r_k), rec%value(r_d_rest), rec%value(r_c))
+        end if
+      end associate
+    end do
+  end subroutine element_records
+
+  !> One more element between a and b.
+  pure subroutine add_element(records, a, b, k, rest, c)
+    type(mechanism_records), intent(inout) :: records
+    integer, intent(in) :: a, b
+    real(wp), intent(in) :: k, rest, c
+    records%n_elements = records%n_elements + 1
+    associate (e => records%n_elements)
+      records%element_body(:, e) = [a, b]
+      records%element_k(e) = k
+      records%element_rest(e) = rest
+      records%element_c(e) = c
+    end associate
+  end subroutine add_element
+
+  !> The arrays cut to the records made.
+  pure subroutine shrink(records)
+    type(mechanism_records), intent(inout) :: records
+    associate (nc => records%n_contacts, ne => records%n_elements)
+      records%contact_body = records%contact_body(:, :nc)
+      records%contact_has = records%contact_has(:, :nc)
+      records%contact_limit = records%contact_limit(:, :nc)
+      records%contact_restitution = records%contact_restitution(:, :nc)
+      records%contact_name = records%contact_name(:nc)
+      records%element_body = records%element_body(:, :ne)
+      records%element_k = records%element_k(:ne)
+      records%element_c = records%element_c(:ne)
+      records%element_rest = records%element_rest(:ne)
+    end associate
+  end subroutine shrink
+
+  !> Name of input field id (the flat API's numbering: the tutorial's scalars, its texts,
+  !> the arrays, r_meet, the &contact and &spring record fields as 'contact.a').
+  pure function field_name(id) result(name)
+    integer, intent(in) :: id
+    character(len=16) :: name     ! blank padded: callers trim
+    name = ''
+    if (id >= 1 .and. id <= n_real) then
+      name = real_names(id)
+    else if (id > n_real .and. id <= id_arrays) then
+      name = text_names(id - n_real)
+    else if (id > id_arrays .and. id < id_r_meet) then
+      name = array_names(id - id_arrays)
+    else if (id == id_r_meet) then
+      name = 'r_meet'
+    else if (id > id_contact .and. id <= id_spring) then
+      name = 'contact.' // contact_fields(id - id_contact)
+    else if (id > id_spring .and. id <= n_ids) then
+      name = 'spring.' // spring_fields(id - id_spring)
+    end if
+  end function field_name
+
+  !> Whether field id holds text (a text scalar, f_table's elements, a contact's name).
+  pure logical function field_is_text(id)
+    integer, intent(in) :: id
+    field_is_text = (id > n_real .and. id <= id_arrays) .or. id == id_arrays + a_f_table .or. &
+      id == id_contact + r_name
+  end function field_is_text
+
+  !> Field id := value: a scalar (index ignored), element index of an array, or the field
+  !> of record index. An array or the records grow to index (elements skipped are NaN, which
+  !> the checks refuse).
+  pure subroutine assign_number(input, id, index, value)
+    type(scene_input), intent(inout) :: input
+    integer, intent(in) :: id, index
+    real(wp), intent(in) :: value
+    if (id >= 1 .and. id <= n_real) then
+      input%value(id) = value
+      input%given(id) = .true.
+    else if (id > id_arrays .and. id < id_r_meet) then
+      call grow_array(input%chain%array(id - id_arrays), index)
+      input%chain%array(id - id_arrays)%v(index) = value
+    else if (id == id_r_meet) then
+      input%chain%r_meet = value
+      input%chain%has_r_meet = .true.
+    else if (id > id_contact .and. id <= id_spring) then
+      call grow_records(input%chain%contacts, index)
+      input%chain%contacts(index)%value(id - id_contact) = value
+      input%chain%contacts(index)%given(id - id_contact) = .true.
+    else if (id > id_spring .and. id <= n_ids) then
+      call grow_records(input%chain%springs, index)
+      input%chain%springs(index)%value(id - id_spring) = value
+      input%chain%springs(index)%given(id - id_spring) = .true.
+    end if
+  end subroutine assign_number
+
+  !> Text field id := text (a text scalar, element index of f_table, record index's name).
+  pure subroutine assign_text(input, id, index, text)
+    type(scene_input), intent(inout) :: input
+    integer, intent(in) :: id, index
+    character(len=*), intent(in) :: text
+    if (id > n_real .and. id <= id_arrays) then
+      call set_text(input, id - n_real, text)
+    else if (id == id_arrays + a_f_table) then
+      call grow_array(input%chain%array(a_f_table), index)
+      input%chain%array(a_f_table)%t(index)%s = text
+    else if (id == id_contact + r_name) then
+      call grow_records(input%chain%contacts, index)
+      input%chain%contacts(index)%name = text
+      input%chain%contacts(index)%given(r_name) = .true.
+    end if
+  end subroutine assign_text
+
+  !> An array holds at least n elements (new numbers NaN, new texts '').
+  pure subroutine grow_array(array, n)
+    type(written_array), intent(inout) :: array
+    integer, intent(in) :: n
+    real(wp), allocatable :: v(:)
+    type(text_item), allocatable :: t(:)
+    integer :: k
+    if (array%n >= n) return
+    allocate(v(n), t(n))
+    v = ieee_value(1.0_wp, ieee_quiet_nan)
+    do k = 1, n
+      t(k)%s = ''
+    end do
+    if (allocated(array%v)) v(:array%n) = array%v(:array%n)
+    if (allocated(array%t)) t(:array%n) = array%t(:array%n)
+    call move_alloc(v, array%v)
+    call move_alloc(t, array%t)
+    array%n = n
+  end subroutine grow_array
+
+  !> At least n records.
+  pure subroutine grow_records(records, n)
+    type(record_input), allocatable, intent(inout) :: records(:)
+    integer, intent(in) :: n
+    type(record_input), allocatable :: more(:)
+    if (.not. allocated(records)) allocate(records(0))
+    if (size(records) >= n) return
+    allocate(more(n - size(records)))
+    records = [records, more]
+  end subroutine grow_records
+
+  !> The scene as assignments (what the flat API's read_scene returns): every scalar given
+  !> (index 0), every array element, r_meet, every record field given (index: the record);
+  !> texts likewise, non-empty ones only. n_numbers and n_texts count them all, whatever
+  !> the room (field(:), texts(:) are filled as far as they go).
+  subroutine scene_assignments(input, field, index, value, n_numbers, text_field, text_index, texts, n_texts)
+    type(scene_input), intent(in) :: input
+    integer, intent(out) :: field(:), index(:), text_field(:), text_index(:)
+    real(wp), intent(out) :: value(:)
+    type(text_item), intent(out) :: texts(:)
+    integer, intent(out) :: n_numbers, n_texts
+    integer :: id, i, last
+    n_numbers = 0
+    n_texts = 0
+    do id = 1, n_ids
+      last = 0
+      if (id > id_arrays .and. id < id_r_meet) last = input%chain%array(id - id_arrays)%n
+      if (id > id_contact .and. id <= id_spring .and. allocated(input%chain%contacts)) last = size(input%chain%contacts)
+      if (id > id_spring .and. allocated(input%chain%springs)) last = size(input%chain%springs)
+      if (id <= id_arrays .or. id == id_r_meet) then
+        call put_field(input, id, 0, field, index, value, n_numbers, text_field, text_index, texts, n_texts)
+      end if
+      do i = 1, last
+        call put_field(input, id, i, field, index, value, n_numbers, text_field, text_index, texts, n_texts)
+      end do
+    end do
+  end subroutine scene_assignments
+
+  !> Field id at index i, if given, as the next number or text.
+  subroutine put_field(input, id, i, field, index, value, n_numbers, text_field, text_index, texts, n_texts)
+    type(scene_input), intent(in) :: input
+    integer, intent(in) :: id, i
+    integer, intent(inout) :: field(:), index(:), text_field(:), text_index(:), n_numbers, n_texts
+    real(wp), intent(inout) :: value(:)
+    type(text_item), intent(inout) :: texts(:)
+    character(len=:), allocatable :: text
+    real(wp) :: number
+    logical :: given
+    call field_value(input, id, i, given, number, text)
+    if (.not. given) return
+    if (field_is_text(id)) then
+      n_texts = n_texts + 1
+      if (n_texts > size(texts)) return
+      text_field(n_texts) = id
+      text_index(n_texts) = i
+      texts(n_texts)%s = text
+    else
+      n_numbers = n_numbers + 1
+      if (n_numbers > size(value)) return
+      field(n_numbers) = id
+      index(n_numbers) = i
+      value(n_numbers) = number
+    end if
+  end subroutine put_field
+
+  !> Field id at index i as the input holds it (given false: absent or an empty text).
+  subroutine field_value(input, id, i, given, number, text)
+    type(scene_input), intent(in) :: input
+    integer, intent(in) :: id, i
+    logical, intent(out) :: given
+    real(wp), intent(out) :: number
+    character(len=:), allocatable, intent(out) :: text
+    number = 0.0_wp
+    text = ''
+    given = .false.
+    if (id <= n_real) then
+      given = input%given(id)
+      number = input%value(id)
+    else if (id <= id_arrays) then
+      text = input%text(id - n_real)%s
+    else if (id == id_arrays + a_f_table) then
+      text = input%chain%array(a_f_table)%t(i)%s
+      given = .true.
+    else if (id < id_r_meet) then
+      number = input%chain%array(id - id_arrays)%v(i)
+      given = .true.
+    else if (id == id_r_meet) then
+      given = input%chain%has_r_meet
+      number = input%chain%r_meet
+    else if (id <= id_spring) then
+      call record_value(input%chain%contacts(i), id - id_contact, given, number, text)
+    else
+      call record_value(input%chain%springs(i), id - id_spring, given, number, text)
+    end if
+    if (field_is_text(id) .and. id /= id_arrays + a_f_table) given = len(text) > 0
+  end subroutine field_value
+
+  !> Field f of a record.
+  subroutine record_value(rec, f, given, number, text)
+    type(record_input), intent(in) :: rec
+    integer, intent(in) :: f
+    logical, intent(out) :: given
+    real(wp), intent(out) :: number
+    character(len=:), allocatable, intent(inout) :: text
+    given = rec%given(f)
+    number = rec%value(f)
+    if (allocated(rec%name) .and. f == r_name) text = rec%name
+  end subroutine record_value
+end module impact1d_chain

@@ -1,0 +1,112 @@
+!> The scene as written for any number of bodies (issue 19, "Mechanisms as data"): the
+!> arrays of the chain shorthand (`m = 5*1.0`, `&link d_min = 4*0.25`), the repeatable
+!> `&contact` and `&spring` records, and the field table that says which group each name
+!> belongs to and which tutorial name is an alias of which element (m1 -> m(1), k12 ->
+!> k_link(1)). The tutorial's 43 scalars stay in scene_input's slots; this is the rest.
+module impact1d_fields
+  use impact1d_kinds, only: wp
+  implicit none
+  private
+  public :: n_arrays, array_names, array_groups, array_aliases, array_is_link, array_is_text
+  public :: a_m, a_mu, a_mus, a_x, a_v, a_f, a_f_amp, a_f_period, a_f_phase, a_k, a_x_rest, a_c
+  public :: a_d_min, a_r_min, a_d_max, a_r_max, a_k_link, a_d_rest, a_c_link, a_f_table
+  public :: n_contact_fields, contact_fields, n_spring_fields, spring_fields
+  public :: r_a, r_b, r_d_min, r_r_min, r_d_max, r_r_max, r_name, r_k, r_d_rest, r_c
+  public :: name_len, text_item, written_array, record_input, chain_input, alias_name, mechanism_records
+
+  !> Longest contact name a record may carry (names of events: '<name>', 'rest_<name>', ...).
+  integer, parameter :: name_len = 32
+
+  !> The arrays: body arrays hold N values (body i at i), link arrays N-1 (link i between
+  !> bodies i and i+1). The alias is the tutorial's name of element i ('#' stands for i,
+  !> i = 1, 2); one without '#' names element 1 only (the two-body link).
+  integer, parameter :: n_arrays = 20
+  integer, parameter :: a_m = 1, a_mu = 2, a_mus = 3, a_x = 4, a_v = 5, a_f = 6, a_f_amp = 7, &
+    a_f_period = 8, a_f_phase = 9, a_k = 10, a_x_rest = 11, a_c = 12, a_d_min = 13, a_r_min = 14, &
+    a_d_max = 15, a_r_max = 16, a_k_link = 17, a_d_rest = 18, a_c_link = 19, a_f_table = 20
+  character(len=*), parameter :: array_names(n_arrays) = [character(len=8) :: &
+    'm', 'mu', 'mus', 'x', 'v', 'f', 'f_amp', 'f_period', 'f_phase', 'k', 'x_rest', 'c', &
+    'd_min', 'r_min', 'd_max', 'r_max', 'k_link', 'd_rest', 'c_link', 'f_table']
+  character(len=*), parameter :: array_groups(n_arrays) = [character(len=7) :: &
+    'bodies', 'bodies', 'bodies', 'initial', 'initial', 'forces', 'forces', 'forces', 'forces', &
+    'springs', 'springs', 'springs', 'link', 'link', 'link', 'link', 'springs', 'springs', 'springs', &
+    'forces']
+  character(len=*), parameter :: array_aliases(n_arrays) = [character(len=9) :: &
+    'm#', 'mu#', 'mus#', 'x#', 'v#', 'f#', 'f#_amp', 'f#_period', 'f#_phase', 'k#', 'x#_rest', 'c#', &
+    'd_min', 'r_min', 'd_max', 'r_max', 'k12', 'd_rest', 'c12', 'f#_table']
+  logical, parameter :: array_is_link(n_arrays) = [spread(.false., 1, 12), spread(.true., 1, 7), .false.]
+  logical, parameter :: array_is_text(n_arrays) = [spread(.false., 1, 19), .true.]
+
+  !> The fields of a &contact record (on x_b - x_a; a, b body numbers, 0 the ground) and of
+  !> a &spring record (tension k ((x_b - x_a) - d_rest) + c (v_b - v_a)).
+  integer, parameter :: n_contact_fields = 7, n_spring_fields = 5
+  integer, parameter :: r_a = 1, r_b = 2, r_d_min = 3, r_r_min = 4, r_d_max = 5, r_r_max = 6, r_name = 7
+  integer, parameter :: r_k = 3, r_d_rest = 4, r_c = 5
+  character(len=*), parameter :: contact_fields(n_contact_fields) = [character(len=5) :: &
+    'a', 'b', 'd_min', 'r_min', 'd_max', 'r_max', 'name']
+  character(len=*), parameter :: spring_fields(n_spring_fields) = [character(len=6) :: &
+    'a', 'b', 'k', 'd_rest', 'c']
+
+  !> One text, kept whole (an array of these, not of deferred-length strings: see
+  !> impact1d_scene's scene_text).
+  type :: text_item
+    character(len=:), allocatable :: s
+  end type text_item
+
+  !> An array as written: n values (0: not written), numbers in v or texts in t.
+  type :: written_array
+    integer :: n = 0
+    real(wp), allocatable :: v(:)
+    type(text_item), allocatable :: t(:)
+  end type written_array
+
+  !> One &contact or &spring record as written, with the line it starts on (for messages).
+  type :: record_input
+    real(wp) :: value(n_contact_fields) = 0.0_wp
+    logical :: given(n_contact_fields) = .false.
+    character(len=:), allocatable :: name
+    integer :: line = 0
+  end type record_input
+
+  !> What a scene writes beyond the tutorial's scalars. n_bodies is N when the scene is
+  !> written as arrays of more than two bodies (the arrays are then kept here); 0 when its
+  !> bodies are the tutorial's one or two (arrays of those fold into the scalars).
+  type :: chain_input
+    integer :: n_bodies = 0
+    type(written_array) :: array(n_arrays)
+    real(wp) :: r_meet = 1.0_wp          !< &link r_meet: restitution where neighbours meet
+    logical :: has_r_meet = .false.
+    type(record_input), allocatable :: contacts(:), springs(:)
+  end type chain_input
+
+  !> Contacts and elements as records, in the layout of the model's (scene_type, stage 2;
+  !> here, below impact1d_scene, so that build_scene can take them: impact1d_chain's
+  !> input_records makes them):
+  !> walls, links, then &contact records in file order; ground springs, link springs, then
+  !> &spring records in file order. An end 0 is the ground (always the first end, a).
+  type :: mechanism_records
+    integer :: n_contacts = 0
+    integer, allocatable :: contact_body(:, :)           !< (2, nc) ends a, b; 0 = ground; acts on x_b - x_a
+    logical, allocatable :: contact_has(:, :)            !< (2, nc) lower / upper limit present
+    real(wp), allocatable :: contact_limit(:, :)         !< (2, nc) d_min, d_max on x_b - x_a (walls: positions)
+    real(wp), allocatable :: contact_restitution(:, :)   !< (2, nc) r at the lower, upper limit
+    character(len=name_len), allocatable :: contact_name(:)   !< (nc) 'left' 'right' 'slot' 'link3' ...
+    integer :: n_elements = 0
+    integer, allocatable :: element_body(:, :)           !< (2, ne) ends; elongation (x_b - x_a) - rest
+    real(wp), allocatable :: element_k(:), element_c(:), element_rest(:)   !< (ne)
+  end type mechanism_records
+
+contains
+
+  !> The tutorial's name of element i of array j ('m2', 'k12'), or '' when it has none.
+  pure function alias_name(j, i) result(name)
+    integer, intent(in) :: j, i
+    character(len=16) :: name     ! blank padded: callers trim
+    integer :: hash
+    name = ''
+    hash = index(array_aliases(j), '#')
+    if (hash == 0 .and. i == 1) name = array_aliases(j)
+    if (hash > 0 .and. (i == 1 .or. i == 2)) name = array_aliases(j)(:hash - 1) // achar(iachar('0') + i) // &
+      trim(array_aliases(j)(hash + 1:))
+  end function alias_name
+end module impact1d_fields
