@@ -2,7 +2,7 @@
 !> arrays of the chain shorthand (`m = 5*1.0`, `&link d_min = 4*0.25`), the repeatable
 !> `&contact` and `&spring` records, and the field table that says which group each name
 !> belongs to and which tutorial name is an alias of which element (m1 -> m(1), k12 ->
-!> k_link(1)). The tutorial's 43 scalars stay in scene_input's slots; this is the rest.
+!> k_link(1)). The tutorial's n_real scalars stay in scene_input's slots; this is the rest.
 module impact1d_fields
   use impact1d_kinds, only: wp
   implicit none
