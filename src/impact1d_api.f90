@@ -84,7 +84,7 @@ contains
       text_index(max_texts), text_codes(text_room, max_texts), text_lengths(max_texts)
     real(c_double), intent(out) :: value(max_numbers)
     integer(c_int), intent(out) :: n_numbers, n_texts, status
-    character(len=512), intent(out) :: message
+    character(len=16384), intent(out) :: message    ! 16384: message_length (f2py needs the number)
     type(scene_input) :: input
     type(error_type), allocatable :: error
     type(text_item) :: texts(max_texts)
