@@ -207,9 +207,17 @@ def test_todays_rests_and_sticks():
     band = artist(fig, "rest:left")
     assert band.get_xdata()[0] == pytest.approx(3.0, abs=1e-9) and np.all(np.abs(band.get_ydata()) < 1e-9)
     assert artist(fig, "rest:right").get_ydata()[-1] == pytest.approx(10.0, abs=1e-9)
-    result = run("stick_slip")
-    sticks = [e for e in result.events["kind"] if str(e) == "stick1"]
-    assert sticks and "stuck1" in gids(plot.spacetime(result))
+    result = run("stick_slip")          # sticks and slips by turns: one band, in stretches
+    kinds = [str(k) for k in result.events["kind"]]
+    sticks = [t for t, k in zip(result.events["t"], kinds) if k == "stick1"]
+    slips = [t for t, k in zip(result.events["t"], kinds) if k == "slip1"]
+    band = artist(plot.spacetime(result), "stuck1").get_xdata()
+    gaps = np.flatnonzero(np.isnan(band))
+    starts, ends = band[np.r_[0, gaps + 1]], band[np.r_[gaps - 1, band.size - 1]]
+    # The block starts at rest, held: its first event is a slip, so it is stuck from t = 0.
+    assert len(sticks) > 2 and slips[0] < sticks[0]
+    np.testing.assert_array_equal(starts, [0.0] + sticks)
+    np.testing.assert_array_equal(ends, slips + [result.t[-1]] * (len(sticks) + 1 - len(slips)))
 
 
 def test_many_bodies_get_a_map_of_velocity_over_body_and_time():

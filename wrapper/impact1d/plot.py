@@ -771,6 +771,9 @@ class _Mechanism:
         self.events = [e for e in self.log if self.span[0] <= e.t <= self.span[1]]
         self.ends = {row.name: (row.a, row.b) for row in self.rows}
         self.ends.update((e.contact, e.ends) for e in self.log if e.contact and e.ends)
+        self.by_kind = {}           # kind -> [(index in the log, event)]
+        for index, e in enumerate(self.log):
+            self.by_kind.setdefault(e.kind, []).append((index, e))
 
     def position(self, body, times):
         """Body `body`'s position at `times`, linear between samples."""
@@ -780,7 +783,9 @@ class _Mechanism:
         """(start, end) of each interval from a `begin` event to an `end` one (or the run's
         end; an `end` with no `begin` before it: held from the run's start), in the window."""
         lo, hi = self.span
-        pairs = [(e.t, e.kind) for e in self.log]
+        # Only the two kinds' events, in log order (a body's or contact's events among
+        # 1e5 others: the loops over bodies and contacts stay O(events)).
+        pairs = [(e.t, e.kind) for _, e in sorted(self.by_kind.get(begin, []) + self.by_kind.get(end, []))]
         return [(max(a, lo), min(b, hi)) for a, b in _intervals(pairs, begin, end, *self.run)
                 if b >= lo and a <= hi]
 
@@ -798,12 +803,15 @@ def _impact_points(mech):
     wall's position for a contact with the ground (its limit, when the scene gives it),
     midway between the ends' positions for two bodies (linear between samples)."""
     walls = {row.name: row.limit for row in mech.rows if row.a == 0}
+    lo, hi = mech.span
     points = {}
-    for contact in dict.fromkeys(e.kind for e in mech.events if _is_impact(e.kind)):
+    for contact, events in mech.by_kind.items():
         ends = mech.ends.get(contact)
-        if ends is None:
+        if not _is_impact(contact) or ends is None:
             continue
-        times = np.array([e.t for e in mech.events if e.kind == contact])
+        times = np.array([e.t for _, e in events if lo <= e.t <= hi])
+        if times.size == 0:
+            continue
         a, b = ends
         if a == 0:
             y = np.full(times.size, walls[contact]) if contact in walls else mech.position(b, times)
@@ -813,50 +821,62 @@ def _impact_points(mech):
     return points
 
 
-def _segment(mech, body, start, end):
-    """Body `body`'s path from `start` to `end`: the samples inside, the ends interpolated."""
-    inside = (mech.t > start) & (mech.t < end)
-    times = np.concatenate([[start], mech.t[inside], [end]])
-    return times, mech.position(body, times)
-
-
 def _draw_holds(ax, mech, colors):
     """Under the paths: a grey band over a body while friction holds it (stick<i> to
     slip<i>), an orange one over a body held on a wall or stop and between two bodies
-    held together (rest_<contact> to release_<contact>)."""
-    wide = 7.0 if mech.n <= _LEGEND_UP_TO else 4.0
+    held together (rest_<contact> to release_<contact>). One artist per body or contact,
+    its stretches apart (a long run's thousands of sticks draw as fast as one)."""
+    style = dict(alpha=0.35, linewidth=7.0 if mech.n <= _LEGEND_UP_TO else 4.0,
+                 solid_capstyle="butt", zorder=1.5)
     label = "stuck (friction holds)"
     for body in range(1, mech.n + 1):
-        for start, end in mech.held(f"stick{body}", f"slip{body}"):
-            ax.plot(*_segment(mech, body, start, end), color="0.5", alpha=0.35, linewidth=wide,
-                    solid_capstyle="butt", zorder=1.5, gid=f"stuck{body}", label=label)
+        stretches = mech.held(f"stick{body}", f"slip{body}")
+        if stretches:
+            ax.plot(*_stretches(mech, body, stretches), color="0.5", gid=f"stuck{body}",
+                    label=label, **style)
             label = "_nolegend_"
     label = "held contact"
     for contact, (a, b) in mech.ends.items():
-        for start, end in mech.held("rest_" + contact, "release_" + contact):
-            if a == 0:
-                ax.plot(*_segment(mech, b, start, end), color="tab:orange", alpha=0.35,
-                        linewidth=wide, solid_capstyle="butt", zorder=1.5,
-                        gid=f"rest:{contact}", label=label)
-            else:
-                times, lower = _segment(mech, a, start, end)
-                ax.fill_between(times, lower, mech.position(b, times), color="tab:orange",
-                                alpha=0.3, linewidth=0, zorder=1.5, gid=f"rest:{contact}",
-                                label=label)
-            label = "_nolegend_"
+        stretches = mech.held("rest_" + contact, "release_" + contact)
+        if not stretches:
+            continue
+        if a == 0:
+            ax.plot(*_stretches(mech, b, stretches), color="tab:orange", gid=f"rest:{contact}",
+                    label=label, **style)
+        else:
+            times, lower = _stretches(mech, a, stretches)
+            ax.fill_between(times, lower, mech.position(b, times), color="tab:orange", alpha=0.3,
+                            linewidth=0, zorder=1.5, gid=f"rest:{contact}", label=label)
+        label = "_nolegend_"
+
+
+def _stretches(mech, body, stretches):
+    """Body `body`'s path over each (start, end) stretch: the samples inside, the ends
+    interpolated, a NaN between stretches (a gap in a line or a fill)."""
+    times = []
+    for start, end in stretches:
+        inside = (mech.t > start) & (mech.t < end)
+        times += [[start], mech.t[inside], [end], [np.nan]]
+    times = np.concatenate(times[:-1])
+    return times, mech.position(body, times)
 
 
 def _draw_ground_rows(ax, mech, colors):
     """Walls (body 1's lower limit, body N's upper one) as today's plot draws them; stops
     of the other bodies as dashed lines in the body's colour."""
     for row in (r for r in mech.rows if r.a == 0):
-        sign = "\u2265" if row.side == "min" else "\u2264"
-        label = f"{row.name}: x{row.b} {sign} {row.limit:g} m"
+        label = _row_label(row)
         if (row.b, row.side) in ((1, "min"), (mech.n, "max")):
             ax.axhline(row.limit, color="0.25", linewidth=1.5, gid=f"wall:{row.name}", label=label)
         else:
             ax.axhline(row.limit, color=colors[row.b - 1], linewidth=1.0, linestyle="--",
                        gid=f"wall:{row.name}", label=label)
+
+
+def _row_label(row):
+    """What a limit with the ground says: 'left: x1 \u2265 0 m'."""
+    sign = "\u2265" if row.side == "min" else "\u2264"
+    return f"{row.name}: x{row.b} {sign} {row.limit:.4g} m"
 
 
 def _draw_impact_marks(ax, mech):
@@ -1216,7 +1236,12 @@ class _Stage:
     def _draw_walls(self):
         for row in (r for r in self.mech.rows if r.a == 0):
             edge = row.limit - self.w / 2 if row.side == "min" else row.limit + self.w / 2
-            if (row.b, row.side) in ((1, "min"), (self.mech.n, "max")):
+            wall = (row.b, row.side) in ((1, "min"), (self.mech.n, "max"))
+            # Stops' labels a line above the walls': a stop may stand near a wall.
+            self.ax.text(edge, 0.02 if wall else 0.1, _row_label(row), fontsize="x-small",
+                         transform=self.ax.get_xaxis_transform(), color="0.25",
+                         ha="left" if row.side == "min" else "right")
+            if wall:
                 self.ax.axvline(edge, ymin=0.1, ymax=0.9, color="0.25", linewidth=3, gid=f"wall:{row.name}")
             else:
                 self.ax.plot([edge, edge], [-0.25, 0.3], color=self.colors[row.b - 1], linewidth=3,
