@@ -299,6 +299,13 @@ def test_animation_gif(tmp_path, cradle, case):
         assert block.get_x() == pytest.approx(X[last, i] - width / 2) and block.get_width() == width
 
 
+def test_animation_frames_of_a_time_window(tmp_path, cradle):
+    _, result = cradle              # samples every 5 ms
+    anim = plot.animate(result, tmp_path / "w.gif", t_from=0.2, t_to=0.6, max_frames=5)
+    np.testing.assert_allclose(result.t[anim.frame_samples], [0.2, 0.3, 0.4, 0.5, 0.6], atol=1e-12)
+    assert len(frames_of(tmp_path / "w.gif")) == 5
+
+
 def test_animation_refuses_what_it_cannot_write(tmp_path, cradle):
     _, result = cradle
     with pytest.raises(ValueError, match="gif or .mp4"):
@@ -323,3 +330,6 @@ def test_cli_animates_a_run(tmp_path):
         done = subprocess.run([find_tool("impact1d-plot"), "--animate", str(out), "-o",
                                str(tmp_path / "x.mp4")], capture_output=True, text=True)
         assert done.returncode == 1 and "ffmpeg not found: write .gif" in done.stderr
+    done = subprocess.run([find_tool("impact1d-plot"), "--animate", "--separate", str(out)],
+                          capture_output=True, text=True)
+    assert done.returncode == 1 and "--animate writes one animation" in done.stderr

@@ -31,7 +31,8 @@ def _parser():
         prog=PROG,
         description="Plot an impact1d output file: positions with walls and slot, "
         "velocities, applied forces, kinetic and potential energy, impacts per constraint, "
-        "energy ledger.",
+        "energy ledger (three bodies or more: a space-time plot and the energies); or "
+        "animate it (--animate); or plot a sweep's table.",
         epilog="exit status: 0 done; 1 the output could not be read or drawn (a time window "
         "that misses the run, a --scene it was not run from) or the image written; "
         "2 a bad command line.",
@@ -201,6 +202,9 @@ def _animate(args, result):
     path = args.png or os.path.splitext(args.output)[0] + ".gif"
     if args.fps < 1 or args.max_frames < 1:
         return _fail("--fps and --max-frames must be at least 1")
+    if args.separate or args.show or args.forces is not None:
+        return _fail("--animate writes one animation: --separate, --show and --forces are "
+                     "for figures")
     try:
         plot.animate(result, path, fps=args.fps, max_frames=args.max_frames,
                      t_from=args.t_from, t_to=args.t_to)
