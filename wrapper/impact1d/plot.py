@@ -650,7 +650,8 @@ def _bodies(result):
         names = ("1", "2") if getattr(result, "x2", None) is not None else ("1",)
         x = np.column_stack([np.asarray(getattr(result, "x" + i), dtype=float) for i in names])
         v = np.column_stack([np.asarray(getattr(result, "v" + i), dtype=float) for i in names])
-    return t, np.asarray(x, dtype=float).reshape(t.size, -1), np.asarray(v, dtype=float).reshape(t.size, -1)
+    X = np.asarray(x, dtype=float).reshape(t.size, -1)
+    return t, X, np.asarray(v, dtype=float).reshape(t.size, -1)
 
 
 class _Row(NamedTuple):
@@ -785,7 +786,8 @@ class _Mechanism:
         lo, hi = self.span
         # Only the two kinds' events, in log order (a body's or contact's events among
         # 1e5 others: the loops over bodies and contacts stay O(events)).
-        pairs = [(e.t, e.kind) for _, e in sorted(self.by_kind.get(begin, []) + self.by_kind.get(end, []))]
+        both = sorted(self.by_kind.get(begin, []) + self.by_kind.get(end, []))
+        pairs = [(e.t, e.kind) for _, e in both]
         return [(max(a, lo), min(b, hi)) for a, b in _intervals(pairs, begin, end, *self.run)
                 if b >= lo and a <= hi]
 
@@ -1213,8 +1215,8 @@ class _Stage:
         span = float(np.ptp(mech.X)) if mech.X.size else 1.0
         self.w = min(gaps) if gaps else 0.04 * (span or 1.0)
         # A slot: (its upper row, its lower limit: 0 when the record has none).
-        self.slots = [(r, next((q.limit for q in mech.rows if q.record == r.record and q.side == "min"), 0.0))
-                      for r in mech.rows if r.a and r.side == "max"]
+        lows = {r.record: r.limit for r in mech.rows if r.side == "min"}
+        self.slots = [(r, lows.get(r.record, 0.0)) for r in mech.rows if r.a and r.side == "max"]
         self.blocks = [ax.add_patch(Rectangle((0.0, 0.0), self.w, 1.0, facecolor=c, edgecolor="black",
                                               linewidth=0.8, gid=f"block{i + 1}"))
                        for i, c in enumerate(self.colors)]
@@ -1242,7 +1244,8 @@ class _Stage:
                          transform=self.ax.get_xaxis_transform(), color="0.25",
                          ha="left" if row.side == "min" else "right")
             if wall:
-                self.ax.axvline(edge, ymin=0.1, ymax=0.9, color="0.25", linewidth=3, gid=f"wall:{row.name}")
+                self.ax.axvline(edge, ymin=0.1, ymax=0.9, color="0.25", linewidth=3,
+                                gid=f"wall:{row.name}")
             else:
                 self.ax.plot([edge, edge], [-0.25, 0.3], color=self.colors[row.b - 1], linewidth=3,
                              gid=f"wall:{row.name}")
