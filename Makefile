@@ -32,7 +32,8 @@ INSTALL_STAMP := $(VENV)/.installed
 
 help:
 	@echo "make setup   gfortran (apt, if missing), .venv, pip install .[test]"
-	@echo "make demo    run the scenes in input/ (the six cases, springs, stick-slip, rattle, break-away) and plot them"
+	@echo "make demo    run the scenes in input/ (the six cases, springs, stick-slip, rattle, break-away),"
+	@echo "             plot them, animate case 3 (docs/case3.gif)"
 	@echo "make test    Fortran unit tests (meson test), then pytest"
 	@echo "make study   case 5's rest time over (r_left, r_right), the impact oscillator's bifurcation diagram"
 	@echo "make bench   accuracy and speed studies, Siconos and CVODE as peers (apt, if missing)"
@@ -83,6 +84,8 @@ demo: setup
 	  impact1d input/$$name.nml; \
 	  impact1d-plot output/$$name.dat; \
 	done
+	@echo "== case3 animated (README)"
+	impact1d-plot --animate output/case3.dat -o docs/case3.gif --max-frames 150 --fps 15
 
 # An example study (README): 400 runs of case 5 on every core, then the heatmap.
 study: setup

@@ -1,5 +1,8 @@
 """``impact1d-plot OUTPUT.dat [-o PNG] [--separate] [--show] [--forces | --no-forces]
 [--scene SCENE] [--t-from T] [--t-to T]``: plot a run written by the CLI.
+``impact1d-plot --animate OUTPUT.dat [-o GIF] [--fps N] [--max-frames N] [--t-from T] [--t-to T]``:
+the mechanism moving (impact1d.plot.animate), written as OUTPUT.gif (or -o NAME.gif, NAME.mp4
+with ffmpeg).
 ``impact1d-plot TABLE.csv --x NAME [--y NAME] [--value COLUMN ...]``: plot a sweep's table
 (impact1d-sweep): lines over one varied field, a heatmap over two.
 
@@ -29,7 +32,8 @@ def _parser():
         prog=PROG,
         description="Plot an impact1d output file: positions with walls and slot, "
         "velocities, applied forces, kinetic and potential energy, impacts per constraint, "
-        "energy ledger.",
+        "energy ledger (three bodies or more: a space-time plot and the energies); or "
+        "animate it (--animate); or plot a sweep's table.",
         epilog="exit status: 0 done; 1 the output could not be read or drawn (a time window "
         "that misses the run, a --scene it was not run from) or the image written; "
         "2 a bad command line.",
@@ -47,6 +51,12 @@ def _parser():
                    "force tables (default: the scene file named in OUTPUT's header)")
     p.add_argument("--t-from", type=float, metavar="T", help="draw from time T (s)")
     p.add_argument("--t-to", type=float, metavar="T", help="draw up to time T (s)")
+    p.add_argument("--animate", action="store_true",
+                   help="write an animation of the mechanism instead (-o NAME.gif, or NAME.mp4 "
+                   "with ffmpeg; default OUTPUT with .gif)")
+    p.add_argument("--fps", type=int, default=20, metavar="N", help="animation frames per second")
+    p.add_argument("--max-frames", type=int, default=300, metavar="N",
+                   help="at most N frames: the samples evenly thinned (default 300)")
     p.add_argument("--x", help="a sweep table's varied field for the x axis")
     p.add_argument("--y", help="a second varied field: a heatmap of --value")
     p.add_argument("--value", action="append", default=None,
@@ -163,10 +173,12 @@ def _main(argv):
 
     import matplotlib
 
-    if not args.show:
+    if not args.show or args.animate:
         matplotlib.use("Agg")
     from impact1d import plot
 
+    if args.animate:
+        return _animate(args, result)
     factory = None
     if args.show:
         import matplotlib.pyplot as plt
@@ -198,6 +210,24 @@ def _main(argv):
     if args.show:
         plt.show()
     return 0
+
+
+def _animate(args, result):
+    """The animation of the run (impact1d.plot.animate), written whole."""
+    from impact1d import plot
+
+    path = args.png or os.path.splitext(args.output)[0] + ".gif"
+    if args.fps < 1 or args.max_frames < 1:
+        return _fail("--fps and --max-frames must be at least 1")
+    if args.separate or args.show or args.forces is not None:
+        return _fail("--animate writes one animation: --separate, --show and --forces are "
+                     "for figures")
+    try:
+        plot.animate(result, path, fps=args.fps, max_frames=args.max_frames,
+                     t_from=args.t_from, t_to=args.t_to)
+    except Exception as exc:  # noqa: BLE001 - one line, whatever went wrong
+        return _fail(f"cannot write {path}: {_one_line(exc)}")
+    return 0 if _say(f"wrote {path}") else 1
 
 
 def _plot_table(args):
