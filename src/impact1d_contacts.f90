@@ -28,7 +28,7 @@ contains
     b = scene%pair%normal(2, k) * m%x(2)
     total = a + b
     rounded = total - a
-    gap = (total + scene%row_offset(k)) + (((a - (total - rounded)) + (b - rounded)) + &
+    gap = (total + scene%fixed_offset(k)) + (((a - (total - rounded)) + (b - rounded)) + &
       dot_product(scene%pair%normal(:, k), m%x_lo))
   end function gap
 
@@ -83,12 +83,12 @@ contains
     case (1, 2)
       ! A wall holds one body: normal . x + offset = 0 for the body it faces.
       i = merge(1, 2, scene%pair%normal(1, k) /= 0.0_wp)
-      s%x(i) = -scene%row_offset(k) / scene%pair%normal(i, k)
+      s%x(i) = -scene%fixed_offset(k) / scene%pair%normal(i, k)
       s%x_lo(i) = 0.0_wp
     case (3, 4)
       ! Move the body that no wall holds.
       ! x2 = x1 + d exactly, the sum's rounding kept in the low part.
-      limit = merge(-scene%row_offset(3), scene%row_offset(4), k == 3)
+      limit = merge(-scene%fixed_offset(3), scene%fixed_offset(4), k == 3)
       if (closed(2)) then
         s%x(1) = s%x(2)
         s%x_lo(1) = s%x_lo(2)

@@ -56,16 +56,16 @@ contains
     call state_force(scene, s, f)
     call applied_rate(scene, s%t, s%v, df)
     do k = 1, n_contacts
-      closed(k) = scene%row_present(k)
+      closed(k) = scene%fixed_present(k)
       if (closed(k)) closed(k) = k == which .or. gap(scene, k, s) <= gap_tolerance(scene, k, s, 0.0_wp)
       ! The user's numbers carry their decimal rounding (7.553 - 7.122 is not 0.431): at the
       ! start, a gap within it is contact, as the validator accepted it.
-      if (initial .and. scene%row_present(k)) closed(k) = closed(k) .or. gap(scene, k, s) <= &
-        gap_rounding * max(maxval(abs(scene%pair%normal(:, k) * s%x)), abs(scene%row_offset(k)))
+      if (initial .and. scene%fixed_present(k)) closed(k) = closed(k) .or. gap(scene, k, s) <= &
+        gap_rounding * max(maxval(abs(scene%pair%normal(:, k) * s%x)), abs(scene%fixed_offset(k)))
     end do
     ! A rigid link (d_min = d_max) is one constraint seen from both sides.
-    if (scene%row_present(i_slot_min) .and. scene%row_present(i_slot_max)) then
-      if (scene%row_offset(i_slot_min) == -scene%row_offset(i_slot_max)) then
+    if (scene%fixed_present(i_slot_min) .and. scene%fixed_present(i_slot_max)) then
+      if (scene%fixed_offset(i_slot_min) == -scene%fixed_offset(i_slot_max)) then
         closed(i_slot_min) = closed(i_slot_min) .or. closed(i_slot_max)
         closed(i_slot_max) = closed(i_slot_min)
       end if
@@ -181,7 +181,7 @@ contains
       call mode%acceleration(scene%forcing%constant_lanes, rk%constant_acceleration)
       call watch%find_quiet_times(scene, mode, s, rk%constant_acceleration)
     end if
-    watch%watching = mode%n_hold > 0 .or. any(scene%row_present .and. .not. mode%active) .or. &
+    watch%watching = mode%n_hold > 0 .or. any(scene%fixed_present .and. .not. mode%active) .or. &
       any(scene%pair%static_friction > 0.0_wp .and. mode%sgn /= 0.0_wp)
   end subroutine event_point
 

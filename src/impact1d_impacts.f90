@@ -74,7 +74,7 @@ contains
     type(scene_type), intent(in) :: scene
     integer, intent(in) :: k
     logical, intent(in) :: closed(n_contacts)
-    restitution_of = scene%row_restitution(k)
+    restitution_of = scene%fixed_restitution(k)
     if ((k == i_slot_min .or. k == i_slot_max) .and. closed(i_slot_min) .and. closed(i_slot_max)) &
       restitution_of = 0.0_wp
   end function restitution_of

@@ -71,7 +71,7 @@ contains
     have_acc_rounding = .false.
     have_acc0 = .false.
     do k = 1, n_contacts
-      if (.not. scene%row_present(k) .or. mode%active(k)) cycle
+      if (.not. scene%fixed_present(k) .or. mode%active(k)) cycle
       if (a%t + step < self%quiet_row(k)) cycle
       if (.not. have_dense) call dense_output(a, b, step, c)
       have_dense = .true.
@@ -264,7 +264,7 @@ contains
     integer :: k, i
     constraints_hold = .true.
     do k = 1, n_contacts
-      if (.not. scene%row_present(k) .or. mode%active(k) .or. k == located_contact) cycle
+      if (.not. scene%fixed_present(k) .or. mode%active(k) .or. k == located_contact) cycle
       if (gap(scene, k, b) < -gap_tolerance(scene, k, b, displacement(scene, k, s, b))) constraints_hold = .false.
     end do
     do i = 1, scene%n_bodies
@@ -289,7 +289,7 @@ contains
     self%quiet_row = huge(1.0_wp)
     self%quiet_body(:) = huge(1.0_wp)
     do k = 1, n_contacts
-      if (.not. scene%row_present(k) .or. mode%active(k)) cycle
+      if (.not. scene%fixed_present(k) .or. mode%active(k)) cycle
       self%quiet_row(k) = s%t + 0.99_wp * first_negative(gap(scene, k, s), normal_velocity(scene, k, s%v), &
         dot_product(scene%pair%normal(:, k), constant_acceleration))
     end do

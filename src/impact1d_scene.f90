@@ -20,6 +20,7 @@ module impact1d_scene
   public :: sample_time, set_text, events_kept
   public :: i_title, i_f1_table, i_f2_table, i_method, i_substeps, i_events, default_gravity
   public :: events_all, events_impacts, events_none
+  public :: name_len, set_rows, allocate_contacts
 
   integer, parameter :: n_real = 43, n_text = 6
   !> Names of the real inputs, as in the namelist and in Python's Scene, in this order.
@@ -60,6 +61,15 @@ module impact1d_scene
     [1.0_wp, 0.0_wp, 0.0_wp, -1.0_wp, -1.0_wp, 1.0_wp, 1.0_wp, -1.0_wp], [2, n_contacts])
   real(wp), parameter :: one_body_normal(2, n_contacts) = reshape( &
     [1.0_wp, 0.0_wp, -1.0_wp, 0.0_wp, -1.0_wp, 1.0_wp, 1.0_wp, -1.0_wp], [2, n_contacts])
+
+  !> Longest name of a contact record or row ('slot_max', a user's '<name>_min').
+  integer, parameter :: name_len = 32
+  !> The tutorial's contact records, in the order of docs/nbody-plan.md B4: 'left' (the
+  !> ground and body 1, lower limit x_left), 'right' (the ground and body N, upper limit
+  !> x_right), 'slot' (bodies 1 and 2, lower limit d_min or their meeting, upper d_max); and
+  !> which record and end (1 lower, 2 upper) each of the four tutorial limits is.
+  character(len=*), parameter :: tutorial_records(3) = [character(len=5) :: 'left', 'right', 'slot']
+  integer, parameter :: limit_record(n_contacts) = [1, 2, 3, 3], limit_end(n_contacts) = [1, 2, 1, 2]
 
   real(wp), parameter :: default_gravity = 9.80665_wp
   !> The tutorial's zero-velocity threshold, used by the vissim method only.
@@ -111,12 +121,33 @@ module impact1d_scene
     real(wp), allocatable :: body_x0(:), body_v0(:)  !< (N) initial position (m) and velocity (m/s)
     type(forcing_type) :: forcing                    !< the external forces f_i(t), per body (N)
     type(springs_type) :: springs                    !< springs and dampers: k1, k2, k12 as elements
-    ! rows: the four optional unilateral constraints, in the order left, right, slot_min, slot_max;
-    ! gap_k = pair%normal(:, k) . x + row_offset(k) >= 0 (their normals on the two bodies are
-    ! the kernels' view, pair%normal)
-    logical :: row_present(n_contacts) = .false.     !< (4) the scene has row k
-    real(wp) :: row_offset(n_contacts) = 0.0_wp      !< (4) its offset: -x_left, +x_right, -d_min, +d_max
-    real(wp) :: row_restitution(n_contacts) = 1.0_wp !< (4) Newton's restitution of row k
+    ! contacts: the records as written (docs/nbody-plan.md section 1). Record j constrains
+    ! d = x_b - x_a (a ground end is 0: x = 0) between its limits, d_min <= d <= d_max.
+    integer :: n_contacts = 0
+    integer, allocatable :: contact_body(:, :)          !< (2, nc) ends a, b; 0 = ground; acts on x_b - x_a
+    logical, allocatable :: contact_has(:, :)           !< (2, nc) lower / upper limit present
+    real(wp), allocatable :: contact_limit(:, :)        !< (2, nc) d_min, d_max on x_b - x_a (walls: positions)
+    real(wp), allocatable :: contact_restitution(:, :)  !< (2, nc) Newton's r at the lower, upper limit
+    character(len=name_len), allocatable :: contact_name(:)  !< (nc) 'left', 'right', 'slot', ...
+    ! rows: one unilateral constraint per present limit, what the engine loops over, made
+    ! from the records by set_rows in record order, lower limit first (docs/nbody-plan.md
+    ! B4: left, right, slot_min, slot_max); gap_r = row_normal(:, r) . x(row_body(:, r))
+    ! + row_offset(r) >= 0.
+    integer :: n_rows = 0
+    integer, allocatable :: row_contact(:)              !< (nr) the record it comes from
+    integer, allocatable :: row_body(:, :)              !< (2, nr) ends a, b (a = 0: ground)
+    real(wp), allocatable :: row_normal(:, :)           !< (2, nr) on x_a, x_b: lower (-1, 1), upper (1, -1);
+                                                        !< 0 on a ground end
+    real(wp), allocatable :: row_offset(:)              !< (nr) -d_min (lower) or +d_max (upper)
+    real(wp), allocatable :: row_restitution(:)         !< (nr) Newton's restitution
+    integer, allocatable :: row_partner(:)              !< (nr) the other limit of a rigid link (d_min = d_max), else 0
+    character(len=name_len), allocatable :: row_name(:) !< (nr) one limit: the record's name; two (and
+                                                        !< always the link 'slot'): <name>_min, <name>_max
+    ! The four tutorial rows at fixed indices (left, right, slot_min, slot_max) as the engine
+    ! still reads them until it loops over the rows above (issue 19, stage 2).
+    logical :: fixed_present(n_contacts) = .false.     !< (4) the scene has row k
+    real(wp) :: fixed_offset(n_contacts) = 0.0_wp      !< (4) its offset: -x_left, +x_right, -d_min, +d_max
+    real(wp) :: fixed_restitution(n_contacts) = 1.0_wp !< (4) Newton's restitution of row k
     !> The bodies and rows as the two-body kernels see them (impact1d_modes' pair_type: in
     !> lanes, impact1d_lanes): with one body, padded by a phantom (unit mass, at rest, no
     !> friction, on no row) in the idle lane.
@@ -507,12 +538,14 @@ contains
     scene%method = 'event'
     if (len_trim(input%text(i_method)%s) > 0) scene%method = trim(input%text(i_method)%s)
     call set_bodies(input, tables, scene)
+    call set_contacts(input, scene)
+    call set_rows(scene)
     do k = 1, n_contacts
-      scene%row_present(k) = has_limit(input, k)
-      if (.not. scene%row_present(k)) cycle
+      scene%fixed_present(k) = has_limit(input, k)
+      if (.not. scene%fixed_present(k)) cycle
       ! (A limit of -0 enters as +0: snap puts a body at -offset / normal, which is then +0.)
-      scene%row_offset(k) = offset_sign(k) * (limit_value(input, k) + 0.0_wp)
-      if (input%given(limit_index(k) + 1)) scene%row_restitution(k) = input%value(limit_index(k) + 1)
+      scene%fixed_offset(k) = offset_sign(k) * (limit_value(input, k) + 0.0_wp)
+      if (input%given(limit_index(k) + 1)) scene%fixed_restitution(k) = input%value(limit_index(k) + 1)
     end do
     do k = 1, n_elements
       if (input%given(spring_index(k))) then
@@ -598,6 +631,93 @@ contains
     end do
     call scene%forcing%set_varies()
   end subroutine set_bodies
+
+  !> The tutorial's walls and slot as contact records (docs/nbody-plan.md section 1): a wall
+  !> when the scene names it, the slot whenever there are two bodies (they cannot pass each
+  !> other: the meeting d_min = 0 unless d_min is given). With one body the right wall holds
+  !> body 1. A limit of -0 enters as +0 (docs/architecture.md, "Signed zeros").
+  subroutine set_contacts(input, scene)
+    type(scene_input), intent(in) :: input
+    type(scene_type), intent(inout) :: scene
+    integer :: j, k, r, nc
+    integer :: record_of(size(tutorial_records))
+    logical :: present(size(tutorial_records))
+    present = [(any([(has_limit(input, k) .and. limit_record(k) == r, k = 1, n_contacts)]), &
+      r = 1, size(tutorial_records))]
+    nc = count(present)
+    call allocate_contacts(scene, nc)
+    j = 0
+    record_of = 0
+    do r = 1, size(tutorial_records)
+      if (.not. present(r)) cycle
+      j = j + 1
+      record_of(r) = j
+      scene%contact_name(j) = tutorial_records(r)
+    end do
+    if (record_of(1) > 0) scene%contact_body(:, record_of(1)) = [0, 1]
+    if (record_of(2) > 0) scene%contact_body(:, record_of(2)) = [0, scene%n_bodies]
+    if (record_of(3) > 0) scene%contact_body(:, record_of(3)) = [1, 2]
+    do k = 1, n_contacts
+      if (.not. has_limit(input, k)) cycle
+      associate (e => limit_end(k), j => record_of(limit_record(k)))
+        scene%contact_has(e, j) = .true.
+        scene%contact_limit(e, j) = limit_value(input, k) + 0.0_wp
+        scene%contact_restitution(e, j) = value_or(input, limit_index(k) + 1, 1.0_wp)
+      end associate
+    end do
+  end subroutine set_contacts
+
+  !> Room for nc contact records, none of their limits present yet.
+  subroutine allocate_contacts(scene, nc)
+    type(scene_type), intent(inout) :: scene
+    integer, intent(in) :: nc
+    scene%n_contacts = nc
+    allocate(scene%contact_body(2, nc), scene%contact_has(2, nc), scene%contact_limit(2, nc), &
+      scene%contact_restitution(2, nc), scene%contact_name(nc))
+    scene%contact_body = 0
+    scene%contact_has = .false.
+    scene%contact_limit = 0.0_wp
+    scene%contact_restitution = 1.0_wp
+    scene%contact_name = ''
+  end subroutine allocate_contacts
+
+  !> The rows from the contact records: one per present limit, in record order, the lower
+  !> limit first (the row order decides ties, docs/nbody-plan.md B4). A lower limit's gap
+  !> is (x_b - x_a) - d_min, an upper one's d_max - (x_b - x_a); a ground end has no
+  !> coefficient. The two limits of a rigid link (d_min = d_max) are each other's partner.
+  subroutine set_rows(scene)
+    type(scene_type), intent(inout) :: scene
+    integer :: j, e, r, nr
+    real(wp) :: sgn
+    logical :: suffix
+    nr = count(scene%contact_has)
+    scene%n_rows = nr
+    allocate(scene%row_contact(nr), scene%row_body(2, nr), scene%row_normal(2, nr), scene%row_offset(nr), &
+      scene%row_restitution(nr), scene%row_partner(nr), scene%row_name(nr))
+    scene%row_partner = 0
+    r = 0
+    do j = 1, scene%n_contacts
+      suffix = all(scene%contact_has(:, j)) .or. scene%contact_name(j) == 'slot'
+      do e = 1, 2
+        if (.not. scene%contact_has(e, j)) cycle
+        r = r + 1
+        sgn = merge(1.0_wp, -1.0_wp, e == 1)
+        scene%row_contact(r) = j
+        scene%row_body(:, r) = scene%contact_body(:, j)
+        scene%row_normal(:, r) = merge([-sgn, sgn], [0.0_wp, 0.0_wp], scene%contact_body(:, j) /= 0)
+        scene%row_offset(r) = -sgn * scene%contact_limit(e, j)
+        scene%row_restitution(r) = scene%contact_restitution(e, j)
+        scene%row_name(r) = scene%contact_name(j)
+        if (suffix) scene%row_name(r) = trim(scene%contact_name(j)) // trim(merge('_min', '_max', e == 1))
+      end do
+      if (all(scene%contact_has(:, j))) then
+        if (scene%contact_limit(1, j) == scene%contact_limit(2, j)) then
+          scene%row_partner(r - 1) = r
+          scene%row_partner(r) = r - 1
+        end if
+      end if
+    end do
+  end subroutine set_rows
 
   !> RK4's step against the modes of the springs and dampers (impact1d_stability): past the
   !> largest stable step the numbers would be garbage (positions to 1e76 with a normal exit),

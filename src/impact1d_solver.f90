@@ -484,7 +484,7 @@ contains
     real(wp), parameter :: no_scale(max_lanes) = 0.0_wp
     impact_due = .false.
     do k = 1, n_contacts
-      if (.not. scene%row_present(k) .or. mode%active(k)) cycle
+      if (.not. scene%fixed_present(k) .or. mode%active(k)) cycle
       if (gap(scene, k, s) <= gap_tolerance(scene, k, s, 0.0_wp) .and. &
           normal_velocity(scene, k, s%v) < -u_tolerance(scene, mode, s, k, no_scale)) impact_due = .true.
     end do

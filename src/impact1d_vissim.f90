@@ -76,16 +76,16 @@ contains
       ! Collisions seen at the step's end: the slot's first, then the walls on what it left.
       do k = 1, n_contacts
         associate (c => slot_first(k))
-          if (.not. scene%row_present(c)) cycle
+          if (.not. scene%fixed_present(c)) cycle
           if (.not. (gap_before(c) >= 0.0_wp .and. gap(c, x) < 0.0_wp)) cycle
           v_hit = threshold(v)
           ! A wall clamps the body it faces: normal . x + offset = 0.
           if (c == i_left .or. c == i_right) then
             associate (i => merge(1, 2, scene%pair%normal(1, c) /= 0.0_wp))
-              x(i) = -scene%row_offset(c) / scene%pair%normal(i, c)
+              x(i) = -scene%fixed_offset(c) / scene%pair%normal(i, c)
             end associate
           end if
-          call impulse(scene, c, scene%row_restitution(c), threshold(v_prev), v_new)
+          call impulse(scene, c, scene%fixed_restitution(c), threshold(v_prev), v_new)
           where (scene%pair%normal(:, c) == 0.0_wp) v_new = v
           impact_loss = impact_loss + kinetic_energy(scene, threshold(v)) - kinetic_energy(scene, threshold(v_new))
           v = v_new
@@ -111,7 +111,7 @@ contains
     pure real(wp) function gap(k, positions)
       integer, intent(in) :: k
       real(wp), intent(in) :: positions(max_lanes)
-      gap = dot_product(scene%pair%normal(:, k), positions) + scene%row_offset(k)
+      gap = dot_product(scene%pair%normal(:, k), positions) + scene%fixed_offset(k)
     end function gap
 
     !> The diagram's "no movement on zero velocity": |v| <= threshold reads as zero.

@@ -6,7 +6,8 @@ module testing
   use impact1d_kinds, only: wp
   use impact1d_error, only: error_type
   use impact1d_forcing, only: table_type
-  use impact1d_scene, only: scene_input, scene_type, build_scene, real_names, n_real, i_f1_table, set_text, n_text
+  use impact1d_scene, only: scene_input, scene_type, build_scene, real_names, n_real, i_f1_table, set_text, n_text, &
+    i_m2, i_x2
   implicit none
   private
   public :: check, finish, two_body
@@ -33,11 +34,13 @@ contains
 
   !> A scene checked and built by build_scene from 'name = value' assignments in the
   !> namelist's names ('m2 = 2, mu1 = 1, g = 10, x_left = -1'), over base_scene; with
-  !> f1_table, body 1's force table. A scene the validator refuses ends the test.
-  subroutine two_body(assignments, scene, f1_table)
+  !> f1_table, body 1's force table; with one_body, without m2 and x2 (one body). A scene
+  !> the validator refuses ends the test.
+  subroutine two_body(assignments, scene, f1_table, one_body)
     character(len=*), intent(in) :: assignments
     type(scene_type), intent(out) :: scene
     type(table_type), intent(in), optional :: f1_table
+    logical, intent(in), optional :: one_body
     type(scene_input) :: input
     type(table_type) :: tables(2)
     type(error_type), allocatable :: error
@@ -47,6 +50,9 @@ contains
     end do
     call assign(base_scene, input)
     call assign(assignments, input)
+    if (present(one_body)) then
+      if (one_body) input%given([i_m2, i_x2]) = .false.
+    end if
     if (present(f1_table)) then
       call set_text(input, i_f1_table, 'f1_table')
       tables(1) = f1_table
