@@ -7,7 +7,7 @@ module impact1d_scene
   use impact1d_error, only: error_type, raise, status_input, fmt, fmt_width
   use impact1d_forcing, only: forcing_type, table_type
   use impact1d_springs, only: springs_type, n_elements
-  use impact1d_modes, only: pair_type
+  use impact1d_modes, only: pair_type, pair_rows
   use impact1d_stability, only: linear_modes, stable_step, mode_error, coarse_rate
   implicit none
   private
@@ -20,7 +20,7 @@ module impact1d_scene
   public :: sample_time, set_text, events_kept
   public :: i_title, i_f1_table, i_f2_table, i_method, i_substeps, i_events, default_gravity
   public :: events_all, events_impacts, events_none
-  public :: name_len, set_rows, allocate_contacts
+  public :: name_len, set_rows, allocate_contacts, tutorial_row
 
   integer, parameter :: n_real = 43, n_text = 6
   !> Names of the real inputs, as in the namelist and in Python's Scene, in this order.
@@ -143,11 +143,6 @@ module impact1d_scene
     integer, allocatable :: row_partner(:)              !< (nr) the other limit of a rigid link (d_min = d_max), else 0
     character(len=name_len), allocatable :: row_name(:) !< (nr) one limit: the record's name; two (and
                                                         !< always the link 'slot'): <name>_min, <name>_max
-    ! The four tutorial rows at fixed indices (left, right, slot_min, slot_max) as the engine
-    ! still reads them until it loops over the rows above (issue 19, stage 2).
-    logical :: fixed_present(n_contacts) = .false.     !< (4) the scene has row k
-    real(wp) :: fixed_offset(n_contacts) = 0.0_wp      !< (4) its offset: -x_left, +x_right, -d_min, +d_max
-    real(wp) :: fixed_restitution(n_contacts) = 1.0_wp !< (4) Newton's restitution of row k
     !> The bodies and rows as the two-body kernels see them (impact1d_modes' pair_type: in
     !> lanes, impact1d_lanes): with one body, padded by a phantom (unit mass, at rest, no
     !> friction, on no row) in the idle lane.
@@ -539,14 +534,8 @@ contains
     if (len_trim(input%text(i_method)%s) > 0) scene%method = trim(input%text(i_method)%s)
     call set_bodies(input, tables, scene)
     call set_contacts(input, scene)
-    call set_rows(scene)
-    do k = 1, n_contacts
-      scene%fixed_present(k) = has_limit(input, k)
-      if (.not. scene%fixed_present(k)) cycle
-      ! (A limit of -0 enters as +0: snap puts a body at -offset / normal, which is then +0.)
-      scene%fixed_offset(k) = offset_sign(k) * (limit_value(input, k) + 0.0_wp)
-      if (input%given(limit_index(k) + 1)) scene%fixed_restitution(k) = input%value(limit_index(k) + 1)
-    end do
+    call set_rows(scene, error)
+    if (allocated(error)) return
     do k = 1, n_elements
       if (input%given(spring_index(k))) then
         scene%springs%k(k) = input%value(spring_index(k))
@@ -605,7 +594,6 @@ contains
     scene%pair%mass(1:n) = scene%body_mass
     scene%pair%friction(1:n) = scene%body_friction
     scene%pair%static_friction(1:n) = scene%body_static
-    scene%pair%normal = contact_normals(input)
     ! Inputs of -0 enter as +0 (the limits too, in build_scene): sums over bodies and contacts
     ! drop absent terms exactly only when nothing they meet is -0, and a root formula takes
     ! the sign of a zero (docs/architecture.md, "Signed zeros").
@@ -685,12 +673,18 @@ contains
   !> limit first (the row order decides ties, docs/nbody-plan.md B4). A lower limit's gap
   !> is (x_b - x_a) - d_min, an upper one's d_max - (x_b - x_a); a ground end has no
   !> coefficient. The two limits of a rigid link (d_min = d_max) are each other's partner.
-  subroutine set_rows(scene)
+  subroutine set_rows(scene, error)
     type(scene_type), intent(inout) :: scene
+    type(error_type), allocatable, intent(inout) :: error
     integer :: j, e, r, nr
     real(wp) :: sgn
     logical :: suffix
     nr = count(scene%contact_has)
+    if (nr > pair_rows) then
+      call raise(error, status_input, 'the contacts have ' // trim(fmt(nr)) // ' limits: a scene of one or ' // &
+        'two bodies has at most ' // trim(fmt(pair_rows)) // ' (the two-body kernels'' rows)')
+      return
+    end if
     scene%n_rows = nr
     allocate(scene%row_contact(nr), scene%row_body(2, nr), scene%row_normal(2, nr), scene%row_offset(nr), &
       scene%row_restitution(nr), scene%row_partner(nr), scene%row_name(nr))
@@ -717,7 +711,23 @@ contains
         end if
       end if
     end do
+    ! The kernels' view: each row's coefficients on the pair's lanes (body i in lane i).
+    scene%pair%n_rows = nr
+    scene%pair%normal = 0.0_wp
+    do r = 1, nr
+      do e = 1, 2
+        if (scene%row_body(e, r) > 0) scene%pair%normal(scene%row_body(e, r), r) = scene%row_normal(e, r)
+      end do
+    end do
   end subroutine set_rows
+
+  !> Row k's index among the tutorial's four (left, right, slot_min, slot_max): its event
+  !> kinds' offset, until events carry (class, row) (issue 19, stage 2).
+  pure integer function tutorial_row(scene, k)
+    type(scene_type), intent(in) :: scene
+    integer, intent(in) :: k
+    tutorial_row = findloc(contact_names, scene%row_name(k), dim=1)
+  end function tutorial_row
 
   !> RK4's step against the modes of the springs and dampers (impact1d_stability): past the
   !> largest stable step the numbers would be garbage (positions to 1e76 with a normal exit),

@@ -4,9 +4,12 @@
 program test_scene
   use impact1d_kinds, only: wp
   use impact1d_scene, only: scene_type
-  use testing, only: check, finish, two_body
+  use impact1d_contacts, only: snap
+  use impact1d_state, only: lane_state_type
+  use testing, only: check, finish, two_body, on_rows, row_of
   implicit none
   type(scene_type) :: scene
+  type(lane_state_type) :: s
 
   call two_body('m2 = 2, x_left = -1, r_left = 0.5, x_right = 5, d_min = 0.25, d_max = 2, r_max = 0.75', scene)
   call check(scene%n_contacts == 3, 'walls and slot: three records')
@@ -37,5 +40,22 @@ program test_scene
   call check(scene%n_contacts == 1 .and. all(scene%contact_body(:, 1) == [0, 1]), 'one body: right wall on body 1')
   call check(scene%row_name(1) == 'right' .and. all(scene%row_normal(:, 1) == [0.0_wp, -1.0_wp]), &
     'one body: the right row')
+  ! The kernels' view: the row's coefficient on body 1's lane, none on the idle lane.
+  call check(scene%pair%n_rows == 1 .and. all(scene%pair%normal(:, 1) == [-1.0_wp, 0.0_wp]), &
+    'one body: the right wall on lane 1')
+  s%x = [3.25_wp, 0.0_wp]
+  call snap(scene, 1, on_rows([.true.]), s)
+  call check(s%x(1) == 3.0_wp, 'one body: snap puts it on the right wall')
+
+  ! Snap on a row between the bodies moves the end no closed wall holds: body 2 when only
+  ! the left wall holds body 1, body 1 when the right wall holds body 2.
+  call two_body('x_left = -1, x_right = 5, d_min = 0.5', scene)
+  s%x = [-1.0_wp, -0.25_wp]
+  s%x_lo = 0.0_wp
+  call snap(scene, row_of(scene, 'slot_min'), on_rows([.true., .false., .true.]), s)
+  call check(all(s%x == [-1.0_wp, -0.5_wp]), 'slot_min snap moves body 2 off a held body 1')
+  s%x = [4.25_wp, 5.0_wp]
+  call snap(scene, row_of(scene, 'slot_min'), on_rows([.false., .true., .true.]), s)
+  call check(all(s%x == [4.5_wp, 5.0_wp]), 'slot_min snap moves body 1 when the right wall holds body 2')
   call finish('test_scene')
 end program test_scene
