@@ -6,7 +6,7 @@ module impact1d_scene
   use impact1d_kinds, only: wp, eps_wp
   use impact1d_error, only: error_type, raise, status_input, fmt, fmt_width
   use impact1d_forcing, only: forcing_type, table_type
-  use impact1d_springs, only: springs_type, n_elements
+  use impact1d_springs, only: springs_type, pair_elements
   use impact1d_modes, only: pair_type, pair_rows
   use impact1d_stability, only: linear_modes, stable_step, mode_error, coarse_rate
   implicit none
@@ -20,7 +20,7 @@ module impact1d_scene
   public :: sample_time, set_text, events_kept
   public :: i_title, i_f1_table, i_f2_table, i_method, i_substeps, i_events, default_gravity
   public :: events_all, events_impacts, events_none
-  public :: name_len, set_rows, allocate_contacts, tutorial_row
+  public :: name_len, set_rows, allocate_contacts, tutorial_row, set_springs
 
   integer, parameter :: n_real = 43, n_text = 6
   !> Names of the real inputs, as in the namelist and in Python's Scene, in this order.
@@ -43,8 +43,12 @@ module impact1d_scene
   !> What only a second body can have: refused in a one-body scene (no m2).
   integer, parameter :: body2_fields(18) = [i_x2, i_v2, i_mu2, i_mus2, i_f2, i_f2_amp, i_f2_period, &
     i_f2_phase, i_k2, i_x2_rest, i_c2, i_k12, i_d_rest, i_c12, i_d_min, i_r_min, i_d_max, i_r_max]
-  !> Each spring element's stiffness; its rest position and damping follow it.
-  integer, parameter :: spring_index(n_elements) = [i_k1, i_k2, i_k12]
+  !> The tutorial's spring elements (records in this order, docs/nbody-plan.md B5): body 1
+  !> to the ground, body 2 to the ground, between the bodies; each one's stiffness (its rest
+  !> position and damping follow it) and ends.
+  integer, parameter :: n_tutorial_elements = 3
+  integer, parameter :: spring_index(n_tutorial_elements) = [i_k1, i_k2, i_k12]
+  integer, parameter :: tutorial_element_body(2, n_tutorial_elements) = reshape([0, 1, 0, 2, 1, 2], [2, 3])
   integer, parameter :: i_title = 1, i_f1_table = 2, i_f2_table = 3, i_method = 4, i_substeps = 5, &
     i_events = 6
   !> What the event log keeps (&run events): every event, the impacts only, nothing. The
@@ -120,7 +124,16 @@ module impact1d_scene
     real(wp), allocatable :: body_static(:)          !< (N) static friction bound (mus_i m_i) g >= c_i, N
     real(wp), allocatable :: body_x0(:), body_v0(:)  !< (N) initial position (m) and velocity (m/s)
     type(forcing_type) :: forcing                    !< the external forces f_i(t), per body (N)
-    type(springs_type) :: springs                    !< springs and dampers: k1, k2, k12 as elements
+    ! elements: springs and dampers, each pulling its ends together with tension
+    ! k ((x_b - x_a) - rest) + c (v_b - v_a) (a ground end at x = 0)
+    integer :: n_elements = 0
+    integer, allocatable :: element_body(:, :)       !< (2, ne) ends a, b; 0 = ground
+    real(wp), allocatable :: element_k(:)            !< (ne) stiffness, N/m
+    real(wp), allocatable :: element_c(:)            !< (ne) damping, N s/m
+    real(wp), allocatable :: element_rest(:)         !< (ne) rest length of x_b - x_a, m
+    !> The elements as the two-body kernels see them (set_springs), and whether the scene
+    !> names a stiffness or a damping (present, has_spring, has_damper).
+    type(springs_type) :: springs
     ! contacts: the records as written (docs/nbody-plan.md section 1). Record j constrains
     ! d = x_b - x_a (a ground end is 0: x = 0) between its limits, d_min <= d <= d_max.
     integer :: n_contacts = 0
@@ -208,7 +221,7 @@ contains
     call nonnegative(input, i_mu2, error)
     call nonnegative(input, i_zero_vel, error)
     call nonnegative(input, i_mus1, error); call nonnegative(input, i_mus2, error)
-    do k = 1, n_elements
+    do k = 1, n_tutorial_elements
       call nonnegative(input, spring_index(k), error); call nonnegative(input, spring_index(k) + 2, error)
     end do
     if (allocated(error)) return
@@ -222,7 +235,7 @@ contains
       end if
     end do
     ! A spring needs the position at which it is relaxed; a rest position needs its spring.
-    do k = 1, n_elements
+    do k = 1, n_tutorial_elements
       if (input%given(spring_index(k)) .neqv. input%given(spring_index(k) + 1)) then
         if (input%given(spring_index(k))) then
           call raise(error, status_input, trim(real_names(spring_index(k))) // ' is given but ' // &
@@ -536,18 +549,9 @@ contains
     call set_contacts(input, scene)
     call set_rows(scene, error)
     if (allocated(error)) return
-    do k = 1, n_elements
-      if (input%given(spring_index(k))) then
-        scene%springs%k(k) = input%value(spring_index(k))
-        scene%springs%rest(k) = input%value(spring_index(k) + 1)
-      end if
-      if (input%given(spring_index(k) + 2)) scene%springs%c(k) = input%value(spring_index(k) + 2)
-    end do
-    scene%springs%has_spring = any(input%given(spring_index))
-    scene%springs%has_damper = any(input%given(spring_index + 2))
-    scene%springs%present = scene%springs%has_spring .or. scene%springs%has_damper
-    ! The lightest mass as the kernel sees it (the phantom's 1 with one body).
-    call scene%springs%set_frequency(minval(scene%pair%mass))
+    call set_elements(input, scene)
+    call set_springs(scene, error)
+    if (allocated(error)) return
 
     scene%t_end = input%value(i_t_end)
     scene%dt = input%value(i_dt)
@@ -654,6 +658,59 @@ contains
       end associate
     end do
   end subroutine set_contacts
+
+  !> The tutorial's springs and dampers as element records, in the order k1, k2, k12 (the
+  !> order of the sums, docs/nbody-plan.md B5): one where the scene names its stiffness or
+  !> its damping (a damper alone has k = 0, rest 0). Which of them the scene names sets the
+  !> output's PE and damping_loss columns (springs%has_spring, has_damper).
+  subroutine set_elements(input, scene)
+    type(scene_input), intent(in) :: input
+    type(scene_type), intent(inout) :: scene
+    integer :: j, k, ne
+    logical :: named(n_tutorial_elements)
+    named = input%given(spring_index) .or. input%given(spring_index + 2)
+    ne = count(named)
+    scene%n_elements = ne
+    allocate(scene%element_body(2, ne), scene%element_k(ne), scene%element_c(ne), scene%element_rest(ne))
+    scene%element_k = 0.0_wp
+    scene%element_c = 0.0_wp
+    scene%element_rest = 0.0_wp
+    j = 0
+    do k = 1, n_tutorial_elements
+      if (.not. named(k)) cycle
+      j = j + 1
+      scene%element_body(:, j) = tutorial_element_body(:, k)
+      if (input%given(spring_index(k))) then
+        scene%element_k(j) = input%value(spring_index(k))
+        scene%element_rest(j) = input%value(spring_index(k) + 1)
+      end if
+      if (input%given(spring_index(k) + 2)) scene%element_c(j) = input%value(spring_index(k) + 2)
+    end do
+    scene%springs%has_spring = any(input%given(spring_index))
+    scene%springs%has_damper = any(input%given(spring_index + 2))
+  end subroutine set_elements
+
+  !> The element records as the two-body kernels see them (their ends as lanes: body i is
+  !> lane i, the ground 0), and the rate bound that samples their motion.
+  subroutine set_springs(scene, error)
+    type(scene_type), intent(inout) :: scene
+    type(error_type), allocatable, intent(inout) :: error
+    integer :: ne
+    ne = scene%n_elements
+    if (ne > pair_elements) then
+      call raise(error, status_input, 'the scene has ' // trim(fmt(ne)) // ' springs and dampers: a scene ' // &
+        'of one or two bodies has at most ' // trim(fmt(pair_elements)) // ' (the two-body kernels'' elements)')
+      return
+    end if
+    scene%springs%n = ne
+    scene%springs%body(:, :ne) = scene%element_body
+    scene%springs%k(:ne) = scene%element_k
+    scene%springs%c(:ne) = scene%element_c
+    scene%springs%rest(:ne) = scene%element_rest
+    scene%springs%present = ne > 0
+    ! The lightest mass as the kernel sees it (the phantom's 1 with one body).
+    call scene%springs%set_frequency(minval(scene%pair%mass))
+  end subroutine set_springs
 
   !> Room for nc contact records, none of their limits present yet.
   subroutine allocate_contacts(scene, nc)
@@ -804,23 +861,31 @@ contains
   end function mode_text
 
   !> The spring or damper with the fastest rate of its own ('k12 = 1e4'): sqrt(k / m) or c / m
-  !> with m the mass it moves (the reduced mass between the bodies; the pair's masses as the
-  !> mode kernel sees them).
+  !> with m the mass it moves (the body's on a ground element, the reduced mass between
+  !> bodies; the pair's masses as the mode kernel sees them). Named as the tutorial names
+  !> it: k<b> or c<b> to the ground, k<a><b> or c<a><b> between bodies.
   pure function fastest_element(scene) result(text)
     type(scene_type), intent(in) :: scene
     character(len=fmt_width + 24) :: text     ! blank padded: callers trim
-    real(wp) :: mass(n_elements), rate(2 * n_elements)
-    integer :: j
-    associate (m => scene%pair%mass)
-      mass = [m(1), m(2), 1.0_wp / (1.0_wp / m(1) + 1.0_wp / m(2))]
-    end associate
-    rate = [sqrt(scene%springs%k / mass), scene%springs%c / mass]
+    real(wp) :: mass(scene%n_elements), rate(2 * scene%n_elements)
+    character(len=8) :: ends
+    integer :: j, ne
+    ne = scene%n_elements
+    do j = 1, ne
+      associate (m => scene%pair%mass, a => scene%element_body(1, j), b => scene%element_body(2, j))
+        mass(j) = m(b)
+        if (a > 0) mass(j) = 1.0_wp / (1.0_wp / m(a) + 1.0_wp / m(b))
+      end associate
+    end do
+    rate = [sqrt(scene%element_k / mass), scene%element_c / mass]
     j = maxloc(rate, 1)
-    if (j <= n_elements) then
-      text = trim(real_names(spring_index(j))) // ' = ' // trim(fmt(scene%springs%k(j)))
+    if (j > ne) j = j - ne
+    write(ends, '(i0)') scene%element_body(2, j)
+    if (scene%element_body(1, j) > 0) write(ends, '(i0, i0)') scene%element_body(:, j)
+    if (maxloc(rate, 1) <= ne) then
+      text = 'k' // trim(ends) // ' = ' // trim(fmt(scene%element_k(j)))
     else
-      text = trim(real_names(spring_index(j - n_elements) + 2)) // ' = ' // &
-        trim(fmt(scene%springs%c(j - n_elements)))
+      text = 'c' // trim(ends) // ' = ' // trim(fmt(scene%element_c(j)))
     end if
   end function fastest_element
 
