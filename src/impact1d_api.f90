@@ -13,7 +13,7 @@ module impact1d_api
     i_title, i_f1_table, i_f2_table, i_method, i_substeps, i_events, n_contacts, set_text
   use impact1d_io, only: read_scene_file, prepare_scene
   use impact1d_output, only: memory_sink, summary_sink, column_names_text => column_names, event_names, &
-    n_columns, event_impact, present_columns, i_impact_loss, i_friction_loss, i_pe, i_damping_loss
+    n_columns, event_impact, present_columns, kind_code, i_impact_loss, i_friction_loss, i_pe, i_damping_loss
   use impact1d_solver, only: run, run_stats
   implicit none
   private
@@ -116,6 +116,7 @@ contains
     type(memory_sink) :: sink
     type(error_type), allocatable :: error
     integer, allocatable :: columns(:)
+    integer :: k
 
     n_samples = 0
     n_events = 0
@@ -159,7 +160,10 @@ contains
     end if
     ! The present columns first, in order (has_column says which they are): already there.
     event_t(:n_events) = sink%event_time(:n_events)
-    event_kind(:n_events) = sink%event_kind(:n_events)
+    ! The tutorial's kind codes (Python names them from event_kind_names).
+    do k = 1, n_events
+      event_kind(k) = kind_code(sink%row_names, sink%event_class(k), sink%event_index(k))
+    end do
     event_v(:, :n_events) = sink%event_v(:, :n_events)
   end subroutine simulate
 

@@ -5,12 +5,12 @@
 module impact1d_event_log
   use impact1d_kinds, only: wp
   use impact1d_lanes, only: max_lanes
-  use impact1d_scene, only: scene_type, tutorial_row
-  use impact1d_output, only: sink_type, run_stats, event_rest, event_release
+  use impact1d_scene, only: scene_type
+  use impact1d_output, only: sink_type, run_stats, class_rest, class_release, kind_code
   use impact1d_yardsticks, only: same_instant
   implicit none
   private
-  public :: event_log_type, log_event, reported_pair
+  public :: event_log_type, log_event
 
   !> The log's bookkeeping between event points; the per-row (nr) and per-body (N) arrays
   !> allocated by allocate_log.
@@ -20,7 +20,7 @@ module impact1d_event_log
     !> (nr) A rest after an accumulation of impacts, logged when its time comes.
     real(wp), allocatable :: pending_rest(:)
     !> (nr) A release waiting for time to move on (see begin_rest), with the velocities it
-    !> reports (reported_pair).
+    !> reports (lanes: log_event).
     real(wp), allocatable :: release_time(:)
     real(wp), allocatable :: release_v(:, :)       !< (2, nr)
     !> (N) When impulses last moved each body off its rest (see the stick log at the event point).
@@ -53,25 +53,29 @@ contains
     self%rest_lost_time = -huge(1.0_wp)
   end subroutine allocate_log
 
-  !> The velocities an event reports, of bodies 1 and 2 (v2 = 0 with one body, a
-  !> column the sinks leave out).
-  pure function reported_pair(v) result(pair)
-    real(wp), intent(in) :: v(:)
-    real(wp) :: pair(2)
-    pair = 0.0_wp
-    pair(:size(v)) = v
-  end function reported_pair
-
-  !> An event of `kind` at t (velocities of the N bodies before and after), counted and sent
-  !> to the sink.
-  subroutine log_event(sink, stats, t, kind, v_before, v_after)
+  !> Event (class, index) at t, counted and sent to the sink with the velocities of the
+  !> pair it reports (docs/nbody-plan.md, "The event record"): with one or two bodies that
+  !> is (1, 2), or (1, 0) with one body, whatever the event (a wall's impact reports both
+  !> bodies). v_before, v_after: the N bodies' velocities, or lanes (an idle lane is 0).
+  subroutine log_event(scene, sink, stats, t, class, index, v_before, v_after)
+    type(scene_type), intent(in) :: scene
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
     real(wp), intent(in) :: t
-    integer, intent(in) :: kind
+    integer, intent(in) :: class, index
     real(wp), intent(in) :: v_before(:), v_after(:)
+    real(wp) :: v(4)
+    integer :: kind
+    kind = kind_code(scene%row_name, class, index)
     stats%events(kind) = stats%events(kind) + 1
-    call sink%put_event(t, kind, reported_pair(v_before), reported_pair(v_after))
+    v = 0.0_wp
+    v(1) = v_before(1)
+    v(3) = v_after(1)
+    if (scene%n_bodies == 2) then
+      v(2) = v_before(2)
+      v(4) = v_after(2)
+    end if
+    call sink%put_event(t, class, index, 1, merge(2, 0, scene%n_bodies == 2), v)
   end subroutine log_event
 
   !> Rest after an accumulation of impacts is logged at the accumulation time (t, velocities v).
@@ -84,7 +88,7 @@ contains
     integer :: k
     do k = 1, size(self%pending_rest)
       if (self%pending_rest(k) <= t) then
-        call log_event(sink, stats, t, event_rest + tutorial_row(scene, k), v, v)
+        call log_event(scene, sink, stats, t, class_rest, k, v, v)
         self%pending_rest(k) = huge(1.0_wp)
       end if
     end do
@@ -98,13 +102,12 @@ contains
     logical, intent(in) :: everything
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
-    integer :: k, kind
+    integer :: k
     do k = 1, size(self%release_time)
       if (self%release_time(k) == huge(1.0_wp)) cycle
       if (.not. everything .and. same_instant(scene, t, self%release_time(k))) cycle
-      kind = event_release + tutorial_row(scene, k)
-      stats%events(kind) = stats%events(kind) + 1
-      call sink%put_event(self%release_time(k), kind, self%release_v(:, k), self%release_v(:, k))
+      call log_event(scene, sink, stats, self%release_time(k), class_release, k, self%release_v(:, k), &
+        self%release_v(:, k))
       self%release_time(k) = huge(1.0_wp)
     end do
   end subroutine flush_releases
@@ -132,7 +135,7 @@ contains
     if (when > t) then
       self%pending_rest(k) = when
     else
-      call log_event(sink, stats, t, event_rest + tutorial_row(scene, k), v, v)
+      call log_event(scene, sink, stats, t, class_rest, k, v, v)
     end if
   end subroutine begin_rest
 end module impact1d_event_log

@@ -8,11 +8,11 @@ module impact1d_event_point
   use impact1d_kinds, only: wp, eps_wp
   use impact1d_error, only: error_type, raise, status_simulation, fmt
   use impact1d_lanes, only: max_lanes
-  use impact1d_scene, only: scene_type, tutorial_row
+  use impact1d_scene, only: scene_type
   use impact1d_modes, only: mode_type, solve_mode, pair_rows
   use impact1d_impacts, only: normal_velocity, impulse, most_approaching, restitution_of, &
     kinetic_energy, joint_inelastic, inelastic_projection
-  use impact1d_output, only: sink_type, run_stats, event_impact, event_rest, event_stick, event_slip
+  use impact1d_output, only: sink_type, run_stats, class_impact, class_rest, class_stick, class_slip
   use impact1d_state, only: lane_state_type, add_compensated
   use impact1d_yardsticks, only: gap_rounding, velocity_rounding, time_rounding, energy_rounding, force_scale, &
     same_instant
@@ -97,7 +97,7 @@ contains
           if (pushed(k) .and. all(scene%pair%normal(:, k) /= 0.0_wp)) entry_scale = maxval(entry_scale)
         end do
         do k = 1, scene%n_rows
-          if (pushed(k)) call log_event(sink, stats, s%t, event_impact + tutorial_row(scene, k), v_before, v_after)
+          if (pushed(k)) call log_event(scene, sink, stats, s%t, class_impact, k, v_before, v_after)
         end do
       end if
     end if
@@ -119,7 +119,7 @@ contains
       if (allocated(error)) return
       call apply(scene, s, v_after)
       if (all(scene%pair%normal(:, k) /= 0.0_wp)) entry_scale = maxval(entry_scale)
-      call log_event(sink, stats, s%t, event_impact + tutorial_row(scene, k), v_before, v_after)
+      call log_event(scene, sink, stats, s%t, class_impact, k, v_before, v_after)
     end do
 
     event_log%scale_time = s%t
@@ -213,7 +213,7 @@ contains
             .and. dot_product(scene%pair%normal(:, k), matmul(new_mode%gain, df)) > &
             1.0e3_wp * eps_wp * sum(abs(df)) / minval(scene%pair%mass))) then
           if (event_log%pending_rest(k) < huge(1.0_wp)) then
-            call log_event(sink, stats, s%t, event_rest + tutorial_row(scene, k), s%v, s%v)
+            call log_event(scene, sink, stats, s%t, class_rest, k, s%v, s%v)
             event_log%pending_rest(k) = huge(1.0_wp)
           end if
           ! Logged once time has moved on: a contact that closes again at this same
@@ -237,10 +237,10 @@ contains
       ! logged either).
       if (resting_now .and. .not. event_log%at_rest(i) .and. .not. initial .and. &
           .not. same_instant(scene, s%t, event_log%rest_lost_time(i))) &
-        call log_event(sink, stats, s%t, event_stick + i, s%v, s%v)
+        call log_event(scene, sink, stats, s%t, class_stick, i, s%v, s%v)
       if (.not. resting_now .and. event_log%at_rest(i)) then
         if (s%v(i) == 0.0_wp) then
-          call log_event(sink, stats, s%t, event_slip + i, s%v, s%v)
+          call log_event(scene, sink, stats, s%t, class_slip, i, s%v, s%v)
         else
           event_log%rest_lost_time(i) = s%t
         end if

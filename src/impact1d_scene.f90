@@ -20,7 +20,7 @@ module impact1d_scene
   public :: sample_time, set_text, events_kept
   public :: i_title, i_f1_table, i_f2_table, i_method, i_substeps, i_events, default_gravity
   public :: events_all, events_impacts, events_none
-  public :: name_len, set_rows, allocate_contacts, tutorial_row, set_springs
+  public :: name_len, set_rows, allocate_contacts, set_springs
 
   integer, parameter :: n_real = 43, n_text = 6
   !> Names of the real inputs, as in the namelist and in Python's Scene, in this order.
@@ -778,13 +778,6 @@ contains
     end do
   end subroutine set_rows
 
-  !> Row k's index among the tutorial's four (left, right, slot_min, slot_max): its event
-  !> kinds' offset, until events carry (class, row) (issue 19, stage 2).
-  pure integer function tutorial_row(scene, k)
-    type(scene_type), intent(in) :: scene
-    integer, intent(in) :: k
-    tutorial_row = findloc(contact_names, scene%row_name(k), dim=1)
-  end function tutorial_row
 
   !> RK4's step against the modes of the springs and dampers (impact1d_stability): past the
   !> largest stable step the numbers would be garbage (positions to 1e76 with a normal exit),

@@ -63,6 +63,8 @@ contains
     integer :: window_events
 
     stats%interrupt_epoch = interrupt_count()
+    ! What the sink calls the events on each row.
+    sink%row_names = scene%row_name
     ! The stepping kernels take the bodies in lanes (impact1d_lanes); scenes have no more
     ! bodies than that until the cluster solver (issue 19, stage 4).
     if (scene%n_bodies > max_lanes) then

@@ -12,10 +12,10 @@ module impact1d_vissim
   use impact1d_kinds, only: wp
   use impact1d_lanes, only: max_lanes, to_lanes
   use impact1d_error, only: error_type, raise, status_simulation, fmt
-  use impact1d_scene, only: scene_type, sample_time, tutorial_row
+  use impact1d_scene, only: scene_type, sample_time
   use impact1d_modes, only: pair_rows
   use impact1d_impacts, only: impulse, kinetic_energy
-  use impact1d_output, only: sink_type, run_stats, emit_sample, event_impact, checkpoint
+  use impact1d_output, only: sink_type, run_stats, emit_sample, class_impact, checkpoint
   use impact1d_event_log, only: log_event
   use impact1d_loads, only: applied_force
   implicit none
@@ -99,7 +99,7 @@ contains
           impact_loss = impact_loss + kinetic_energy(scene, threshold(v)) - kinetic_energy(scene, threshold(v_new))
           v = v_new
           v_prev = v
-          call log_event(sink, stats, t, event_impact + tutorial_row(scene, c), v_hit, threshold(v))
+          call log_event(scene, sink, stats, t, class_impact, c, v_hit, threshold(v))
         end associate
       end do
       if (t == t_sample) then
