@@ -10,10 +10,11 @@ module impact1d_api
   use impact1d_error, only: error_type, status_ok, status_input, status_interrupted
   use impact1d_interrupt, only: catch_interrupts
   use impact1d_scene, only: scene_input, scene_type, n_real, n_text, real_names, text_names, &
-    i_title, i_f1_table, i_f2_table, i_method, i_substeps, i_events, n_contacts, set_text
+    i_title, i_f1_table, i_f2_table, i_method, i_substeps, i_events, set_text
   use impact1d_io, only: read_scene_file, prepare_scene
   use impact1d_output, only: memory_sink, summary_sink, column_names_text => column_names, event_names, &
-    n_columns, event_impact, present_columns, i_impact_loss, i_friction_loss, i_pe, i_damping_loss
+    n_columns, event_impact, event_rest, present_columns, class_impact, impacts_on, i_impact_loss, &
+    i_friction_loss, i_pe, i_damping_loss
   use impact1d_solver, only: run, run_stats
   implicit none
   private
@@ -200,7 +201,7 @@ contains
     type(summary_sink) :: sink
     type(error_type), allocatable :: error
     character(len=message_length) :: message
-    integer :: j
+    integer :: j, k
 
     summary = ieee_value(1.0_c_double, ieee_quiet_nan)
     message_codes = ichar(' ')
@@ -235,8 +236,8 @@ contains
         cycle
       end if
       summary(:, j) = [stats%last_row([2, 3, 4, 5, 6]), &
-        real(sum(stats%events(event_impact + 1:event_impact + n_contacts)), wp), &
-        real(stats%events(event_impact + 1:event_impact + n_contacts), wp), &
+        real(sum(stats%row_events(class_impact, :)), wp), &
+        real([(impacts_on(stats, scene%row_name, event_names(k)), k = event_impact + 1, event_rest)], wp), &
         sink%rest_time(stats%last_row), stats%last_row([i_impact_loss, i_friction_loss]), &
         stats%max_residual, real(stats%steps, wp), stats%last_row([i_pe, i_damping_loss])]
       ! A one-body scene has no x2_end, v2_end.

@@ -6,7 +6,7 @@ module impact1d_event_log
   use impact1d_kinds, only: wp
   use impact1d_lanes, only: max_lanes
   use impact1d_scene, only: scene_type
-  use impact1d_output, only: sink_type, run_stats, class_rest, class_release, kind_code
+  use impact1d_output, only: sink_type, run_stats, class_rest, class_release, count_event
   use impact1d_yardsticks, only: same_instant
   implicit none
   private
@@ -65,9 +65,7 @@ contains
     integer, intent(in) :: class, index
     real(wp), intent(in) :: v_before(:), v_after(:)
     real(wp) :: v(4)
-    integer :: kind
-    kind = kind_code(scene%row_name, class, index)
-    stats%events(kind) = stats%events(kind) + 1
+    call count_event(stats, class, index)
     v = 0.0_wp
     v(1) = v_before(1)
     v(3) = v_after(1)

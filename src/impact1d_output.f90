@@ -15,7 +15,8 @@ module impact1d_output
   private
   public :: sink_type, memory_sink, summary_sink, file_sink, n_columns, column_names, n_event_kinds, event_names
   public :: event_impact, event_rest, event_release, event_stick, event_slip, run_stats, checkpoint
-  public :: class_impact, class_rest, class_release, class_stick, class_slip, kind_code, event_name
+  public :: class_impact, class_rest, class_release, class_stick, class_slip, event_name, start_counts, &
+    count_event, event_count, impacts_on
   public :: emit_sample, events_path, present_columns, i_pe, i_work, i_friction_loss, i_impact_loss, &
     i_damping_loss
 
@@ -38,10 +39,9 @@ module impact1d_output
     'stick', 'slip']
   !> Longest event name: a prefix and a row's name.
   integer, parameter :: event_name_len = 8 + name_len
-  !> The tutorial's event kinds, as codes: the run's counts (run_stats) and the flat API
-  !> (Python rebuilds the names from them) still use these for one and two bodies: impact on
-  !> row left, right, slot_min, slot_max is 1..4; rest, release add 4 and 8; stick, slip of
-  !> body i are 12 + i and 14 + i (kind_code).
+  !> The event kinds of the tutorial's scenes (its walls and slot, one or two bodies), for
+  !> Python's event_kinds(); impact on left, right, slot_min, slot_max, then the rests and
+  !> releases on them, stick1, stick2, slip1, slip2.
   integer, parameter :: n_event_kinds = 16
   integer, parameter :: event_impact = 0, event_rest = 4, event_release = 8, event_stick = 12, &
     event_slip = 14
@@ -53,7 +53,10 @@ module impact1d_output
   !> What a run did, for the CLI's summary and Python's result.
   type :: run_stats
     integer(int64) :: steps = 0
-    integer :: events(n_event_kinds) = 0
+    !> Events counted: every one, per row (impacts, rests, releases: (3, nr)) and per body
+    !> (sticks, slips: (2, N)); start_counts allocates them.
+    integer :: n_events = 0
+    integer, allocatable :: row_events(:, :), body_events(:, :)
     real(wp) :: last_row(n_columns) = 0.0_wp
     real(wp) :: max_residual = 0.0_wp
     !> The interrupt count when the run started (impact1d_interrupt): a run ends when it moves on.
@@ -272,20 +275,49 @@ contains
     end if
   end function event_name
 
-  !> The tutorial's code of event (class, index) (event_names): rows by their name.
-  pure integer function kind_code(row_names, class, index)
-    character(len=*), intent(in) :: row_names(:)
+  !> Counts for a run of n_rows rows and n_bodies bodies, none yet.
+  pure subroutine start_counts(stats, n_rows, n_bodies)
+    type(run_stats), intent(inout) :: stats
+    integer, intent(in) :: n_rows, n_bodies
+    allocate(stats%row_events(class_impact:class_release, n_rows), stats%body_events(class_stick:class_slip, n_bodies))
+    stats%row_events = 0
+    stats%body_events = 0
+    stats%n_events = 0
+  end subroutine start_counts
+
+  !> One more event (class, index).
+  pure subroutine count_event(stats, class, index)
+    type(run_stats), intent(inout) :: stats
     integer, intent(in) :: class, index
-    select case (class)
-    case (class_stick)
-      kind_code = event_stick + index
-    case (class_slip)
-      kind_code = event_slip + index
-    case default
-      kind_code = 4 * (class - class_impact) + findloc(event_names(event_impact + 1:event_rest), &
-        row_names(index), dim=1)
-    end select
-  end function kind_code
+    if (class >= class_stick) then
+      stats%body_events(class, index) = stats%body_events(class, index) + 1
+    else
+      stats%row_events(class, index) = stats%row_events(class, index) + 1
+    end if
+    stats%n_events = stats%n_events + 1
+  end subroutine count_event
+
+  !> How many events (class, index) the run had.
+  pure integer function event_count(stats, class, index)
+    type(run_stats), intent(in) :: stats
+    integer, intent(in) :: class, index
+    if (class >= class_stick) then
+      event_count = stats%body_events(class, index)
+    else
+      event_count = stats%row_events(class, index)
+    end if
+  end function event_count
+
+  !> Impacts on the row called name (0 if the run has none of that name): a sweep's
+  !> n_left .. n_slot_max.
+  pure integer function impacts_on(stats, row_names, name)
+    type(run_stats), intent(in) :: stats
+    character(len=*), intent(in) :: row_names(:), name
+    integer :: k
+    impacts_on = 0
+    k = findloc(row_names, name, dim=1)
+    if (k > 0) impacts_on = stats%row_events(class_impact, k)
+  end function impacts_on
 
   !> Every 4096 steps of a run: progress on stderr where it is shown, and an interrupt
   !> (Ctrl-C while Python waits for the run) ends the run within a fraction of a second.
@@ -294,7 +326,7 @@ contains
     type(run_stats), intent(in) :: stats
     real(wp), intent(in) :: t, t_end
     type(error_type), allocatable, intent(inout) :: error
-    call sink%progress(t, t_end, sum(stats%events))
+    call sink%progress(t, t_end, stats%n_events)
     if (interrupt_count() /= stats%interrupt_epoch) &
       call raise(error, status_interrupted, 'interrupted at t = ' // trim(fmt(t)) // ' s')
   end subroutine checkpoint

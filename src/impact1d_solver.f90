@@ -12,7 +12,7 @@ module impact1d_solver
   use impact1d_scene, only: scene_type, sample_time
   use impact1d_modes, only: mode_type
   use impact1d_impacts, only: normal_velocity, kinetic_energy
-  use impact1d_output, only: sink_type, run_stats, emit_sample, checkpoint
+  use impact1d_output, only: sink_type, run_stats, emit_sample, checkpoint, start_counts
   use impact1d_vissim, only: run_vissim
   use impact1d_interrupt, only: interrupt_count
   use impact1d_state, only: state_type, lane_state_type, load_lanes, new_state, renormalise, &
@@ -63,8 +63,9 @@ contains
     integer :: window_events
 
     stats%interrupt_epoch = interrupt_count()
-    ! What the sink calls the events on each row.
+    ! What the sink calls the events on each row; nothing counted yet.
     sink%row_names = scene%row_name
+    call start_counts(stats, scene%n_rows, scene%n_bodies)
     ! The stepping kernels take the bodies in lanes (impact1d_lanes); scenes have no more
     ! bodies than that until the cluster solver (issue 19, stage 4).
     if (scene%n_bodies > max_lanes) then
