@@ -12,7 +12,7 @@ module impact1d_scene
   implicit none
   private
   public :: n_real, n_text, real_names, text_names, scene_input, scene_type, build_scene, validate
-  public :: n_contacts, i_left, i_right, i_slot_min, i_slot_max
+  public :: i_left, i_right, i_slot_min, i_slot_max
   public :: i_m1, i_m2, i_mu1, i_mu2, i_g, i_x_left, i_r_left, i_x_right, i_r_right, i_d_min, &
     i_r_min, i_d_max, i_r_max, i_x1, i_v1, i_x2, i_v2, i_f1, i_f2, i_f1_amp, i_f1_period, &
     i_f1_phase, i_f2_amp, i_f2_period, i_f2_phase, i_t_end, i_dt, i_dt_out, i_mus1, i_mus2, &
@@ -55,16 +55,17 @@ module impact1d_scene
   !> run's counts (the summary, a sweep's row) are exact whatever it keeps.
   integer, parameter :: events_all = 0, events_impacts = 1, events_none = 2
 
-  !> The four optional unilateral constraints: gap_k = normal(:,k) . x + offset_k >= 0.
-  integer, parameter :: n_contacts = 4, i_left = 1, i_right = 2, i_slot_min = 3, i_slot_max = 4
-  character(len=*), parameter :: contact_names(n_contacts) = [character(len=8) :: &
+  !> The tutorial's four optional limits (left, right, slot_min, slot_max: the rows of its
+  !> scenes in this order, which validate checks and set_contacts turns into records).
+  integer, parameter :: n_limits = 4, i_left = 1, i_right = 2, i_slot_min = 3, i_slot_max = 4
+  character(len=*), parameter :: contact_names(n_limits) = [character(len=8) :: &
     'left', 'right', 'slot_min', 'slot_max']
   !> Their normals with two bodies: the left wall holds body 1, the right wall body 2. With
   !> one body both walls hold body 1 (the pair's normal: scene_type's pair%normal).
-  real(wp), parameter :: two_body_normal(2, n_contacts) = reshape( &
-    [1.0_wp, 0.0_wp, 0.0_wp, -1.0_wp, -1.0_wp, 1.0_wp, 1.0_wp, -1.0_wp], [2, n_contacts])
-  real(wp), parameter :: one_body_normal(2, n_contacts) = reshape( &
-    [1.0_wp, 0.0_wp, -1.0_wp, 0.0_wp, -1.0_wp, 1.0_wp, 1.0_wp, -1.0_wp], [2, n_contacts])
+  real(wp), parameter :: two_body_normal(2, n_limits) = reshape( &
+    [1.0_wp, 0.0_wp, 0.0_wp, -1.0_wp, -1.0_wp, 1.0_wp, 1.0_wp, -1.0_wp], [2, n_limits])
+  real(wp), parameter :: one_body_normal(2, n_limits) = reshape( &
+    [1.0_wp, 0.0_wp, -1.0_wp, 0.0_wp, -1.0_wp, 1.0_wp, 1.0_wp, -1.0_wp], [2, n_limits])
 
   !> Longest name of a contact record or row ('slot_max', a user's '<name>_min').
   integer, parameter :: name_len = 32
@@ -73,7 +74,7 @@ module impact1d_scene
   !> x_right), 'slot' (bodies 1 and 2, lower limit d_min or their meeting, upper d_max); and
   !> which record and end (1 lower, 2 upper) each of the four tutorial limits is.
   character(len=*), parameter :: tutorial_records(3) = [character(len=5) :: 'left', 'right', 'slot']
-  integer, parameter :: limit_record(n_contacts) = [1, 2, 3, 3], limit_end(n_contacts) = [1, 2, 1, 2]
+  integer, parameter :: limit_record(n_limits) = [1, 2, 3, 3], limit_end(n_limits) = [1, 2, 1, 2]
 
   real(wp), parameter :: default_gravity = 9.80665_wp
   !> The tutorial's zero-velocity threshold, used by the vissim method only.
@@ -176,7 +177,7 @@ contains
     logical, intent(in) :: require_run
     type(error_type), allocatable, intent(out) :: error
     integer :: k
-    real(wp) :: gap, scale, nrm(2, n_contacts), rows, limit
+    real(wp) :: gap, scale, nrm(2, n_limits), rows, limit
 
     do k = 1, n_text
       if (.not. allocated(input%text(k)%s)) then
@@ -289,7 +290,7 @@ contains
     ! that is positive but within a few dozen ulps of the coordinates it is measured
     ! against cannot be told from contact (case 3 moved to x = 2e14 m got an impact across
     ! its 0.5 m gap): refused, as is a friction bound mu m g that overflows.
-    do k = 1, n_contacts
+    do k = 1, n_limits
       if (.not. has_limit(input, k)) cycle
       nrm = contact_normals(input)
       gap = nrm(1, k) * input%value(i_x1) + nrm(2, k) * input%value(i_x2) + offset_of(input, k)
@@ -634,7 +635,7 @@ contains
     integer :: j, k, r, nc
     integer :: record_of(size(tutorial_records))
     logical :: present(size(tutorial_records))
-    present = [(any([(has_limit(input, k) .and. limit_record(k) == r, k = 1, n_contacts)]), &
+    present = [(any([(has_limit(input, k) .and. limit_record(k) == r, k = 1, n_limits)]), &
       r = 1, size(tutorial_records))]
     nc = count(present)
     call allocate_contacts(scene, nc)
@@ -649,7 +650,7 @@ contains
     if (record_of(1) > 0) scene%contact_body(:, record_of(1)) = [0, 1]
     if (record_of(2) > 0) scene%contact_body(:, record_of(2)) = [0, scene%n_bodies]
     if (record_of(3) > 0) scene%contact_body(:, record_of(3)) = [1, 2]
-    do k = 1, n_contacts
+    do k = 1, n_limits
       if (.not. has_limit(input, k)) cycle
       associate (e => limit_end(k), j => record_of(limit_record(k)))
         scene%contact_has(e, j) = .true.
@@ -707,6 +708,7 @@ contains
     scene%springs%k(:ne) = scene%element_k
     scene%springs%c(:ne) = scene%element_c
     scene%springs%rest(:ne) = scene%element_rest
+    call scene%springs%set_normals()
     scene%springs%present = ne > 0
     ! The lightest mass as the kernel sees it (the phantom's 1 with one body).
     call scene%springs%set_frequency(minval(scene%pair%mass))
@@ -934,7 +936,7 @@ contains
   !> The contacts' normals: with one body (no m2) both walls hold body 1.
   pure function contact_normals(input) result(nrm)
     type(scene_input), intent(in) :: input
-    real(wp) :: nrm(2, n_contacts)
+    real(wp) :: nrm(2, n_limits)
     nrm = two_body_normal
     if (.not. input%given(i_m2)) nrm = one_body_normal
   end function contact_normals
@@ -950,14 +952,14 @@ contains
   !> Index of the variable that names constraint k (its limit); the restitution follows it.
   pure integer function limit_index(k)
     integer, intent(in) :: k
-    integer, parameter :: indices(n_contacts) = [i_x_left, i_x_right, i_d_min, i_d_max]
+    integer, parameter :: indices(n_limits) = [i_x_left, i_x_right, i_d_min, i_d_max]
     limit_index = indices(k)
   end function limit_index
 
   !> gap = normal . x + offset_sign * limit (left: x1 - x_left; right: x_right - x2; ...).
   pure real(wp) function offset_sign(k)
     integer, intent(in) :: k
-    real(wp), parameter :: signs(n_contacts) = [-1.0_wp, 1.0_wp, -1.0_wp, 1.0_wp]
+    real(wp), parameter :: signs(n_limits) = [-1.0_wp, 1.0_wp, -1.0_wp, 1.0_wp]
     offset_sign = signs(k)
   end function offset_sign
 end module impact1d_scene
