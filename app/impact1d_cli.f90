@@ -8,12 +8,10 @@ program impact1d_cli
   use impact1d_kinds, only: wp
   use impact1d_error, only: error_type, status_input, status_simulation, fmt
   use impact1d_scene, only: scene_input, scene_type, set_text, i_t_end, i_dt, i_dt_out, i_max_events, i_method, &
-    i_events, i_title, &
-    events_none, events_impacts, n_contacts, &
-    i_f1_table, i_f2_table
+    i_events, i_title, events_none, events_impacts, i_f1_table, i_f2_table
   use impact1d_io, only: read_scene_file, prepare_scene, lower
-  use impact1d_output, only: file_sink, event_names, event_impact, n_event_kinds, events_path, i_pe, i_work, &
-    i_friction_loss, i_impact_loss, i_damping_loss
+  use impact1d_output, only: file_sink, events_path, i_pe, i_work, i_friction_loss, i_impact_loss, i_damping_loss, &
+    class_impact, class_stick, class_slip, event_name, event_count
   use impact1d_files, only: make_folders, resolve, write_text
   use impact1d_solver, only: run, run_stats
   use impact1d_version, only: version
@@ -80,7 +78,7 @@ program impact1d_cli
   type(run_stats) :: stats
   type(error_type), allocatable :: error, close_error
   character(len=:), allocatable :: scene_path, out_path, option, value, events_file
-  integer :: i, n_args, k, equals
+  integer :: i, n_args, k, c, equals
   real(wp) :: overrides(4)
   logical :: overridden(4), has_value, out_given, quiet, stream
   character(len=64) :: method, events
@@ -222,18 +220,18 @@ contains
     character(len=:), allocatable :: text
     if (stream .and. len(events_file) == 0 .and. scene%events /= events_none) then
       text = 'no event log (-o - writes the samples alone: --events-file FILE keeps one; ' // &
-        trim(fmt(sum(stats%events))) // ' events counted)'
+        trim(fmt(stats%n_events)) // ' events counted)'
       return
     end if
     select case (scene%events)
     case (events_none)
-      text = 'no event log (events = ''none''; ' // trim(fmt(sum(stats%events))) // ' events counted)'
+      text = 'no event log (events = ''none''; ' // trim(fmt(stats%n_events)) // ' events counted)'
     case (events_impacts)
       text = sink%event_path // ' (' // &
-        trim(fmt(sum(stats%events(event_impact + 1:event_impact + n_contacts)))) // ' impacts of ' // &
-        trim(fmt(sum(stats%events))) // ' events: events = ''impacts'')'
+        trim(fmt(sum(stats%row_events(class_impact, :)))) // ' impacts of ' // &
+        trim(fmt(stats%n_events)) // ' events: events = ''impacts'')'
     case default
-      text = sink%event_path // ' (' // trim(fmt(sum(stats%events))) // ' events)'
+      text = sink%event_path // ' (' // trim(fmt(stats%n_events)) // ' events)'
     end select
     if (sink%n_cut > 0) text = text(:len(text) - 1) // ', cut at ' // trim(fmt(sink%n_logged)) // &
       ': max_events)'
@@ -255,8 +253,12 @@ contains
     text = text // '  output    ' // where // ' (' // trim(fmt(scene%n_samples)) // ' rows every ' // &
       trim(fmt(scene%dt_out)) // ' s) and ' // trim(event_log_text()) // nl
     line = ''
-    do k = 1, n_event_kinds
-      if (stats%events(k) > 0) line = line // ' ' // trim(event_names(k)) // ' ' // trim(fmt(stats%events(k)))
+    ! Per row, impacts, rests, releases; then per body, sticks and slips.
+    do c = class_impact, class_slip
+      do k = 1, merge(scene%n_rows, scene%n_bodies, c < class_stick)
+        if (event_count(stats, c, k) > 0) line = line // ' ' // trim(event_name(scene%row_name, c, k)) // ' ' // &
+          trim(fmt(event_count(stats, c, k)))
+      end do
     end do
     if (len(line) == 0) line = ' none'
     text = text // '  events   ' // line // nl

@@ -10,13 +10,14 @@ module impact1d_api
   use impact1d_error, only: error_type, status_ok, status_input, status_interrupted, raise
   use impact1d_interrupt, only: catch_interrupts
   use impact1d_scene, only: scene_input, scene_type, validate, is_nbody, nbody_refusal, n_real, n_text, real_names, text_names, &
-    i_title, i_f1_table, i_f2_table, i_method, i_substeps, i_events, n_contacts, set_text
+    i_title, i_f1_table, i_f2_table, i_method, i_substeps, i_events, set_text
   use impact1d_io, only: read_scene_file, prepare_scene
   use impact1d_chain, only: settle_chain, validate_chain, n_ids, id_arrays, id_r_meet, field_name, assign_number, &
     assign_text, scene_assignments
   use impact1d_fields, only: text_item
   use impact1d_output, only: memory_sink, summary_sink, column_names_text => column_names, event_names, &
-    n_columns, event_impact, present_columns, i_impact_loss, i_friction_loss, i_pe, i_damping_loss
+    n_columns, event_impact, event_rest, present_columns, class_impact, impacts_on, i_impact_loss, &
+    i_friction_loss, i_pe, i_damping_loss
   use impact1d_solver, only: run, run_stats
   implicit none
   private
@@ -186,26 +187,33 @@ contains
   end subroutine settle_scene
 
   !> Check and run a scene given as flat fields. The samples fill samples(:n_samples, :) and
-  !> the events the event arrays up to n_events; when either needs more room than the caller
-  !> gave (max_samples, max_events), status is 3 and n_samples, n_events are the sizes needed:
-  !> call again with them. has_column(k) is 1 for the columns the scene has (column_names
-  !> lists all of them; x2 and v2 only exist with a second body, pe and damping_loss with
-  !> springs and dampers): they fill samples' first columns, in column_names' order.
+  !> the events the event arrays up to n_events; the run's row names fill row_name_codes(:,
+  !> :n_rows) as character codes (blank-padded); when any needs more room than the caller
+  !> gave (max_samples, max_events, max_rows), status is 3 and n_samples, n_events, n_rows
+  !> are the sizes needed: call again with them. has_column(k) is 1 for the columns the
+  !> scene has (column_names lists all of them; x2 and v2 only exist with a second body, pe
+  !> and damping_loss with springs and dampers): they fill samples' first columns, in
+  !> column_names' order. Event j is (event_class(j), event_index(j)): class 1 impact, 2
+  !> rest, 3 release of row index (named '', 'rest_', 'release_' and the row's name), 4
+  !> stick, 5 slip of body index ('stick', 'slip' and the body's number); it reports the
+  !> bodies event_ends(:, j) (0: none; (1, 2) with two bodies, (1, 0) with one) with the
+  !> velocities event_v(:, j) = [v_a before, v_b before, v_a after, v_b after].
   subroutine simulate(n, values, given, title, f1_table, f2_table, method, substeps, events, progress, max_samples, &
-      n_cols, max_events, samples, has_column, event_t, event_kind, event_v, n_samples, n_events, steps, &
-      energy_residual, status, message, warnings)
+      n_cols, max_events, max_rows, samples, has_column, event_t, event_class, event_index, event_ends, event_v, &
+      row_name_codes, n_samples, n_events, n_rows, steps, energy_residual, status, message, warnings)
     !f2py threadsafe
     integer(c_int), intent(in) :: n
     real(c_double), intent(in) :: values(n)
     integer(c_int), intent(in) :: given(n)
     character(len=*), intent(in) :: title, f1_table, f2_table, method, substeps, events
     integer(c_int), intent(in) :: progress    !< non-zero: show progress on stderr after 1 s
-    integer(c_int), intent(in) :: max_samples, n_cols, max_events
+    integer(c_int), intent(in) :: max_samples, n_cols, max_events, max_rows
     real(c_double), intent(out), target :: samples(max_samples, n_cols)
     integer(c_int), intent(out) :: has_column(n_cols)
     real(c_double), intent(out) :: event_t(max_events), event_v(4, max_events)
-    integer(c_int), intent(out) :: event_kind(max_events)
-    integer(c_int), intent(out) :: n_samples, n_events, steps
+    integer(c_int), intent(out) :: event_class(max_events), event_index(max_events), event_ends(2, max_events)
+    integer(c_int), intent(out) :: row_name_codes(32, max_rows)   ! 32: name_len (f2py needs the number)
+    integer(c_int), intent(out) :: n_samples, n_events, n_rows, steps
     real(c_double), intent(out) :: energy_residual
     integer(c_int), intent(out) :: status
     character(len=16384), intent(out) :: message    ! 16384: message_length (f2py needs the number)
@@ -217,10 +225,13 @@ contains
     type(error_type), allocatable :: error
     integer, allocatable :: columns(:)
     character(len=:), allocatable :: note
+    integer :: k
 
     n_samples = 0
     n_events = 0
+    n_rows = 0
     has_column = 0
+    row_name_codes = ichar(' ')
     steps = 0
     energy_residual = 0.0_c_double
     warnings = ''
@@ -255,17 +266,23 @@ contains
     if (len(note) > 0) warnings = trim(warnings) // repeat(new_line('a'), min(len_trim(warnings), 1)) // note
     n_samples = sink%n_samples
     n_events = sink%n_events
+    n_rows = scene%n_rows
     steps = int(min(stats%steps, int(huge(1_c_int), kind(stats%steps))), c_int)
     energy_residual = stats%max_residual
-    if (n_samples > max_samples .or. n_events > max_events) then
+    if (n_samples > max_samples .or. n_events > max_events .or. n_rows > max_rows) then
       status = status_too_small
       message = 'internal: the result arrays are too small'
       return
     end if
     ! The present columns first, in order (has_column says which they are): already there.
     event_t(:n_events) = sink%event_time(:n_events)
-    event_kind(:n_events) = sink%event_kind(:n_events)
+    event_class(:n_events) = sink%event_class(:n_events)
+    event_index(:n_events) = sink%event_index(:n_events)
+    event_ends(:, :n_events) = sink%event_ends(:, :n_events)
     event_v(:, :n_events) = sink%event_v(:, :n_events)
+    do k = 1, n_rows
+      call put_codes(trim(scene%row_name(k)), row_name_codes(:, k))
+    end do
   end subroutine simulate
 
   !> Run one scene n_runs times, run j with the real fields over_index(:) (1-based, in the
@@ -289,7 +306,7 @@ contains
     type(summary_sink) :: sink
     type(error_type), allocatable :: error
     character(len=message_length) :: message
-    integer :: j
+    integer :: j, k
 
     summary = ieee_value(1.0_c_double, ieee_quiet_nan)
     message_codes = ichar(' ')
@@ -324,8 +341,8 @@ contains
         cycle
       end if
       summary(:, j) = [stats%last_row([2, 3, 4, 5, 6]), &
-        real(sum(stats%events(event_impact + 1:event_impact + n_contacts)), wp), &
-        real(stats%events(event_impact + 1:event_impact + n_contacts), wp), &
+        real(sum(stats%row_events(class_impact, :)), wp), &
+        real([(impacts_on(stats, scene%row_name, event_names(k)), k = event_impact + 1, event_rest)], wp), &
         sink%rest_time(stats%last_row), stats%last_row([i_impact_loss, i_friction_loss]), &
         stats%max_residual, real(stats%steps, wp), stats%last_row([i_pe, i_damping_loss])]
       ! A one-body scene has no x2_end, v2_end.

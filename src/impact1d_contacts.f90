@@ -2,11 +2,11 @@
 !> levels, and putting a closed contact exactly on its constraint.
 module impact1d_contacts
   use impact1d_kinds, only: wp
-  use impact1d_scene, only: scene_type, n_contacts, i_slot_min, i_slot_max
-  use impact1d_impacts, only: normal_velocity
+  use impact1d_scene, only: scene_type
+  use impact1d_impacts, only: normal_velocity, both_limits_closed
   use impact1d_state, only: lane_state_type, add_compensated
   use impact1d_yardsticks, only: gap_rounding, time_rounding, velocity_rounding
-  use impact1d_modes, only: mode_type
+  use impact1d_modes, only: mode_type, pair_rows
   use impact1d_loads, only: state_force
   use impact1d_lanes, only: max_lanes
   implicit none
@@ -71,40 +71,49 @@ contains
     displacement = dot_product(abs(scene%pair%normal(:, k)), abs((b%x - a%x) + (b%x_lo - a%x_lo)))
   end function displacement
 
-  !> Put a closed contact exactly on its constraint (gap = 0, no roundoff penetration).
+  !> Put closed row k exactly on its constraint (gap = 0, no roundoff penetration). A ground
+  !> row puts its body at -offset / n_b; a row between bodies puts x_b - x_a on its limit
+  !> by moving the end that no closed ground row holds (b if neither is held).
   pure subroutine snap(scene, k, closed, s)
     type(scene_type), intent(in) :: scene
     integer, intent(in) :: k
-    logical, intent(in) :: closed(n_contacts)
+    logical, intent(in) :: closed(pair_rows)
     type(lane_state_type), intent(inout) :: s
     real(wp) :: limit
-    integer :: i
-    select case (k)
-    case (1, 2)
-      ! A wall holds one body: normal . x + offset = 0 for the body it faces.
-      i = merge(1, 2, scene%pair%normal(1, k) /= 0.0_wp)
-      s%x(i) = -scene%row_offset(k) / scene%pair%normal(i, k)
-      s%x_lo(i) = 0.0_wp
-    case (3, 4)
-      ! Move the body that no wall holds.
-      ! x2 = x1 + d exactly, the sum's rounding kept in the low part.
-      limit = merge(-scene%row_offset(3), scene%row_offset(4), k == 3)
-      if (closed(2)) then
-        s%x(1) = s%x(2)
-        s%x_lo(1) = s%x_lo(2)
-        call add_compensated(s%x(1), s%x_lo(1), -limit)
-      else
-        s%x(2) = s%x(1)
-        s%x_lo(2) = s%x_lo(1)
-        call add_compensated(s%x(2), s%x_lo(2), limit)
+    integer :: j
+    associate (a => scene%row_body(1, k), b => scene%row_body(2, k))
+      if (a == 0) then
+        s%x(b) = -scene%row_offset(k) / scene%row_normal(2, k)
+        s%x_lo(b) = 0.0_wp
+        return
       end if
-    end select
+      ! x_b = x_a + d exactly, the sum's rounding kept in the low part (d = -offset / n_b:
+      ! d_min for a lower limit, d_max for an upper one).
+      limit = -scene%row_offset(k) / scene%row_normal(2, k)
+      do j = 1, scene%n_rows
+        if (closed(j) .and. scene%row_body(1, j) == 0 .and. scene%row_body(2, j) == b) then
+          s%x(a) = s%x(b)
+          s%x_lo(a) = s%x_lo(b)
+          call add_compensated(s%x(a), s%x_lo(a), -limit)
+          return
+        end if
+      end do
+      s%x(b) = s%x(a)
+      s%x_lo(b) = s%x_lo(a)
+      call add_compensated(s%x(b), s%x_lo(b), limit)
+    end associate
   end subroutine snap
 
-  !> Both slot limits closed on a rigid link (d_min = d_max): the bodies are one.
-  pure logical function rigid_pair(closed)
-    logical, intent(in) :: closed(n_contacts)
-    rigid_pair = closed(i_slot_min) .and. closed(i_slot_max)
+  !> Both limits of a link closed (a rigid link, d_min = d_max, whose row_partner the event
+  !> point closed with its row): its bodies are one.
+  pure logical function rigid_pair(scene, closed)
+    type(scene_type), intent(in) :: scene
+    logical, intent(in) :: closed(pair_rows)
+    integer :: k
+    rigid_pair = .false.
+    do k = 1, scene%n_rows
+      rigid_pair = rigid_pair .or. both_limits_closed(scene, k, closed)
+    end do
   end function rigid_pair
 
   !> Rounding level of contact k's normal velocity: from the speeds of the bodies it
@@ -129,12 +138,13 @@ contains
     type(mode_type), intent(in) :: mode
     type(lane_state_type), intent(in) :: s
     real(wp), intent(in) :: entry_scale(max_lanes)
-    real(wp) :: tol(n_contacts), f(max_lanes), acc(max_lanes), speed(max_lanes)
+    real(wp) :: tol(pair_rows), f(max_lanes), acc(max_lanes), speed(max_lanes)
     integer :: k
     call state_force(scene, s, f)
     call mode%acceleration(f, acc)
     speed = max(abs(s%v) + abs(acc) * scene%dt, entry_scale)
-    do k = 1, n_contacts
+    tol = 0.0_wp
+    do k = 1, scene%n_rows
       tol(k) = velocity_rounding * dot_product(abs(scene%pair%normal(:, k)), speed)
     end do
   end function u_tolerances

@@ -5,24 +5,24 @@
 module impact1d_event_log
   use impact1d_kinds, only: wp
   use impact1d_lanes, only: max_lanes
-  use impact1d_scene, only: scene_type, n_contacts
-  use impact1d_output, only: sink_type, run_stats, event_rest, event_release
+  use impact1d_scene, only: scene_type
+  use impact1d_output, only: sink_type, run_stats, class_rest, class_release, count_event
   use impact1d_yardsticks, only: same_instant
   implicit none
   private
-  public :: event_log_type, log_event, reported_pair
+  public :: event_log_type, log_event
 
-  !> The log's bookkeeping between event points; the per-body arrays (N) allocated by
-  !> allocate_bodies.
+  !> The log's bookkeeping between event points; the per-row (nr) and per-body (N) arrays
+  !> allocated by allocate_log.
   type :: event_log_type
-    logical :: in_contact(n_contacts) = .false.    !< contact k has been logged resting
+    logical, allocatable :: in_contact(:)          !< (nr) row k has been logged resting
     logical, allocatable :: at_rest(:)             !< (N) body i has been logged at rest (stick)
-    !> A rest after an accumulation of impacts, logged when its time comes.
-    real(wp) :: pending_rest(n_contacts) = huge(1.0_wp)
-    !> A release waiting for time to move on (see begin_rest), with the velocities it reports
-    !> (reported_pair).
-    real(wp) :: release_time(n_contacts) = huge(1.0_wp)
-    real(wp) :: release_v(2, n_contacts) = 0.0_wp
+    !> (nr) A rest after an accumulation of impacts, logged when its time comes.
+    real(wp), allocatable :: pending_rest(:)
+    !> (nr) A release waiting for time to move on (see begin_rest), with the velocities it
+    !> reports (lanes: log_event).
+    real(wp), allocatable :: release_time(:)
+    real(wp), allocatable :: release_v(:, :)       !< (2, nr)
     !> (N) When impulses last moved each body off its rest (see the stick log at the event point).
     real(wp), allocatable :: rest_lost_time(:)
     !> The last event point's instant and the velocity scale its impulses came from (lanes): a
@@ -31,7 +31,7 @@ module impact1d_event_log
     real(wp) :: scale_time = -huge(1.0_wp)
     real(wp) :: scale(max_lanes) = 0.0_wp
   contains
-    procedure :: allocate_bodies
+    procedure :: allocate_log
     procedure :: flush_pending_rest
     procedure :: flush_releases
     procedure :: begin_rest
@@ -39,46 +39,54 @@ module impact1d_event_log
 
 contains
 
-  !> Nothing logged yet, for n bodies.
-  pure subroutine allocate_bodies(self, n)
+  !> Nothing logged yet, for n_rows rows and n bodies.
+  pure subroutine allocate_log(self, n_rows, n)
     class(event_log_type), intent(inout) :: self
-    integer, intent(in) :: n
-    allocate(self%at_rest(n), self%rest_lost_time(n))
+    integer, intent(in) :: n_rows, n
+    allocate(self%in_contact(n_rows), self%pending_rest(n_rows), self%release_time(n_rows), &
+      self%release_v(2, n_rows), self%at_rest(n), self%rest_lost_time(n))
+    self%in_contact = .false.
+    self%pending_rest = huge(1.0_wp)
+    self%release_time = huge(1.0_wp)
+    self%release_v = 0.0_wp
     self%at_rest = .false.
     self%rest_lost_time = -huge(1.0_wp)
-  end subroutine allocate_bodies
+  end subroutine allocate_log
 
-  !> The velocities an event reports, of bodies 1 and 2 (v2 = 0 with one body, a
-  !> column the sinks leave out).
-  pure function reported_pair(v) result(pair)
-    real(wp), intent(in) :: v(:)
-    real(wp) :: pair(2)
-    pair = 0.0_wp
-    pair(:size(v)) = v
-  end function reported_pair
-
-  !> An event of `kind` at t (velocities of the N bodies before and after), counted and sent
-  !> to the sink.
-  subroutine log_event(sink, stats, t, kind, v_before, v_after)
+  !> Event (class, index) at t, counted and sent to the sink with the velocities of the
+  !> pair it reports (docs/nbody-plan.md, "The event record"): with one or two bodies that
+  !> is (1, 2), or (1, 0) with one body, whatever the event (a wall's impact reports both
+  !> bodies). v_before, v_after: the N bodies' velocities, or lanes (an idle lane is 0).
+  subroutine log_event(scene, sink, stats, t, class, index, v_before, v_after)
+    type(scene_type), intent(in) :: scene
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
     real(wp), intent(in) :: t
-    integer, intent(in) :: kind
+    integer, intent(in) :: class, index
     real(wp), intent(in) :: v_before(:), v_after(:)
-    stats%events(kind) = stats%events(kind) + 1
-    call sink%put_event(t, kind, reported_pair(v_before), reported_pair(v_after))
+    real(wp) :: v(4)
+    call count_event(stats, class, index)
+    v = 0.0_wp
+    v(1) = v_before(1)
+    v(3) = v_after(1)
+    if (scene%n_bodies == 2) then
+      v(2) = v_before(2)
+      v(4) = v_after(2)
+    end if
+    call sink%put_event(t, class, index, 1, merge(2, 0, scene%n_bodies == 2), v)
   end subroutine log_event
 
   !> Rest after an accumulation of impacts is logged at the accumulation time (t, velocities v).
-  subroutine flush_pending_rest(self, t, v, sink, stats)
+  subroutine flush_pending_rest(self, scene, t, v, sink, stats)
     class(event_log_type), intent(inout) :: self
+    type(scene_type), intent(in) :: scene
     real(wp), intent(in) :: t, v(:)
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
     integer :: k
-    do k = 1, n_contacts
+    do k = 1, size(self%pending_rest)
       if (self%pending_rest(k) <= t) then
-        call log_event(sink, stats, t, event_rest + k, v, v)
+        call log_event(scene, sink, stats, t, class_rest, k, v, v)
         self%pending_rest(k) = huge(1.0_wp)
       end if
     end do
@@ -93,11 +101,11 @@ contains
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
     integer :: k
-    do k = 1, n_contacts
+    do k = 1, size(self%release_time)
       if (self%release_time(k) == huge(1.0_wp)) cycle
       if (.not. everything .and. same_instant(scene, t, self%release_time(k))) cycle
-      stats%events(event_release + k) = stats%events(event_release + k) + 1
-      call sink%put_event(self%release_time(k), event_release + k, self%release_v(:, k), self%release_v(:, k))
+      call log_event(scene, sink, stats, self%release_time(k), class_release, k, self%release_v(:, k), &
+        self%release_v(:, k))
       self%release_time(k) = huge(1.0_wp)
     end do
   end subroutine flush_releases
@@ -125,7 +133,7 @@ contains
     if (when > t) then
       self%pending_rest(k) = when
     else
-      call log_event(sink, stats, t, event_rest + k, v, v)
+      call log_event(scene, sink, stats, t, class_rest, k, v, v)
     end if
   end subroutine begin_rest
 end module impact1d_event_log

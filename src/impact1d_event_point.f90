@@ -8,17 +8,17 @@ module impact1d_event_point
   use impact1d_kinds, only: wp, eps_wp
   use impact1d_error, only: error_type, raise, status_simulation, fmt
   use impact1d_lanes, only: max_lanes
-  use impact1d_scene, only: scene_type, n_contacts, i_slot_min, i_slot_max
-  use impact1d_modes, only: mode_type, solve_mode
+  use impact1d_scene, only: scene_type
+  use impact1d_modes, only: mode_type, solve_mode, pair_rows
   use impact1d_impacts, only: normal_velocity, impulse, most_approaching, restitution_of, &
     kinetic_energy, joint_inelastic, inelastic_projection
-  use impact1d_output, only: sink_type, run_stats, event_impact, event_rest, event_stick, event_slip
+  use impact1d_output, only: sink_type, run_stats, class_impact, class_rest, class_stick, class_slip
   use impact1d_state, only: lane_state_type, add_compensated
   use impact1d_yardsticks, only: gap_rounding, velocity_rounding, time_rounding, energy_rounding, force_scale, &
     same_instant
   use impact1d_contacts, only: gap, gap_tolerance, snap, rigid_pair, u_tolerance, u_tolerances
   use impact1d_stepping, only: rk4_type
-  use impact1d_location, only: watch_type
+  use impact1d_location, only: watch_type, located_type, located_row, located_body
   use impact1d_loads, only: state_force, applied_rate
   use impact1d_event_log, only: event_log_type, log_event
   implicit none
@@ -28,14 +28,14 @@ module impact1d_event_point
 
 contains
 
-  !> The event point at s%t. which: what the location found (contact k, 100 + body i, -1 a
-  !> mode condition) or 0; initial: the start of the run (no mode yet). Leaves the new mode,
+  !> The event point at s%t. which: what the location found (a row, a body, a mode
+  !> condition) or nothing; initial: the start of the run (no mode yet). Leaves the new mode,
   !> what it needs watched and the integrator's constant acceleration set. s: the run's state,
   !> in lanes (the run keeps it there: impact1d_solver's run).
   subroutine event_point(scene, initial, which, s, mode, event_log, watch, rk, sink, stats, error)
     type(scene_type), intent(in) :: scene
     logical, intent(in) :: initial
-    integer, intent(in) :: which
+    type(located_type), intent(in) :: which
     type(lane_state_type), intent(inout) :: s
     type(mode_type), intent(inout) :: mode
     type(event_log_type), intent(inout) :: event_log
@@ -44,8 +44,8 @@ contains
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
     type(error_type), allocatable, intent(inout) :: error
-    logical :: closed(n_contacts), candidate(n_contacts), resting(max_lanes), found
-    logical :: pushed(n_contacts)
+    logical :: closed(pair_rows), candidate(pair_rows), resting(max_lanes), found
+    logical :: pushed(pair_rows)
     real(wp), dimension(max_lanes) :: f, df, v_before, v_after, moving_sign, acc
     ! Velocity scale of each body entering this event point: impulses redistribute
     ! velocity but cannot create precision, so what is below its rounding is zero.
@@ -55,22 +55,20 @@ contains
 
     call state_force(scene, s, f)
     call applied_rate(scene, s%t, s%v, df)
-    do k = 1, n_contacts
-      closed(k) = scene%row_present(k)
-      if (closed(k)) closed(k) = k == which .or. gap(scene, k, s) <= gap_tolerance(scene, k, s, 0.0_wp)
+    closed = .false.
+    do k = 1, scene%n_rows
+      closed(k) = (which%kind == located_row .and. which%index == k) .or. &
+        gap(scene, k, s) <= gap_tolerance(scene, k, s, 0.0_wp)
       ! The user's numbers carry their decimal rounding (7.553 - 7.122 is not 0.431): at the
       ! start, a gap within it is contact, as the validator accepted it.
-      if (initial .and. scene%row_present(k)) closed(k) = closed(k) .or. gap(scene, k, s) <= &
+      if (initial) closed(k) = closed(k) .or. gap(scene, k, s) <= &
         gap_rounding * max(maxval(abs(scene%pair%normal(:, k) * s%x)), abs(scene%row_offset(k)))
     end do
     ! A rigid link (d_min = d_max) is one constraint seen from both sides.
-    if (scene%row_present(i_slot_min) .and. scene%row_present(i_slot_max)) then
-      if (scene%row_offset(i_slot_min) == -scene%row_offset(i_slot_max)) then
-        closed(i_slot_min) = closed(i_slot_min) .or. closed(i_slot_max)
-        closed(i_slot_max) = closed(i_slot_min)
-      end if
-    end if
-    do k = 1, n_contacts
+    do k = 1, scene%n_rows
+      if (scene%row_partner(k) > 0) closed(k) = closed(k) .or. closed(scene%row_partner(k))
+    end do
+    do k = 1, scene%n_rows
       if (closed(k)) call snap(scene, k, closed, s)
     end do
     ! A sliding body whose stop was located, or that stopped within rounding (its velocity
@@ -81,8 +79,8 @@ contains
     if (same_instant(scene, s%t, event_log%scale_time)) entry_scale = max(entry_scale, event_log%scale)
     do i = 1, 2
       if (scene%pair%static_friction(i) == 0.0_wp) cycle
-      if (i == which - 100 .or. abs(s%v(i)) <= velocity_rounding * abs(acc(i)) * scene%dt) &
-        call zero_velocity(scene, s, i)
+      if ((which%kind == located_body .and. which%index == i) .or. &
+          abs(s%v(i)) <= velocity_rounding * abs(acc(i)) * scene%dt) call zero_velocity(scene, s, i)
     end do
 
     ! Perfectly inelastic contacts closed together take one joint impact: sequential
@@ -94,9 +92,12 @@ contains
         call check_dissipative(scene, s%t, v_before, v_after, error)
         if (allocated(error)) return
         call apply(scene, s, v_after)
-        if (any(pushed .and. [.false., .false., .true., .true.])) entry_scale = maxval(entry_scale)
-        do k = 1, n_contacts
-          if (pushed(k)) call log_event(sink, stats, s%t, event_impact + k, v_before, v_after)
+        ! A row between the bodies pushed both: each takes the larger scale.
+        do k = 1, scene%n_rows
+          if (pushed(k) .and. all(scene%pair%normal(:, k) /= 0.0_wp)) entry_scale = maxval(entry_scale)
+        end do
+        do k = 1, scene%n_rows
+          if (pushed(k)) call log_event(scene, sink, stats, s%t, class_impact, k, v_before, v_after)
         end do
       end if
     end if
@@ -113,12 +114,12 @@ contains
         return
       end if
       v_before = s%v
-      call impulse(scene, k, restitution_of(scene, k, closed), s%v, v_after, rigid_pair(closed))
+      call impulse(scene, k, restitution_of(scene, k, closed), s%v, v_after, rigid_pair(scene, closed))
       call check_dissipative(scene, s%t, v_before, v_after, error)
       if (allocated(error)) return
       call apply(scene, s, v_after)
       if (all(scene%pair%normal(:, k) /= 0.0_wp)) entry_scale = maxval(entry_scale)
-      call log_event(sink, stats, s%t, event_impact + k, v_before, v_after)
+      call log_event(scene, sink, stats, s%t, class_impact, k, v_before, v_after)
     end do
 
     event_log%scale_time = s%t
@@ -129,22 +130,22 @@ contains
     ! joint inelastic impact): removed one contact at a time it would pass back and forth, a
     ! fraction smaller each time (a body on a wall under a heavier one).
     call zero_stopped(scene, s, acc, entry_scale)
-    if (.not. rigid_pair(closed)) then
-      call inelastic_projection(scene, closed, s%v, spread(0.0_wp, 1, n_contacts), v_after, pushed)
+    if (.not. rigid_pair(scene, closed)) then
+      call inelastic_projection(scene, closed, s%v, spread(0.0_wp, 1, pair_rows), v_after, pushed)
       if (count(pushed) >= 2) call apply(scene, s, v_after)
     end if
-    do k = 1, n_contacts
+    do k = 1, scene%n_rows
       if (.not. closed(k)) cycle
       if (abs(normal_velocity(scene, k, s%v)) <= u_tolerance(scene, mode, s, k, entry_scale) .and. &
           normal_velocity(scene, k, s%v) /= 0.0_wp) then
-        call impulse(scene, k, 0.0_wp, s%v, v_after, rigid_pair(closed))
+        call impulse(scene, k, 0.0_wp, s%v, v_after, rigid_pair(scene, closed))
         call apply(scene, s, v_after)
       end if
     end do
 
     ! Zeno: a bounce series whose remaining time is below the clock's resolution ends in
     ! rest now; the rest is logged at the series' accumulation time.
-    do k = 1, n_contacts
+    do k = 1, scene%n_rows
       if (.not. closed(k)) cycle
       call settle_bounce_series(scene, mode, k, f, df, closed, entry_scale, s, event_log, sink, stats)
     end do
@@ -153,7 +154,7 @@ contains
     call zero_stopped(scene, s, acc, entry_scale)
     ! A body still against the other one (a closed slot limit) that has stopped has stopped
     ! too: its velocity is the contact's rounding-level normal velocity.
-    do k = 1, n_contacts
+    do k = 1, scene%n_rows
       if (.not. closed(k) .or. any(scene%pair%normal(:, k) == 0.0_wp)) cycle
       if (abs(normal_velocity(scene, k, s%v)) > u_tolerance(scene, mode, s, k, entry_scale)) cycle
       do i = 1, 2
@@ -181,7 +182,7 @@ contains
       call mode%acceleration(scene%forcing%constant_lanes, rk%constant_acceleration)
       call watch%find_quiet_times(scene, mode, s, rk%constant_acceleration)
     end if
-    watch%watching = mode%n_hold > 0 .or. any(scene%row_present .and. .not. mode%active) .or. &
+    watch%watching = mode%n_hold > 0 .or. any(.not. mode%active(:scene%n_rows)) .or. &
       any(scene%pair%static_friction > 0.0_wp .and. mode%sgn /= 0.0_wp)
   end subroutine event_point
 
@@ -189,7 +190,7 @@ contains
   !> or stop holding, bodies that come to rest or break away.
   subroutine log_mode_change(scene, initial, f, df, candidate, new_mode, s, event_log, sink, stats)
     type(scene_type), intent(in) :: scene
-    logical, intent(in) :: initial, candidate(n_contacts)
+    logical, intent(in) :: initial, candidate(pair_rows)
     real(wp), intent(in) :: f(max_lanes), df(max_lanes)
     type(mode_type), intent(in) :: new_mode
     type(lane_state_type), intent(in) :: s
@@ -202,7 +203,7 @@ contains
 
     call new_mode%acceleration(f, acc)
     tol_a = 1.0e3_wp * eps_wp * force_scale(scene, f, df) / scene%pair%mass
-    do k = 1, n_contacts
+    do k = 1, scene%n_rows
       if (new_mode%active(k) .and. .not. event_log%in_contact(k)) then
         call event_log%begin_rest(scene, k, s%t, s%t, s%v, sink, stats)
       else if (event_log%in_contact(k) .and. .not. new_mode%active(k)) then
@@ -212,7 +213,7 @@ contains
             .and. dot_product(scene%pair%normal(:, k), matmul(new_mode%gain, df)) > &
             1.0e3_wp * eps_wp * sum(abs(df)) / minval(scene%pair%mass))) then
           if (event_log%pending_rest(k) < huge(1.0_wp)) then
-            call log_event(sink, stats, s%t, event_rest + k, s%v, s%v)
+            call log_event(scene, sink, stats, s%t, class_rest, k, s%v, s%v)
             event_log%pending_rest(k) = huge(1.0_wp)
           end if
           ! Logged once time has moved on: a contact that closes again at this same
@@ -236,10 +237,10 @@ contains
       ! logged either).
       if (resting_now .and. .not. event_log%at_rest(i) .and. .not. initial .and. &
           .not. same_instant(scene, s%t, event_log%rest_lost_time(i))) &
-        call log_event(sink, stats, s%t, event_stick + i, s%v, s%v)
+        call log_event(scene, sink, stats, s%t, class_stick, i, s%v, s%v)
       if (.not. resting_now .and. event_log%at_rest(i)) then
         if (s%v(i) == 0.0_wp) then
-          call log_event(sink, stats, s%t, event_slip + i, s%v, s%v)
+          call log_event(scene, sink, stats, s%t, class_slip, i, s%v, s%v)
         else
           event_log%rest_lost_time(i) = s%t
         end if
@@ -258,7 +259,7 @@ contains
     type(mode_type), intent(in) :: mode
     integer, intent(in) :: k
     real(wp), dimension(max_lanes), intent(in) :: f, df, entry_scale
-    logical, intent(in) :: closed(n_contacts)
+    logical, intent(in) :: closed(pair_rows)
     type(lane_state_type), intent(inout) :: s
     type(event_log_type), intent(inout) :: event_log
     class(sink_type), intent(inout) :: sink
@@ -268,13 +269,13 @@ contains
     if (u <= u_tolerance(scene, mode, s, k, entry_scale)) return
     a_up = free_gap_acceleration(scene, mode, k, s, s%v, f, df, closed, entry_scale)
     if (a_up >= 0.0_wp) return
-    call impulse(scene, k, 1.0_wp, s%v, v_bounce, rigid_pair(closed))
+    call impulse(scene, k, 1.0_wp, s%v, v_bounce, rigid_pair(scene, closed))
     a_down = free_gap_acceleration(scene, mode, k, s, v_bounce, f, df, closed, entry_scale)
     remaining = bounce_series_time(u, a_up, a_down, restitution_of(scene, k, closed))
     ! Gaps are exact to their own size, so the series is followed until what remains of it
     ! is below the clock's resolution.
     if (remaining > time_rounding * max(abs(s%t), scene%dt)) return
-    call impulse(scene, k, 0.0_wp, s%v, v_bounce, rigid_pair(closed))
+    call impulse(scene, k, 0.0_wp, s%v, v_bounce, rigid_pair(scene, closed))
     call apply(scene, s, v_bounce)
     if (remaining < huge(1.0_wp)) then
       call event_log%begin_rest(scene, k, s%t, s%t + remaining, s%v, sink, stats)
@@ -307,10 +308,10 @@ contains
     integer, intent(in) :: k
     type(lane_state_type), intent(in) :: s
     real(wp), dimension(max_lanes), intent(in) :: v, f, df, entry_scale
-    logical, intent(in) :: closed(n_contacts)
+    logical, intent(in) :: closed(pair_rows)
     type(mode_type) :: free_mode
     type(lane_state_type) :: probe
-    logical :: candidate(n_contacts), resting(max_lanes), found
+    logical :: candidate(pair_rows), resting(max_lanes), found
     real(wp) :: moving_sign(max_lanes), acc(max_lanes)
     probe = s
     probe%v = v
@@ -384,11 +385,12 @@ contains
     type(mode_type), intent(in) :: mode
     type(lane_state_type), intent(in) :: s
     real(wp), intent(in) :: entry_scale(max_lanes)
-    logical, intent(in) :: closed(n_contacts)
-    logical, intent(out) :: candidate(n_contacts), resting(max_lanes)
+    logical, intent(in) :: closed(pair_rows)
+    logical, intent(out) :: candidate(pair_rows), resting(max_lanes)
     real(wp), intent(out) :: moving_sign(max_lanes)
     integer :: k
-    do k = 1, n_contacts
+    candidate = .false.
+    do k = 1, scene%n_rows
       candidate(k) = closed(k)
       if (candidate(k)) candidate(k) = abs(normal_velocity(scene, k, s%v)) <= u_tolerance(scene, mode, s, k, entry_scale)
     end do

@@ -6,11 +6,12 @@
 module impact1d_impacts
   use impact1d_kinds, only: wp
   use impact1d_lanes, only: max_lanes
-  use impact1d_scene, only: scene_type, n_contacts, i_left, i_right, i_slot_min, i_slot_max
+  use impact1d_scene, only: scene_type
+  use impact1d_modes, only: pair_rows
   implicit none
   private
   public :: normal_velocity, impulse, most_approaching, restitution_of, kinetic_energy, &
-    joint_inelastic, inelastic_projection
+    joint_inelastic, inelastic_projection, both_limits_closed
 
 contains
 
@@ -36,7 +37,7 @@ contains
     logical, intent(in), optional :: rigid
     real(wp) :: p, v_pair
     if (present(rigid)) then
-      if (rigid .and. (k == i_left .or. k == i_right)) then
+      if (rigid .and. scene%row_body(1, k) == 0) then
         ! Written so that it is v(1) to the bit when the bodies already move together.
         v_pair = v(1) + scene%pair%mass(2) * (v(2) - v(1)) / sum(scene%pair%mass)
         v_after = v_pair - (1.0_wp + r) * normal_velocity(scene, k, [v_pair, v_pair]) * sum(scene%pair%normal(:, k))
@@ -49,16 +50,17 @@ contains
     where (scene%pair%normal(:, k) == 0.0_wp) v_after = v
   end subroutine impulse
 
-  !> The closed contact approaching fastest (0 if none approaches faster than its tol).
+  !> The closed contact approaching fastest (0 if none approaches faster than its tol; the
+  !> first in row order among equals).
   pure integer function most_approaching(scene, closed, v, tol) result(k_best)
     type(scene_type), intent(in) :: scene
-    logical, intent(in) :: closed(n_contacts)
-    real(wp), intent(in) :: v(max_lanes), tol(n_contacts)
+    logical, intent(in) :: closed(pair_rows)
+    real(wp), intent(in) :: v(max_lanes), tol(pair_rows)
     integer :: k
     real(wp) :: u_best
     k_best = 0
     u_best = 0.0_wp
-    do k = 1, n_contacts
+    do k = 1, scene%n_rows
       if (.not. closed(k)) cycle
       if (normal_velocity(scene, k, v) < min(u_best, -tol(k))) then
         k_best = k
@@ -67,17 +69,30 @@ contains
     end do
   end function most_approaching
 
-  !> Restitution used for contact k. When both slot limits are closed at once (a rigid link,
-  !> d_min = d_max) the link has no room to rebound: the bodies move as one (r = 0), where
-  !> elastic limits would otherwise exchange the relative velocity forever in zero time.
+  !> Restitution used for row k. When both limits of its record are closed at once (a rigid
+  !> link, d_min = d_max: the event point closes a row_partner with its row) the link has no
+  !> room to rebound: the bodies move as one (r = 0), where elastic limits would otherwise
+  !> exchange the relative velocity forever in zero time.
   pure real(wp) function restitution_of(scene, k, closed)
     type(scene_type), intent(in) :: scene
     integer, intent(in) :: k
-    logical, intent(in) :: closed(n_contacts)
+    logical, intent(in) :: closed(pair_rows)
     restitution_of = scene%row_restitution(k)
-    if ((k == i_slot_min .or. k == i_slot_max) .and. closed(i_slot_min) .and. closed(i_slot_max)) &
-      restitution_of = 0.0_wp
+    if (both_limits_closed(scene, k, closed)) restitution_of = 0.0_wp
   end function restitution_of
+
+  !> Whether row k and the other limit of its record (rows of one record are adjacent) are
+  !> both closed.
+  pure logical function both_limits_closed(scene, k, closed)
+    type(scene_type), intent(in) :: scene
+    integer, intent(in) :: k
+    logical, intent(in) :: closed(pair_rows)
+    integer :: j
+    both_limits_closed = .false.
+    do j = max(k - 1, 1), min(k + 1, scene%n_rows)
+      if (j /= k .and. scene%row_contact(j) == scene%row_contact(k)) both_limits_closed = closed(k) .and. closed(j)
+    end do
+  end function both_limits_closed
 
   !> Whether the impact at this instant is one joint projection (inelastic_projection) rather
   !> than a sequence of impulses: two or more contacts are closed and every one of them is
@@ -85,10 +100,13 @@ contains
   !> constraint, which a single impulse already resolves exactly: they keep that path.
   pure logical function joint_inelastic(scene, closed)
     type(scene_type), intent(in) :: scene
-    logical, intent(in) :: closed(n_contacts)
+    logical, intent(in) :: closed(pair_rows)
     integer :: k
-    joint_inelastic = count(closed) > 1 .and. .not. (closed(i_slot_min) .and. closed(i_slot_max))
-    do k = 1, n_contacts
+    joint_inelastic = count(closed) > 1
+    do k = 1, scene%n_rows
+      joint_inelastic = joint_inelastic .and. .not. both_limits_closed(scene, k, closed)
+    end do
+    do k = 1, scene%n_rows
       if (closed(k)) joint_inelastic = joint_inelastic .and. restitution_of(scene, k, closed) == 0.0_wp
     end do
   end function joint_inelastic
@@ -105,10 +123,10 @@ contains
   !> pushed: the contacts whose face the projection lies on (they take an impulse).
   pure subroutine inelastic_projection(scene, closed, v, tol, v_after, pushed)
     type(scene_type), intent(in) :: scene
-    logical, intent(in) :: closed(n_contacts)
-    real(wp), intent(in) :: v(max_lanes), tol(n_contacts)
+    logical, intent(in) :: closed(pair_rows)
+    real(wp), intent(in) :: v(max_lanes), tol(pair_rows)
     real(wp), intent(out) :: v_after(max_lanes)
-    logical, intent(out) :: pushed(n_contacts)
+    logical, intent(out) :: pushed(pair_rows)
     real(wp) :: candidate(max_lanes), distance, best_distance
     integer :: j, k
 
@@ -116,9 +134,9 @@ contains
     pushed = .false.
     if (most_approaching(scene, closed, v, tol) == 0) return
     best_distance = huge(1.0_wp)
-    do k = 1, n_contacts
+    do k = 1, scene%n_rows
       if (.not. closed(k)) cycle
-      do j = k, n_contacts
+      do j = k, scene%n_rows
         if (.not. closed(j)) cycle
         if (j == k) then
           ! The single-face projection is the r = 0 impulse (exact for a wall: its body stops).

@@ -3,8 +3,8 @@
 !> integrator's own state, and the quiet times before which nothing needs locating.
 module impact1d_location
   use impact1d_kinds, only: wp, eps_wp
-  use impact1d_scene, only: scene_type, n_contacts
-  use impact1d_modes, only: mode_type, max_holds
+  use impact1d_scene, only: scene_type
+  use impact1d_modes, only: mode_type, max_holds, pair_rows
   use impact1d_events, only: earliest_crossing
   use impact1d_impacts, only: normal_velocity
   use impact1d_state, only: lane_state_type
@@ -16,12 +16,21 @@ module impact1d_location
   implicit none
   private
   public :: watch_type, hold_crossing, refine, constraints_hold, first_negative
+  public :: located_type, located_none, located_row, located_body, located_hold
+
+  !> What a location found: a row's gap closing, a sliding body stopping, a mode condition
+  !> failing (located_hold, no index), or nothing.
+  integer, parameter :: located_none = 0, located_row = 1, located_body = 2, located_hold = 3
+  type :: located_type
+    integer :: kind = located_none
+    integer :: index = 0      !< the row or the body
+  end type located_type
 
   !> What the current mode needs watched.
   type :: watch_type
     !> Until when each open gap (row) and each sliding body (N, allocated in run) needs no
     !> location.
-    real(wp) :: quiet_row(n_contacts) = -huge(1.0_wp)
+    real(wp) :: quiet_row(pair_rows) = -huge(1.0_wp)
     real(wp), allocatable :: quiet_body(:)
     !> Something in the mode can end it (else its steps need no location at all).
     logical :: watching = .true.
@@ -48,7 +57,7 @@ contains
   end function quiet_time
 
   !> Earliest event in (0, step]: a gap closing, a sliding body stopping, a mode condition
-  !> failing. which = k for contact k, 100 + i for body i, -1 for a mode condition.
+  !> failing: which says what (nothing if theta is past the step).
   subroutine locate(self, scene, mode, constant_forcing, polynomial_forcing, a, b, step, theta, which)
     class(watch_type), intent(in) :: self
     type(scene_type), intent(in) :: scene
@@ -59,19 +68,18 @@ contains
     type(lane_state_type), intent(in) :: a, b
     real(wp), intent(in) :: step
     real(wp), intent(out) :: theta
-    integer, intent(out) :: which
+    type(located_type), intent(out) :: which
     real(wp) :: p(0:3), q(0:3), candidate, scale, c(3, max_lanes), f(max_lanes), df(max_lanes)
     real(wp) :: acc_rounding(max_lanes), acc0(max_lanes)
     integer :: k, i
     logical :: have_dense, have_acc_rounding, have_acc0
 
     theta = huge(1.0_wp)
-    which = 0
     have_dense = .false.
     have_acc_rounding = .false.
     have_acc0 = .false.
-    do k = 1, n_contacts
-      if (.not. scene%row_present(k) .or. mode%active(k)) cycle
+    do k = 1, scene%n_rows
+      if (mode%active(k)) cycle
       if (a%t + step < self%quiet_row(k)) cycle
       if (.not. have_dense) call dense_output(a, b, step, c)
       have_dense = .true.
@@ -102,7 +110,7 @@ contains
       candidate = earliest_crossing(p, step, q)
       if (candidate < theta) then
         theta = candidate
-        which = k
+        which = located_type(located_row, k)
       end if
     end do
     do i = 1, scene%n_bodies
@@ -130,7 +138,7 @@ contains
       candidate = earliest_crossing(p, step, q)
       if (candidate < theta) then
         theta = candidate
-        which = 100 + i
+        which = located_type(located_body, i)
       end if
     end do
     ! Under constant forces the mode's conditions are constant: they held when it began.
@@ -139,7 +147,7 @@ contains
       candidate = hold_crossing(scene, mode, a, c, step)
       if (candidate < theta) then
         theta = candidate
-        which = -1
+        which = located_type(located_hold, 0)
       end if
     end if
   end subroutine locate
@@ -226,25 +234,27 @@ contains
     type(mode_type), intent(in) :: mode
     type(lane_state_type), intent(in) :: a
     real(wp), intent(inout) :: step
-    integer, intent(in) :: which
+    type(located_type), intent(in) :: which
     type(lane_state_type), intent(inout) :: b
     real(wp) :: value, slope, tol, located_step, f(max_lanes), acc(max_lanes)
     integer :: iteration
     located_step = step
     call rk%step(scene, mode, a, step, b)
-    if (which <= 0) return
+    if (which%kind /= located_row .and. which%kind /= located_body) return
     do iteration = 1, 8
-      if (which > 100) then
-        value = b%v(which - 100)
-        call state_force(scene, b, f)
-        call mode%acceleration(f, acc)
-        slope = acc(which - 100)
-        tol = velocity_rounding * max(abs(a%v(which - 100)), abs(value))
-      else
-        value = gap(scene, which, b)
-        slope = normal_velocity(scene, which, b%v)
-        tol = gap_tolerance(scene, which, b, displacement(scene, which, a, b))
-      end if
+      associate (i => which%index, k => which%index)
+        if (which%kind == located_body) then
+          value = b%v(i)
+          call state_force(scene, b, f)
+          call mode%acceleration(f, acc)
+          slope = acc(i)
+          tol = velocity_rounding * max(abs(a%v(i)), abs(value))
+        else
+          value = gap(scene, k, b)
+          slope = normal_velocity(scene, k, b%v)
+          tol = gap_tolerance(scene, k, b, displacement(scene, k, a, b))
+        end if
+      end associate
       if (abs(value) <= tol .or. slope == 0.0_wp) exit
       ! Newton stays inside the step that was located, or the clock could pass a stop.
       if (step - value / slope <= 0.0_wp .or. step - value / slope > located_step) exit
@@ -254,17 +264,17 @@ contains
   end subroutine refine
 
   !> No step from s may end (at b) with a gap below zero beyond rounding, nor a sliding body
-  !> past zero. The contact whose closing ended the step (located_contact) is put on its
+  !> past zero. The row whose closing ended the step (located, else 0) is put on its
   !> constraint at the event point, so its own rounding does not count.
-  pure logical function constraints_hold(scene, mode, s, b, located_contact)
+  pure logical function constraints_hold(scene, mode, s, b, located)
     type(scene_type), intent(in) :: scene
     type(mode_type), intent(in) :: mode
     type(lane_state_type), intent(in) :: s, b
-    integer, intent(in) :: located_contact
+    integer, intent(in) :: located
     integer :: k, i
     constraints_hold = .true.
-    do k = 1, n_contacts
-      if (.not. scene%row_present(k) .or. mode%active(k) .or. k == located_contact) cycle
+    do k = 1, scene%n_rows
+      if (mode%active(k) .or. k == located) cycle
       if (gap(scene, k, b) < -gap_tolerance(scene, k, b, displacement(scene, k, s, b))) constraints_hold = .false.
     end do
     do i = 1, scene%n_bodies
@@ -288,8 +298,8 @@ contains
     ! What is not watched needs no location.
     self%quiet_row = huge(1.0_wp)
     self%quiet_body(:) = huge(1.0_wp)
-    do k = 1, n_contacts
-      if (.not. scene%row_present(k) .or. mode%active(k)) cycle
+    do k = 1, scene%n_rows
+      if (mode%active(k)) cycle
       self%quiet_row(k) = s%t + 0.99_wp * first_negative(gap(scene, k, s), normal_velocity(scene, k, s%v), &
         dot_product(scene%pair%normal(:, k), constant_acceleration))
     end do

@@ -15,12 +15,15 @@ module impact1d_modes
   !> Conditions a mode needs (contact force >= 0, |static friction| <= bound): at most two
   !> locked rows, two conditions for a stuck body.
   integer, parameter :: max_holds = 4
-  !> Rows a unit of two bodies can have: a wall each side and the link's two limits.
-  integer, parameter :: pair_rows = 4
+  !> Rows a unit of two bodies can have: the tutorial's walls and slot (four), and room for
+  !> more contact records on the pair (issue 19, stage 3). The enumeration tries subsets of
+  !> the rows present only (2**n_rows masks), so the room costs nothing per event.
+  integer, parameter :: pair_rows = 8
 
   !> What the kernel sees of a unit of n bodies (n = 1: body 2 is the phantom).
   type :: pair_type
     integer :: n = 2                                !< bodies in the unit: 1 or 2
+    integer :: n_rows = 0                           !< rows on the unit (<= pair_rows): the model's rows
     real(wp) :: mass(2) = 1.0_wp                    !< (2) kg; the phantom's 1
     real(wp) :: friction(2) = 0.0_wp                !< (2) sliding friction bounds c_i, N
     real(wp) :: static_friction(2) = 0.0_wp        !< (2) static friction bounds s_i >= c_i, N
@@ -106,7 +109,7 @@ contains
           if ((.not. resting(1) .and. o1 /= 0) .or. (.not. resting(2) .and. o2 /= 0)) cycle
           if (count(option == 0 .and. resting) /= target_stuck) cycle
           do target_active = count(candidate), 0, -1
-            do mask = 0, 2**pair_rows - 1
+            do mask = 0, 2**pair%n_rows - 1
               active = [(btest(mask, k - 1), k = 1, pair_rows)]
               if (any(active .and. .not. candidate)) cycle
               n_active = count(active)

@@ -8,7 +8,7 @@ module impact1d_output
   use impact1d_error, only: error_type, raise, status_input, status_simulation, status_interrupted, fmt
   use impact1d_interrupt, only: interrupt_count
   use impact1d_scene, only: scene_input, real_names, n_real, i_title, i_method, i_g, i_dt_out, &
-    events_all, events_impacts, events_none, events_kept, n_contacts, &
+    events_all, events_impacts, events_none, events_kept, name_len, &
     i_dt, default_gravity, i_k1, i_k2, i_k12, i_c1, i_c2, i_c12, i_m2
   use impact1d_files, only: output_target, make_temporary, resolve_output, lock_folders, unlock_folders, write_text, &
     lock_timed_out, lock_wait
@@ -16,6 +16,8 @@ module impact1d_output
   private
   public :: sink_type, memory_sink, summary_sink, file_sink, n_columns, column_names, n_event_kinds, event_names
   public :: event_impact, event_rest, event_release, event_stick, event_slip, run_stats, checkpoint
+  public :: class_impact, class_rest, class_release, class_stick, class_slip, event_name, start_counts, &
+    count_event, event_count, impacts_on
   public :: emit_sample, events_path, present_columns, i_pe, i_work, i_friction_loss, i_impact_loss, &
     i_damping_loss
 
@@ -28,8 +30,19 @@ module impact1d_output
   character(len=*), parameter :: column_words(n_columns) = [character(len=13) :: 't', 'x1', 'v1', &
     'x2', 'v2', 'ke', 'pe', 'work', 'friction_loss', 'impact_loss', 'damping_loss', 'residual']
 
-  !> Event kinds: impact on contact k is code k; rest, release add 4 and 8; stick, slip of
-  !> body i are 12 + i and 14 + i.
+  !> Events are (class, index): an impact, rest or release of row index, a stick or slip of
+  !> body index; each carries the velocities of a pair of bodies (a, b; 0: none), before and
+  !> after: [v_a-, v_b-, v_a+, v_b+] (docs/nbody-plan.md, "The event record"). Named
+  !> '<row>', 'rest_<row>', 'release_<row>' (the row's name), 'stick<i>', 'slip<i>'.
+  integer, parameter :: class_impact = 1, class_rest = 2, class_release = 3, class_stick = 4, &
+    class_slip = 5
+  character(len=*), parameter :: class_prefix(5) = [character(len=8) :: '', 'rest_', 'release_', &
+    'stick', 'slip']
+  !> Longest event name: a prefix and a row's name.
+  integer, parameter :: event_name_len = 8 + name_len
+  !> The event kinds of the tutorial's scenes (its walls and slot, one or two bodies), for
+  !> Python's event_kinds(); impact on left, right, slot_min, slot_max, then the rests and
+  !> releases on them, stick1, stick2, slip1, slip2.
   integer, parameter :: n_event_kinds = 16
   integer, parameter :: event_impact = 0, event_rest = 4, event_release = 8, event_stick = 12, &
     event_slip = 14
@@ -41,7 +54,10 @@ module impact1d_output
   !> What a run did, for the CLI's summary and Python's result.
   type :: run_stats
     integer(int64) :: steps = 0
-    integer :: events(n_event_kinds) = 0
+    !> Events counted: every one, per row (impacts, rests, releases: (3, nr)) and per body
+    !> (sticks, slips: (2, N)); start_counts allocates them.
+    integer :: n_events = 0
+    integer, allocatable :: row_events(:, :), body_events(:, :)
     real(wp) :: last_row(n_columns) = 0.0_wp
     real(wp) :: max_residual = 0.0_wp
     !> The interrupt count when the run started (impact1d_interrupt): a run ends when it moves on.
@@ -61,6 +77,8 @@ module impact1d_output
     integer(int64) :: n_logged = 0, n_cut = 0
     integer(int64) :: clock_start = -1, clock_shown = 0
     logical :: progress_shown = .false.
+    !> The run's row names (scene_type's row_name, set by the run): what its events are called.
+    character(len=name_len), allocatable :: row_names(:)
   contains
     procedure(put_sample_interface), deferred :: put_sample
     procedure(put_event_interface), deferred :: put_event
@@ -78,12 +96,13 @@ module impact1d_output
       class(sink_type), intent(inout) :: self
       real(wp), intent(in) :: row(n_columns)
     end subroutine put_sample_interface
-    !> One event: time, kind code, velocities before and after.
-    subroutine put_event_interface(self, t, kind, v_before, v_after)
+    !> One event: time, class and index, the pair of bodies it reports (a, b; 0: none) and
+    !> their velocities [v_a-, v_b-, v_a+, v_b+] (0 for a missing body).
+    subroutine put_event_interface(self, t, class, index, a, b, v)
       import :: sink_type, wp
       class(sink_type), intent(inout) :: self
-      real(wp), intent(in) :: t, v_before(2), v_after(2)
-      integer, intent(in) :: kind
+      real(wp), intent(in) :: t, v(4)
+      integer, intent(in) :: class, index, a, b
     end subroutine put_event_interface
   end interface
 
@@ -95,8 +114,9 @@ module impact1d_output
     real(wp), pointer :: into(:, :) => null()
     integer, allocatable :: columns(:)
     integer :: n_samples = 0
-    real(wp), allocatable :: event_time(:), event_v(:, :)
-    integer, allocatable :: event_kind(:)
+    real(wp), allocatable :: event_time(:), event_v(:, :)   !< (n), (4, n)
+    integer, allocatable :: event_class(:), event_index(:)  !< (n)
+    integer, allocatable :: event_ends(:, :)                !< (2, n) the reported pair
     integer :: n_events = 0
   contains
     procedure :: put_sample => memory_put_sample
@@ -250,20 +270,19 @@ contains
     end do
   end subroutine names_of
 
-  !> Whether an event of this kind goes into the sink's log (the memory and file sinks ask).
-  pure logical function keeps_event(self, kind)
+  !> Whether an event of this class goes into the sink's log (the memory and file sinks ask).
+  pure logical function keeps_event(self, class)
     class(sink_type), intent(in) :: self
-    integer, intent(in) :: kind
-    keeps_event = self%events == events_all .or. (self%events == events_impacts .and. &
-      kind > event_impact .and. kind <= event_impact + n_contacts)
+    integer, intent(in) :: class
+    keeps_event = self%events == events_all .or. (self%events == events_impacts .and. class == class_impact)
   end function keeps_event
 
   !> Whether this event goes into the log: a kind the log keeps, while there is room
   !> (max_events); every one past the room is counted (n_cut) for the note.
-  logical function logs_event(self, kind)
+  logical function logs_event(self, class)
     class(sink_type), intent(inout) :: self
-    integer, intent(in) :: kind
-    logs_event = self%keeps_event(kind)
+    integer, intent(in) :: class
+    logs_event = self%keeps_event(class)
     if (.not. logs_event) return
     logs_event = self%n_logged < self%max_events
     if (logs_event) then
@@ -284,6 +303,65 @@ contains
       '); the run went on to its end and the counts are exact'
   end subroutine cut_note
 
+  !> The name of event (class, index) of a run whose rows are named row_names ('left',
+  !> 'rest_slot_min', 'stick1').
+  pure function event_name(row_names, class, index) result(name)
+    character(len=*), intent(in) :: row_names(:)
+    integer, intent(in) :: class, index
+    character(len=event_name_len) :: name     ! blank padded: callers trim
+    character(len=12) :: body
+    if (class >= class_stick) then
+      write(body, '(i0)') index
+      name = trim(class_prefix(class)) // body
+    else
+      name = trim(class_prefix(class)) // row_names(index)
+    end if
+  end function event_name
+
+  !> Counts for a run of n_rows rows and n_bodies bodies, none yet.
+  pure subroutine start_counts(stats, n_rows, n_bodies)
+    type(run_stats), intent(inout) :: stats
+    integer, intent(in) :: n_rows, n_bodies
+    allocate(stats%row_events(class_impact:class_release, n_rows), stats%body_events(class_stick:class_slip, n_bodies))
+    stats%row_events = 0
+    stats%body_events = 0
+    stats%n_events = 0
+  end subroutine start_counts
+
+  !> One more event (class, index).
+  pure subroutine count_event(stats, class, index)
+    type(run_stats), intent(inout) :: stats
+    integer, intent(in) :: class, index
+    if (class >= class_stick) then
+      stats%body_events(class, index) = stats%body_events(class, index) + 1
+    else
+      stats%row_events(class, index) = stats%row_events(class, index) + 1
+    end if
+    stats%n_events = stats%n_events + 1
+  end subroutine count_event
+
+  !> How many events (class, index) the run had.
+  pure integer function event_count(stats, class, index)
+    type(run_stats), intent(in) :: stats
+    integer, intent(in) :: class, index
+    if (class >= class_stick) then
+      event_count = stats%body_events(class, index)
+    else
+      event_count = stats%row_events(class, index)
+    end if
+  end function event_count
+
+  !> Impacts on the row called name (0 if the run has none of that name): a sweep's
+  !> n_left .. n_slot_max.
+  pure integer function impacts_on(stats, row_names, name)
+    type(run_stats), intent(in) :: stats
+    character(len=*), intent(in) :: row_names(:), name
+    integer :: k
+    impacts_on = 0
+    k = findloc(row_names, name, dim=1)
+    if (k > 0) impacts_on = stats%row_events(class_impact, k)
+  end function impacts_on
+
   !> Every 4096 steps of a run: progress on stderr where it is shown, and an interrupt
   !> (Ctrl-C while Python waits for the run) ends the run within a fraction of a second.
   subroutine checkpoint(sink, stats, t, t_end, error)
@@ -291,7 +369,7 @@ contains
     type(run_stats), intent(in) :: stats
     real(wp), intent(in) :: t, t_end
     type(error_type), allocatable, intent(inout) :: error
-    call sink%progress(t, t_end, sum(stats%events))
+    call sink%progress(t, t_end, stats%n_events)
     if (interrupt_count() /= stats%interrupt_epoch) &
       call raise(error, status_interrupted, 'interrupted at t = ' // trim(fmt(t)) // ' s')
   end subroutine checkpoint
@@ -351,8 +429,10 @@ contains
       allocate(self%samples(n_samples, size(columns)))
     end if
     self%n_samples = 0
-    if (allocated(self%event_time)) deallocate(self%event_time, self%event_v, self%event_kind)
-    allocate(self%event_time(64), self%event_v(4, 64), self%event_kind(64))
+    if (allocated(self%event_time)) deallocate(self%event_time, self%event_v, self%event_class, &
+      self%event_index, self%event_ends)
+    allocate(self%event_time(64), self%event_v(4, 64), self%event_class(64), self%event_index(64), &
+      self%event_ends(2, 64))
     self%n_events = 0
   end subroutine memory_reserve
 
@@ -367,11 +447,12 @@ contains
     end if
   end subroutine summary_put_sample
 
-  subroutine summary_put_event(self, t, kind, v_before, v_after)
+  subroutine summary_put_event(self, t, class, index, a, b, v)
     class(summary_sink), intent(inout) :: self
-    real(wp), intent(in) :: t, v_before(2), v_after(2)
-    integer, intent(in) :: kind
-    if (any(v_after /= 0.0_wp)) then
+    real(wp), intent(in) :: t, v(4)
+    integer, intent(in) :: class, index, a, b
+    ! (With one or two bodies the pair is every body.)
+    if (any(v(3:4) /= 0.0_wp)) then
       self%rest_event = huge(1.0_wp)
       self%rest_sample = huge(1.0_wp)
     else if (self%rest_event == huge(1.0_wp)) then
@@ -402,30 +483,36 @@ contains
     end if
   end subroutine memory_put_sample
 
-  subroutine memory_put_event(self, t, kind, v_before, v_after)
+  subroutine memory_put_event(self, t, class, index, a, b, v)
     class(memory_sink), intent(inout) :: self
-    real(wp), intent(in) :: t, v_before(2), v_after(2)
-    integer, intent(in) :: kind
+    real(wp), intent(in) :: t, v(4)
+    integer, intent(in) :: class, index, a, b
     real(wp), allocatable :: times(:), velocities(:, :)
-    integer, allocatable :: kinds(:)
+    integer, allocatable :: classes(:), indices(:), ends(:, :)
     integer :: n
-    if (.not. self%logs_event(kind)) return
+    if (.not. self%logs_event(class)) return
     n = self%n_events
     if (n == size(self%event_time)) then
       ! Geometric growth: events are rare next to steps, copies are amortised.
-      allocate(times(2 * n), velocities(4, 2 * n), kinds(2 * n))
+      allocate(times(2 * n), velocities(4, 2 * n), classes(2 * n), indices(2 * n), ends(2, 2 * n))
       times(:n) = self%event_time
       velocities(:, :n) = self%event_v
-      kinds(:n) = self%event_kind
+      classes(:n) = self%event_class
+      indices(:n) = self%event_index
+      ends(:, :n) = self%event_ends
       call move_alloc(times, self%event_time)
       call move_alloc(velocities, self%event_v)
-      call move_alloc(kinds, self%event_kind)
+      call move_alloc(classes, self%event_class)
+      call move_alloc(indices, self%event_index)
+      call move_alloc(ends, self%event_ends)
     end if
     n = n + 1
     self%n_events = n
     self%event_time(n) = t
-    self%event_kind(n) = kind
-    self%event_v(:, n) = [v_before, v_after]
+    self%event_class(n) = class
+    self%event_index(n) = index
+    self%event_ends(:, n) = [a, b]
+    self%event_v(:, n) = v
   end subroutine memory_put_event
 
   !> Open OUT (and OUT's events file: event_file when given and not '', else events_path's
@@ -541,18 +628,21 @@ contains
     self%bytes(1) = self%bytes(1) + self%sample_bytes
   end subroutine file_put_sample
 
-  subroutine file_put_event(self, t, kind, v_before, v_after)
+  subroutine file_put_event(self, t, class, index, a, b, v)
     class(file_sink), intent(inout) :: self
-    real(wp), intent(in) :: t, v_before(2), v_after(2)
-    integer, intent(in) :: kind
+    real(wp), intent(in) :: t, v(4)
+    integer, intent(in) :: class, index, a, b
     integer :: ios
     character(len=512) :: message
     if (allocated(self%write_failure)) return
-    if (.not. self%logs_event(kind)) return
+    if (.not. self%logs_event(class)) return
+    ! One or two bodies: the pair is (1, 2), or (1, 0) with one body, whose line has v1 only.
     if (self%n_bodies == 2) then
-      write(self%event_unit, event_format, iostat=ios, iomsg=message) t, event_names(kind), v_before, v_after
+      write(self%event_unit, event_format, iostat=ios, iomsg=message) t, &
+        event_name(self%row_names, class, index), v
     else
-      write(self%event_unit, event_format, iostat=ios, iomsg=message) t, event_names(kind), v_before(1), v_after(1)
+      write(self%event_unit, event_format, iostat=ios, iomsg=message) t, &
+        event_name(self%row_names, class, index), v(1), v(3)
     end if
     if (ios /= 0) self%write_failure = self%event_path // ': ' // trim(reason(message))
     self%bytes(2) = self%bytes(2) + self%event_bytes

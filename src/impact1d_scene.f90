@@ -6,14 +6,14 @@ module impact1d_scene
   use impact1d_kinds, only: wp, eps_wp
   use impact1d_error, only: error_type, raise, status_input, fmt, fmt_width
   use impact1d_forcing, only: forcing_type, table_type
-  use impact1d_springs, only: springs_type, n_elements
-  use impact1d_modes, only: pair_type
+  use impact1d_springs, only: springs_type, pair_elements
+  use impact1d_modes, only: pair_type, pair_rows
   use impact1d_fields, only: chain_input
   use impact1d_stability, only: linear_modes, stable_step, mode_error, coarse_rate
   implicit none
   private
   public :: n_real, n_text, real_names, text_names, scene_input, scene_type, build_scene, validate
-  public :: n_contacts, i_left, i_right, i_slot_min, i_slot_max
+  public :: i_left, i_right, i_slot_min, i_slot_max
   public :: i_m1, i_m2, i_mu1, i_mu2, i_g, i_x_left, i_r_left, i_x_right, i_r_right, i_d_min, &
     i_r_min, i_d_max, i_r_max, i_x1, i_v1, i_x2, i_v2, i_f1, i_f2, i_f1_amp, i_f1_period, &
     i_f1_phase, i_f2_amp, i_f2_period, i_f2_phase, i_t_end, i_dt, i_dt_out, i_mus1, i_mus2, &
@@ -22,6 +22,7 @@ module impact1d_scene
   public :: positive_value, nonnegative_value, unit_interval, resolvable
   public :: i_title, i_f1_table, i_f2_table, i_method, i_substeps, i_events, default_gravity
   public :: events_all, events_impacts, events_none
+  public :: name_len, set_rows, allocate_contacts, set_springs
 
   integer, parameter :: n_real = 44, n_text = 6
   !> Names of the real inputs, as in the namelist and in Python's Scene, in this order.
@@ -44,24 +45,38 @@ module impact1d_scene
   !> What only a second body can have: refused in a one-body scene (no m2).
   integer, parameter :: body2_fields(18) = [i_x2, i_v2, i_mu2, i_mus2, i_f2, i_f2_amp, i_f2_period, &
     i_f2_phase, i_k2, i_x2_rest, i_c2, i_k12, i_d_rest, i_c12, i_d_min, i_r_min, i_d_max, i_r_max]
-  !> Each spring element's stiffness; its rest position and damping follow it.
-  integer, parameter :: spring_index(n_elements) = [i_k1, i_k2, i_k12]
+  !> The tutorial's spring elements (records in this order, docs/nbody-plan.md B5): body 1
+  !> to the ground, body 2 to the ground, between the bodies; each one's stiffness (its rest
+  !> position and damping follow it) and ends.
+  integer, parameter :: n_tutorial_elements = 3
+  integer, parameter :: spring_index(n_tutorial_elements) = [i_k1, i_k2, i_k12]
+  integer, parameter :: tutorial_element_body(2, n_tutorial_elements) = reshape([0, 1, 0, 2, 1, 2], [2, 3])
   integer, parameter :: i_title = 1, i_f1_table = 2, i_f2_table = 3, i_method = 4, i_substeps = 5, &
     i_events = 6
   !> What the event log keeps (&run events): every event, the impacts only, nothing. The
   !> run's counts (the summary, a sweep's row) are exact whatever it keeps.
   integer, parameter :: events_all = 0, events_impacts = 1, events_none = 2
 
-  !> The four optional unilateral constraints: gap_k = normal(:,k) . x + offset_k >= 0.
-  integer, parameter :: n_contacts = 4, i_left = 1, i_right = 2, i_slot_min = 3, i_slot_max = 4
-  character(len=*), parameter :: contact_names(n_contacts) = [character(len=8) :: &
+  !> The tutorial's four optional limits (left, right, slot_min, slot_max: the rows of its
+  !> scenes in this order, which validate checks and set_contacts turns into records).
+  integer, parameter :: n_limits = 4, i_left = 1, i_right = 2, i_slot_min = 3, i_slot_max = 4
+  character(len=*), parameter :: contact_names(n_limits) = [character(len=8) :: &
     'left', 'right', 'slot_min', 'slot_max']
   !> Their normals with two bodies: the left wall holds body 1, the right wall body 2. With
   !> one body both walls hold body 1 (the pair's normal: scene_type's pair%normal).
-  real(wp), parameter :: two_body_normal(2, n_contacts) = reshape( &
-    [1.0_wp, 0.0_wp, 0.0_wp, -1.0_wp, -1.0_wp, 1.0_wp, 1.0_wp, -1.0_wp], [2, n_contacts])
-  real(wp), parameter :: one_body_normal(2, n_contacts) = reshape( &
-    [1.0_wp, 0.0_wp, -1.0_wp, 0.0_wp, -1.0_wp, 1.0_wp, 1.0_wp, -1.0_wp], [2, n_contacts])
+  real(wp), parameter :: two_body_normal(2, n_limits) = reshape( &
+    [1.0_wp, 0.0_wp, 0.0_wp, -1.0_wp, -1.0_wp, 1.0_wp, 1.0_wp, -1.0_wp], [2, n_limits])
+  real(wp), parameter :: one_body_normal(2, n_limits) = reshape( &
+    [1.0_wp, 0.0_wp, -1.0_wp, 0.0_wp, -1.0_wp, 1.0_wp, 1.0_wp, -1.0_wp], [2, n_limits])
+
+  !> Longest name of a contact record or row ('slot_max', a user's '<name>_min').
+  integer, parameter :: name_len = 32
+  !> The tutorial's contact records, in the order of docs/nbody-plan.md B4: 'left' (the
+  !> ground and body 1, lower limit x_left), 'right' (the ground and body N, upper limit
+  !> x_right), 'slot' (bodies 1 and 2, lower limit d_min or their meeting, upper d_max); and
+  !> which record and end (1 lower, 2 upper) each of the four tutorial limits is.
+  character(len=*), parameter :: tutorial_records(3) = [character(len=5) :: 'left', 'right', 'slot']
+  integer, parameter :: limit_record(n_limits) = [1, 2, 3, 3], limit_end(n_limits) = [1, 2, 1, 2]
 
   real(wp), parameter :: default_gravity = 9.80665_wp
   !> What a scene that needs the N-body engine gets until the engine has records (is_nbody).
@@ -123,13 +138,38 @@ module impact1d_scene
     real(wp), allocatable :: body_static(:)          !< (N) static friction bound (mus_i m_i) g >= c_i, N
     real(wp), allocatable :: body_x0(:), body_v0(:)  !< (N) initial position (m) and velocity (m/s)
     type(forcing_type) :: forcing                    !< the external forces f_i(t), per body (N)
-    type(springs_type) :: springs                    !< springs and dampers: k1, k2, k12 as elements
-    ! rows: the four optional unilateral constraints, in the order left, right, slot_min, slot_max;
-    ! gap_k = pair%normal(:, k) . x + row_offset(k) >= 0 (their normals on the two bodies are
-    ! the kernels' view, pair%normal)
-    logical :: row_present(n_contacts) = .false.     !< (4) the scene has row k
-    real(wp) :: row_offset(n_contacts) = 0.0_wp      !< (4) its offset: -x_left, +x_right, -d_min, +d_max
-    real(wp) :: row_restitution(n_contacts) = 1.0_wp !< (4) Newton's restitution of row k
+    ! elements: springs and dampers, each pulling its ends together with tension
+    ! k ((x_b - x_a) - rest) + c (v_b - v_a) (a ground end at x = 0)
+    integer :: n_elements = 0
+    integer, allocatable :: element_body(:, :)       !< (2, ne) ends a, b; 0 = ground
+    real(wp), allocatable :: element_k(:)            !< (ne) stiffness, N/m
+    real(wp), allocatable :: element_c(:)            !< (ne) damping, N s/m
+    real(wp), allocatable :: element_rest(:)         !< (ne) rest length of x_b - x_a, m
+    !> The elements as the two-body kernels see them (set_springs), and whether the scene
+    !> names a stiffness or a damping (present, has_spring, has_damper).
+    type(springs_type) :: springs
+    ! contacts: the records as written (docs/nbody-plan.md section 1). Record j constrains
+    ! d = x_b - x_a (a ground end is 0: x = 0) between its limits, d_min <= d <= d_max.
+    integer :: n_contacts = 0
+    integer, allocatable :: contact_body(:, :)          !< (2, nc) ends a, b; 0 = ground; acts on x_b - x_a
+    logical, allocatable :: contact_has(:, :)           !< (2, nc) lower / upper limit present
+    real(wp), allocatable :: contact_limit(:, :)        !< (2, nc) d_min, d_max on x_b - x_a (walls: positions)
+    real(wp), allocatable :: contact_restitution(:, :)  !< (2, nc) Newton's r at the lower, upper limit
+    character(len=name_len), allocatable :: contact_name(:)  !< (nc) 'left', 'right', 'slot', ...
+    ! rows: one unilateral constraint per present limit, what the engine loops over, made
+    ! from the records by set_rows in record order, lower limit first (docs/nbody-plan.md
+    ! B4: left, right, slot_min, slot_max); gap_r = row_normal(:, r) . x(row_body(:, r))
+    ! + row_offset(r) >= 0.
+    integer :: n_rows = 0
+    integer, allocatable :: row_contact(:)              !< (nr) the record it comes from
+    integer, allocatable :: row_body(:, :)              !< (2, nr) ends a, b (a = 0: ground)
+    real(wp), allocatable :: row_normal(:, :)           !< (2, nr) on x_a, x_b: lower (-1, 1), upper (1, -1);
+                                                        !< 0 on a ground end
+    real(wp), allocatable :: row_offset(:)              !< (nr) -d_min (lower) or +d_max (upper)
+    real(wp), allocatable :: row_restitution(:)         !< (nr) Newton's restitution
+    integer, allocatable :: row_partner(:)              !< (nr) the other limit of a rigid link (d_min = d_max), else 0
+    character(len=name_len), allocatable :: row_name(:) !< (nr) one limit: the record's name; two (and
+                                                        !< always the link 'slot'): <name>_min, <name>_max
     !> The bodies and rows as the two-body kernels see them (impact1d_modes' pair_type: in
     !> lanes, impact1d_lanes): with one body, padded by a phantom (unit mass, at rest, no
     !> friction, on no row) in the idle lane.
@@ -186,7 +226,7 @@ contains
     logical, intent(in) :: require_run
     type(error_type), allocatable, intent(inout) :: error
     integer :: k
-    real(wp) :: gap, scale, nrm(2, n_contacts)
+    real(wp) :: gap, scale, nrm(2, n_limits)
 
     ! Without m2 the scene has one body, and nothing may name the second.
     call require(input, [i_m1, i_x1], error)
@@ -218,7 +258,7 @@ contains
     call nonnegative(input, i_mu2, error)
     call nonnegative(input, i_zero_vel, error)
     call nonnegative(input, i_mus1, error); call nonnegative(input, i_mus2, error)
-    do k = 1, n_elements
+    do k = 1, n_tutorial_elements
       call nonnegative(input, spring_index(k), error); call nonnegative(input, spring_index(k) + 2, error)
     end do
     if (allocated(error)) return
@@ -232,7 +272,7 @@ contains
       end if
     end do
     ! A spring needs the position at which it is relaxed; a rest position needs its spring.
-    do k = 1, n_elements
+    do k = 1, n_tutorial_elements
       if (input%given(spring_index(k)) .neqv. input%given(spring_index(k) + 1)) then
         if (input%given(spring_index(k))) then
           call raise(error, status_input, trim(name_of(input, spring_index(k))) // ' is given but ' // &
@@ -278,7 +318,7 @@ contains
     ! that is positive but within a few dozen ulps of the coordinates it is measured
     ! against cannot be told from contact (case 3 moved to x = 2e14 m got an impact across
     ! its 0.5 m gap): refused, as is a friction bound mu m g that overflows.
-    do k = 1, n_contacts
+    do k = 1, n_limits
       if (.not. has_limit(input, k)) cycle
       nrm = contact_normals(input)
       gap = nrm(1, k) * input%value(i_x1) + nrm(2, k) * input%value(i_x2) + offset_of(input, k)
@@ -608,25 +648,12 @@ contains
     scene%method = 'event'
     if (len_trim(input%text(i_method)%s) > 0) scene%method = trim(input%text(i_method)%s)
     call set_bodies(input, tables, scene)
-    do k = 1, n_contacts
-      scene%row_present(k) = has_limit(input, k)
-      if (.not. scene%row_present(k)) cycle
-      ! (A limit of -0 enters as +0: snap puts a body at -offset / normal, which is then +0.)
-      scene%row_offset(k) = offset_sign(k) * (limit_value(input, k) + 0.0_wp)
-      if (input%given(limit_index(k) + 1)) scene%row_restitution(k) = input%value(limit_index(k) + 1)
-    end do
-    do k = 1, n_elements
-      if (input%given(spring_index(k))) then
-        scene%springs%k(k) = input%value(spring_index(k))
-        scene%springs%rest(k) = input%value(spring_index(k) + 1)
-      end if
-      if (input%given(spring_index(k) + 2)) scene%springs%c(k) = input%value(spring_index(k) + 2)
-    end do
-    scene%springs%has_spring = any(input%given(spring_index))
-    scene%springs%has_damper = any(input%given(spring_index + 2))
-    scene%springs%present = scene%springs%has_spring .or. scene%springs%has_damper
-    ! The lightest mass as the kernel sees it (the phantom's 1 with one body).
-    call scene%springs%set_frequency(minval(scene%pair%mass))
+    call set_contacts(input, scene)
+    call set_rows(scene, error)
+    if (allocated(error)) return
+    call set_elements(input, scene)
+    call set_springs(scene, error)
+    if (allocated(error)) return
 
     scene%t_end = input%value(i_t_end)
     scene%dt = input%value(i_dt)
@@ -674,7 +701,6 @@ contains
     scene%pair%mass(1:n) = scene%body_mass
     scene%pair%friction(1:n) = scene%body_friction
     scene%pair%static_friction(1:n) = scene%body_static
-    scene%pair%normal = contact_normals(input)
     ! Inputs of -0 enter as +0 (the limits too, in build_scene): sums over bodies and contacts
     ! drop absent terms exactly only when nothing they meet is -0, and a root formula takes
     ! the sign of a zero (docs/architecture.md, "Signed zeros").
@@ -700,6 +726,162 @@ contains
     end do
     call scene%forcing%set_varies()
   end subroutine set_bodies
+
+  !> The tutorial's walls and slot as contact records (docs/nbody-plan.md section 1): a wall
+  !> when the scene names it, the slot whenever there are two bodies (they cannot pass each
+  !> other: the meeting d_min = 0 unless d_min is given). With one body the right wall holds
+  !> body 1. A limit of -0 enters as +0 (docs/architecture.md, "Signed zeros").
+  subroutine set_contacts(input, scene)
+    type(scene_input), intent(in) :: input
+    type(scene_type), intent(inout) :: scene
+    integer :: j, k, r, nc
+    integer :: record_of(size(tutorial_records))
+    logical :: present(size(tutorial_records))
+    present = [(any([(has_limit(input, k) .and. limit_record(k) == r, k = 1, n_limits)]), &
+      r = 1, size(tutorial_records))]
+    nc = count(present)
+    call allocate_contacts(scene, nc)
+    j = 0
+    record_of = 0
+    do r = 1, size(tutorial_records)
+      if (.not. present(r)) cycle
+      j = j + 1
+      record_of(r) = j
+      scene%contact_name(j) = tutorial_records(r)
+    end do
+    if (record_of(1) > 0) scene%contact_body(:, record_of(1)) = [0, 1]
+    if (record_of(2) > 0) scene%contact_body(:, record_of(2)) = [0, scene%n_bodies]
+    if (record_of(3) > 0) scene%contact_body(:, record_of(3)) = [1, 2]
+    do k = 1, n_limits
+      if (.not. has_limit(input, k)) cycle
+      associate (e => limit_end(k), j => record_of(limit_record(k)))
+        scene%contact_has(e, j) = .true.
+        scene%contact_limit(e, j) = limit_value(input, k) + 0.0_wp
+        scene%contact_restitution(e, j) = value_or(input, limit_index(k) + 1, 1.0_wp)
+      end associate
+    end do
+  end subroutine set_contacts
+
+  !> The tutorial's springs and dampers as element records, in the order k1, k2, k12 (the
+  !> order of the sums, docs/nbody-plan.md B5): one where the scene names its stiffness or
+  !> its damping (a damper alone has k = 0, rest 0). Which of them the scene names sets the
+  !> output's PE and damping_loss columns (springs%has_spring, has_damper).
+  subroutine set_elements(input, scene)
+    type(scene_input), intent(in) :: input
+    type(scene_type), intent(inout) :: scene
+    integer :: j, k, ne
+    logical :: named(n_tutorial_elements)
+    named = input%given(spring_index) .or. input%given(spring_index + 2)
+    ne = count(named)
+    scene%n_elements = ne
+    allocate(scene%element_body(2, ne), scene%element_k(ne), scene%element_c(ne), scene%element_rest(ne))
+    scene%element_k = 0.0_wp
+    scene%element_c = 0.0_wp
+    scene%element_rest = 0.0_wp
+    j = 0
+    do k = 1, n_tutorial_elements
+      if (.not. named(k)) cycle
+      j = j + 1
+      scene%element_body(:, j) = tutorial_element_body(:, k)
+      if (input%given(spring_index(k))) then
+        scene%element_k(j) = input%value(spring_index(k))
+        scene%element_rest(j) = input%value(spring_index(k) + 1)
+      end if
+      if (input%given(spring_index(k) + 2)) scene%element_c(j) = input%value(spring_index(k) + 2)
+    end do
+    scene%springs%has_spring = any(input%given(spring_index))
+    scene%springs%has_damper = any(input%given(spring_index + 2))
+  end subroutine set_elements
+
+  !> The element records as the two-body kernels see them (their ends as lanes: body i is
+  !> lane i, the ground 0), and the rate bound that samples their motion.
+  subroutine set_springs(scene, error)
+    type(scene_type), intent(inout) :: scene
+    type(error_type), allocatable, intent(inout) :: error
+    integer :: ne
+    ne = scene%n_elements
+    if (ne > pair_elements) then
+      call raise(error, status_input, 'the scene has ' // trim(fmt(ne)) // ' springs and dampers: a scene ' // &
+        'of one or two bodies has at most ' // trim(fmt(pair_elements)) // ' (the two-body kernels'' elements)')
+      return
+    end if
+    scene%springs%n = ne
+    scene%springs%body(:, :ne) = scene%element_body
+    scene%springs%k(:ne) = scene%element_k
+    scene%springs%c(:ne) = scene%element_c
+    scene%springs%rest(:ne) = scene%element_rest
+    call scene%springs%set_normals()
+    scene%springs%present = ne > 0
+    ! The lightest mass as the kernel sees it (the phantom's 1 with one body).
+    call scene%springs%set_frequency(minval(scene%pair%mass))
+  end subroutine set_springs
+
+  !> Room for nc contact records, none of their limits present yet.
+  subroutine allocate_contacts(scene, nc)
+    type(scene_type), intent(inout) :: scene
+    integer, intent(in) :: nc
+    scene%n_contacts = nc
+    allocate(scene%contact_body(2, nc), scene%contact_has(2, nc), scene%contact_limit(2, nc), &
+      scene%contact_restitution(2, nc), scene%contact_name(nc))
+    scene%contact_body = 0
+    scene%contact_has = .false.
+    scene%contact_limit = 0.0_wp
+    scene%contact_restitution = 1.0_wp
+    scene%contact_name = ''
+  end subroutine allocate_contacts
+
+  !> The rows from the contact records: one per present limit, in record order, the lower
+  !> limit first (the row order decides ties, docs/nbody-plan.md B4). A lower limit's gap
+  !> is (x_b - x_a) - d_min, an upper one's d_max - (x_b - x_a); a ground end has no
+  !> coefficient. The two limits of a rigid link (d_min = d_max) are each other's partner.
+  subroutine set_rows(scene, error)
+    type(scene_type), intent(inout) :: scene
+    type(error_type), allocatable, intent(inout) :: error
+    integer :: j, e, r, nr
+    real(wp) :: sgn
+    logical :: suffix
+    nr = count(scene%contact_has)
+    if (nr > pair_rows) then
+      call raise(error, status_input, 'the contacts have ' // trim(fmt(nr)) // ' limits: a scene of one or ' // &
+        'two bodies has at most ' // trim(fmt(pair_rows)) // ' (the two-body kernels'' rows)')
+      return
+    end if
+    scene%n_rows = nr
+    allocate(scene%row_contact(nr), scene%row_body(2, nr), scene%row_normal(2, nr), scene%row_offset(nr), &
+      scene%row_restitution(nr), scene%row_partner(nr), scene%row_name(nr))
+    scene%row_partner = 0
+    r = 0
+    do j = 1, scene%n_contacts
+      suffix = all(scene%contact_has(:, j)) .or. scene%contact_name(j) == 'slot'
+      do e = 1, 2
+        if (.not. scene%contact_has(e, j)) cycle
+        r = r + 1
+        sgn = merge(1.0_wp, -1.0_wp, e == 1)
+        scene%row_contact(r) = j
+        scene%row_body(:, r) = scene%contact_body(:, j)
+        scene%row_normal(:, r) = merge([-sgn, sgn], [0.0_wp, 0.0_wp], scene%contact_body(:, j) /= 0)
+        scene%row_offset(r) = -sgn * scene%contact_limit(e, j)
+        scene%row_restitution(r) = scene%contact_restitution(e, j)
+        scene%row_name(r) = scene%contact_name(j)
+        if (suffix) scene%row_name(r) = trim(scene%contact_name(j)) // trim(merge('_min', '_max', e == 1))
+      end do
+      if (all(scene%contact_has(:, j))) then
+        if (scene%contact_limit(1, j) == scene%contact_limit(2, j)) then
+          scene%row_partner(r - 1) = r
+          scene%row_partner(r) = r - 1
+        end if
+      end if
+    end do
+    ! The kernels' view: each row's coefficients on the pair's lanes (body i in lane i).
+    scene%pair%n_rows = nr
+    scene%pair%normal = 0.0_wp
+    do r = 1, nr
+      do e = 1, 2
+        if (scene%row_body(e, r) > 0) scene%pair%normal(scene%row_body(e, r), r) = scene%row_normal(e, r)
+      end do
+    end do
+  end subroutine set_rows
+
 
   !> RK4's step against the modes of the springs and dampers (impact1d_stability): past the
   !> largest stable step the numbers would be garbage (positions to 1e76 with a normal exit),
@@ -776,23 +958,31 @@ contains
   end function mode_text
 
   !> The spring or damper with the fastest rate of its own ('k12 = 1e4'): sqrt(k / m) or c / m
-  !> with m the mass it moves (the reduced mass between the bodies; the pair's masses as the
-  !> mode kernel sees them).
+  !> with m the mass it moves (the body's on a ground element, the reduced mass between
+  !> bodies; the pair's masses as the mode kernel sees them). Named as the tutorial names
+  !> it: k<b> or c<b> to the ground, k<a><b> or c<a><b> between bodies.
   pure function fastest_element(scene) result(text)
     type(scene_type), intent(in) :: scene
     character(len=fmt_width + 24) :: text     ! blank padded: callers trim
-    real(wp) :: mass(n_elements), rate(2 * n_elements)
-    integer :: j
-    associate (m => scene%pair%mass)
-      mass = [m(1), m(2), 1.0_wp / (1.0_wp / m(1) + 1.0_wp / m(2))]
-    end associate
-    rate = [sqrt(scene%springs%k / mass), scene%springs%c / mass]
+    real(wp) :: mass(scene%n_elements), rate(2 * scene%n_elements)
+    character(len=8) :: ends
+    integer :: j, ne
+    ne = scene%n_elements
+    do j = 1, ne
+      associate (m => scene%pair%mass, a => scene%element_body(1, j), b => scene%element_body(2, j))
+        mass(j) = m(b)
+        if (a > 0) mass(j) = 1.0_wp / (1.0_wp / m(a) + 1.0_wp / m(b))
+      end associate
+    end do
+    rate = [sqrt(scene%element_k / mass), scene%element_c / mass]
     j = maxloc(rate, 1)
-    if (j <= n_elements) then
-      text = trim(real_names(spring_index(j))) // ' = ' // trim(fmt(scene%springs%k(j)))
+    if (j > ne) j = j - ne
+    write(ends, '(i0)') scene%element_body(2, j)
+    if (scene%element_body(1, j) > 0) write(ends, '(i0, i0)') scene%element_body(:, j)
+    if (maxloc(rate, 1) <= ne) then
+      text = 'k' // trim(ends) // ' = ' // trim(fmt(scene%element_k(j)))
     else
-      text = trim(real_names(spring_index(j - n_elements) + 2)) // ' = ' // &
-        trim(fmt(scene%springs%c(j - n_elements)))
+      text = 'c' // trim(ends) // ' = ' // trim(fmt(scene%element_c(j)))
     end if
   end function fastest_element
 
@@ -848,7 +1038,7 @@ contains
   !> The contacts' normals: with one body (no m2) both walls hold body 1.
   pure function contact_normals(input) result(nrm)
     type(scene_input), intent(in) :: input
-    real(wp) :: nrm(2, n_contacts)
+    real(wp) :: nrm(2, n_limits)
     nrm = two_body_normal
     if (.not. input%given(i_m2)) nrm = one_body_normal
   end function contact_normals
@@ -864,14 +1054,14 @@ contains
   !> Index of the variable that names constraint k (its limit); the restitution follows it.
   pure integer function limit_index(k)
     integer, intent(in) :: k
-    integer, parameter :: indices(n_contacts) = [i_x_left, i_x_right, i_d_min, i_d_max]
+    integer, parameter :: indices(n_limits) = [i_x_left, i_x_right, i_d_min, i_d_max]
     limit_index = indices(k)
   end function limit_index
 
   !> gap = normal . x + offset_sign * limit (left: x1 - x_left; right: x_right - x2; ...).
   pure real(wp) function offset_sign(k)
     integer, intent(in) :: k
-    real(wp), parameter :: signs(n_contacts) = [-1.0_wp, 1.0_wp, -1.0_wp, 1.0_wp]
+    real(wp), parameter :: signs(n_limits) = [-1.0_wp, 1.0_wp, -1.0_wp, 1.0_wp]
     offset_sign = signs(k)
   end function offset_sign
 end module impact1d_scene

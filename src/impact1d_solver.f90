@@ -9,10 +9,10 @@ module impact1d_solver
   use, intrinsic :: iso_fortran_env, only: int64
   use impact1d_kinds, only: wp
   use impact1d_error, only: error_type, raise, status_simulation, fmt
-  use impact1d_scene, only: scene_type, n_contacts, sample_time
+  use impact1d_scene, only: scene_type, sample_time
   use impact1d_modes, only: mode_type
   use impact1d_impacts, only: normal_velocity, kinetic_energy
-  use impact1d_output, only: sink_type, run_stats, emit_sample, checkpoint
+  use impact1d_output, only: sink_type, run_stats, emit_sample, checkpoint, start_counts
   use impact1d_vissim, only: run_vissim
   use impact1d_interrupt, only: interrupt_count
   use impact1d_state, only: state_type, lane_state_type, load_lanes, new_state, renormalise, &
@@ -20,7 +20,7 @@ module impact1d_solver
   use impact1d_lanes, only: max_lanes, to_lanes
   use impact1d_contacts, only: gap, gap_tolerance, u_tolerance
   use impact1d_stepping, only: rk4_type, book_constant_ledger, books_ledger
-  use impact1d_location, only: watch_type, refine, constraints_hold
+  use impact1d_location, only: watch_type, refine, constraints_hold, located_type, located_row
   use impact1d_event_log, only: event_log_type
   use impact1d_event_point, only: event_point
   implicit none
@@ -59,9 +59,13 @@ contains
     type(stops_type) :: stops
     real(wp) :: ke0, pe0, t_stop, window_start, x0(max_lanes)
     logical :: located, at_stop, glided, event_due
-    integer :: watched, window_events
+    type(located_type) :: watched
+    integer :: window_events
 
     stats%interrupt_epoch = interrupt_count()
+    ! What the sink calls the events on each row; nothing counted yet.
+    sink%row_names = scene%row_name
+    call start_counts(stats, scene%n_rows, scene%n_bodies)
     ! The stepping kernels take the bodies in lanes (impact1d_lanes); scenes have no more
     ! bodies than that until the cluster solver (issue 19, stage 4).
     if (scene%n_bodies > max_lanes) then
@@ -75,12 +79,13 @@ contains
     end if
     ! Springs and dampers make the forces depend on the state: no closed forms then.
     rk%polynomial_forcing = scene%forcing%is_polynomial() .and. .not. scene%springs%present
+    rk%bulk_steps => constant_steps
     rk%constant_forcing = .not. (any(scene%forcing%has_table) .or. any(scene%forcing%has_sine) .or. &
       scene%springs%present)
     ! Every array of the run, once: nothing allocates per step.
     call new_state(scene%n_bodies, s0)
     allocate(watch%quiet_body(scene%n_bodies))
-    call event_log%allocate_bodies(scene%n_bodies)
+    call event_log%allocate_log(scene%n_rows, scene%n_bodies)
     s0%x(:) = scene%body_x0
     s0%v(:) = scene%body_v0
     ke0 = kinetic_energy(scene, s0%v)
@@ -91,7 +96,7 @@ contains
     window_events = 0
     window_start = 0.0_wp
 
-    call event_point(scene, .true., 0, s, mode, event_log, watch, rk, sink, stats, error)
+    call event_point(scene, .true., located_type(), s, mode, event_log, watch, rk, sink, stats, error)
     if (allocated(error)) return
     call emit(scene, s, ke0, pe0, stops%j_sample, sink, stats, error)
     if (allocated(error)) return
@@ -141,9 +146,9 @@ contains
           return
         end if
         call event_log%flush_releases(scene, s%t, .false., sink, stats)
-        call event_log%flush_pending_rest(s%t, s%v(:scene%n_bodies), sink, stats)
+        call event_log%flush_pending_rest(scene, s%t, s%v(:scene%n_bodies), sink, stats)
         ! The event point: impacts, rest, the new mode, the log.
-        call event_point(scene, .false., merge(watched, 0, located), s, mode, event_log, watch, rk, &
+        call event_point(scene, .false., merge(watched, located_type(), located), s, mode, event_log, watch, rk, &
           sink, stats, error)
         if (allocated(error)) return
       end if
@@ -186,7 +191,7 @@ contains
     type(lane_state_type), intent(inout) :: s
     type(lane_state_type), intent(inout) :: trial   !< scratch: the step's end (inout: no default init)
     logical, intent(out) :: located, at_stop
-    integer, intent(out) :: watched
+    type(located_type), intent(out) :: watched
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
     type(error_type), allocatable, intent(inout) :: error
@@ -197,7 +202,7 @@ contains
     halvings = 0
     do
       located = .false.
-      watched = 0
+      watched = located_type()
       ! An event that landed exactly on the stop leaves nothing to step.
       if (h <= 0.0_wp) then
         trial = s
@@ -219,7 +224,7 @@ contains
       ! Under polynomial forcing the dense output is exact and nothing can be missed; only
       ! a sine's approximate dense output needs the step's end checked.
       if (rk%polynomial_forcing) exit
-      if (constraints_hold(scene, mode, s, trial, merge(watched, 0, located))) exit
+      if (constraints_hold(scene, mode, s, trial, merge(watched%index, 0, located .and. watched%kind == located_row))) exit
       halvings = halvings + 1
       if (halvings > max_halvings) then
         call raise(error, status_simulation, 'at t = ' // trim(fmt(s%t)) // &
@@ -377,7 +382,7 @@ contains
     left = n_bulk
     do while (left > 0)
       n = min(left, 4096_int64 - iand(stats%steps, 4095_int64))
-      call constant_steps(n, h, dv, half_dv, t, t_lo, x, x_lo, v, v_lo)
+      call rk%bulk_steps(n, h, dv, half_dv, t, t_lo, x, x_lo, v, v_lo)
       left = left - n
       stats%steps = stats%steps + n
       if (iand(stats%steps, 4095_int64) == 0) then
@@ -483,8 +488,8 @@ contains
     integer :: k
     real(wp), parameter :: no_scale(max_lanes) = 0.0_wp
     impact_due = .false.
-    do k = 1, n_contacts
-      if (.not. scene%row_present(k) .or. mode%active(k)) cycle
+    do k = 1, scene%n_rows
+      if (mode%active(k)) cycle
       if (gap(scene, k, s) <= gap_tolerance(scene, k, s, 0.0_wp) .and. &
           normal_velocity(scene, k, s%v) < -u_tolerance(scene, mode, s, k, no_scale)) impact_due = .true.
     end do

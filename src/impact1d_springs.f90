@@ -1,26 +1,35 @@
-!> Linear springs and viscous dampers (docs/method.md, "Springs and dampers"): body 1 to the
-!> ground, body 2 to the ground, and between the bodies along x2 - x1. Each element is
-!> present only when the scene names it; a scene that names none has springs%present false
-!> and the solver never calls this module.
-!> A kernel of the pair, in lanes (impact1d_lanes): the three elements of two bodies written
-!> out, so that the stepping loop computes them without a branch or an index. A one-body
-!> scene has k1 alone (k2 and k12 are 0; its body 2 is the idle lane at 0).
+!> Linear springs and viscous dampers (docs/method.md, "Springs and dampers"): elements
+!> between two ends, a body or the ground, each pulling its ends together with tension
+!> k ((x_b - x_a) - rest) + c (v_b - v_a). A scene that names none has springs%present
+!> false and the solver never calls this module.
+!> A kernel of the pair, in lanes (impact1d_lanes): the model's element records
+!> (scene_type's element_*) as the kernel sees them, their ends as lanes (0: the ground, at
+!> x = 0). Sums run over the elements in record order from +0 (k1, k2, k12 for the tutorial's
+!> scenes: docs/nbody-plan.md B5), which gives today's per-body forces up to the sign of a
+!> zero that every consumer discards.
 module impact1d_springs
   use impact1d_kinds, only: wp
   use impact1d_lanes, only: max_lanes
   implicit none
   private
-  public :: springs_type, n_elements
+  public :: springs_type, pair_elements
 
-  !> Elements: 1 body 1 to the ground, 2 body 2 to the ground, 3 between the bodies.
-  integer, parameter :: n_elements = 3
+  !> Elements a unit of two bodies can have: the tutorial's three (each body to the ground,
+  !> and between them) and room for more records on the pair (issue 19, stage 3).
+  integer, parameter :: pair_elements = 8
 
   type :: springs_type
     logical :: present = .false.                  !< any stiffness or damping named
+    !> The scene names a stiffness / a damping (its output has the PE / damping_loss column).
     logical :: has_spring = .false., has_damper = .false.
-    real(wp) :: k(n_elements) = 0.0_wp            !< (3) stiffness, N/m
-    real(wp) :: rest(n_elements) = 0.0_wp         !< (3) x1_rest, x2_rest, d_rest
-    real(wp) :: c(n_elements) = 0.0_wp            !< (3) damping, N s/m
+    integer :: n = 0                              !< elements (<= pair_elements)
+    integer :: body(2, pair_elements) = 0         !< ends a, b as lanes; 0 = the ground
+    !> (max_lanes, pair_elements) each element's coefficients on the lanes: -1 on end a, +1 on
+    !> end b (set_normals)
+    real(wp) :: normal(max_lanes, pair_elements) = 0.0_wp
+    real(wp) :: k(pair_elements) = 0.0_wp         !< stiffness, N/m
+    real(wp) :: rest(pair_elements) = 0.0_wp      !< rest length of x_b - x_a, m
+    real(wp) :: c(pair_elements) = 0.0_wp         !< damping, N s/m
     !> An upper bound of the fastest rate in the motion (rad/s), set once (set_frequency).
     real(wp) :: omega = 0.0_wp
   contains
@@ -30,42 +39,46 @@ module impact1d_springs
     procedure :: damping_power
     procedure :: set_frequency
     procedure :: linear_part
+    procedure :: set_normals
   end type springs_type
 
 contains
 
-  !> Elongations of the three springs for positions x + dx (lanes): dx carries the low parts
-  !> of compensated positions (and a stage's displacement), added after the large terms cancel.
-  pure subroutine elongation(self, x, dx, e)
+  !> Element j's elongation for positions x + dx (lanes): dx carries the low parts of
+  !> compensated positions (and a stage's displacement), added after the large terms cancel.
+  !> On its lane coefficients (normal: -1 on end a, +1 on end b, 0 on the ground or an idle
+  !> lane), x_b - x_a = n . x exactly; a ground element's (x_b + 0) - rest is x_b - rest up
+  !> to the sign of a zero.
+  pure real(wp) function elongation(self, j, x, dx) result(e)
     class(springs_type), intent(in) :: self
+    integer, intent(in) :: j
     real(wp), intent(in) :: x(max_lanes), dx(max_lanes)
-    real(wp), intent(out) :: e(n_elements)
-    e(1) = (x(1) - self%rest(1)) + dx(1)
-    e(2) = (x(2) - self%rest(2)) + dx(2)
-    e(3) = ((x(2) - x(1)) - self%rest(3)) + (dx(2) - dx(1))
-  end subroutine elongation
+    e = (along(self%normal(:, j), x) - self%rest(j)) + along(self%normal(:, j), dx)
+  end function elongation
 
-  !> Rates of the three elongations (lanes).
-  pure subroutine elongation_rate(v, r)
-    real(wp), intent(in) :: v(max_lanes)
-    real(wp), intent(out) :: r(n_elements)
-    r(1) = v(1)
-    r(2) = v(2)
-    r(3) = v(2) - v(1)
-  end subroutine elongation_rate
+  !> n . y on the two lanes, lane 1's term first.
+  pure real(wp) function along(n, y)
+    real(wp), intent(in) :: n(max_lanes), y(max_lanes)
+    along = n(1) * y(1) + n(2) * y(2)
+  end function along
 
-  !> f += the forces on the bodies at positions x + dx and velocities v.
+  !> f += the forces on the bodies at positions x + dx and velocities v: each element pulls
+  !> its ends together with its tension t (+t on end a, -t on end b), each body's pulls summed
+  !> from +0 in record order and then added to f. In lanes, with no index per end: this is
+  !> the spring step's inner loop (five calls a step), and on ends looked up by index it took
+  !> 17% longer (stores and loads through memory).
   pure subroutine add_force(self, x, dx, v, f)
     class(springs_type), intent(in) :: self
     real(wp), dimension(max_lanes), intent(in) :: x, dx, v
     real(wp), intent(inout) :: f(max_lanes)
-    real(wp) :: e(n_elements), r(n_elements), tension(n_elements)
-    call elongation(self, x, dx, e)
-    call elongation_rate(v, r)
-    ! Tension of each element: what it pulls its ends together with.
-    tension = self%k * e + self%c * r
-    f(1) = f(1) + (-tension(1) + tension(3))
-    f(2) = f(2) + (-tension(2) - tension(3))
+    real(wp) :: pulls(max_lanes), tension
+    integer :: j
+    pulls = 0.0_wp
+    do j = 1, self%n
+      tension = self%k(j) * elongation(self, j, x, dx) + self%c(j) * along(self%normal(:, j), v)
+      pulls = pulls - self%normal(:, j) * tension
+    end do
+    f = f + pulls
   end subroutine add_force
 
   !> df += the rate of the spring forces at velocities v (the dampers' part needs the
@@ -74,62 +87,102 @@ contains
     class(springs_type), intent(in) :: self
     real(wp), intent(in) :: v(max_lanes)
     real(wp), intent(inout) :: df(max_lanes)
-    real(wp) :: r(n_elements), rate(n_elements)
-    call elongation_rate(v, r)
-    rate = self%k * r
-    df(1) = df(1) + (-rate(1) + rate(3))
-    df(2) = df(2) + (-rate(2) - rate(3))
+    real(wp) :: pulls(max_lanes)
+    integer :: j
+    pulls = 0.0_wp
+    do j = 1, self%n
+      pulls = pulls - self%normal(:, j) * (self%k(j) * along(self%normal(:, j), v))
+    end do
+    df = df + pulls
   end subroutine add_force_rate
 
   !> Potential energy stored in the springs at positions x + dx.
   pure real(wp) function potential(self, x, dx)
     class(springs_type), intent(in) :: self
     real(wp), dimension(max_lanes), intent(in) :: x, dx
-    real(wp) :: e(n_elements)
-    call elongation(self, x, dx, e)
-    potential = 0.5_wp * sum(self%k * e**2)
+    integer :: j
+    potential = 0.0_wp
+    do j = 1, self%n
+      potential = potential + self%k(j) * elongation(self, j, x, dx)**2
+    end do
+    potential = 0.5_wp * potential
   end function potential
 
   !> Power the dampers dissipate at velocities v.
   pure real(wp) function damping_power(self, v)
     class(springs_type), intent(in) :: self
     real(wp), intent(in) :: v(max_lanes)
-    real(wp) :: r(n_elements)
-    call elongation_rate(v, r)
-    damping_power = sum(self%c * r**2)
+    integer :: j
+    damping_power = 0.0_wp
+    do j = 1, self%n
+      damping_power = damping_power + self%c(j) * along(self%normal(:, j), v)**2
+    end do
   end function damping_power
 
   !> omega: the stiffest natural frequency and the fastest damping rate over the lightest
-  !> mass (min_mass). Steps sample the mode's conditions at least 16 times per 2 pi of it.
+  !> mass (min_mass): an element between bodies counts twice (it pulls on both). Steps
+  !> sample the mode's conditions at least 16 times per 2 pi of it.
   pure subroutine set_frequency(self, min_mass)
     class(springs_type), intent(inout) :: self
     real(wp), intent(in) :: min_mass
-    real(wp) :: stiffness, damping
-    stiffness = self%k(1) + self%k(2) + 2.0_wp * self%k(3)
-    damping = self%c(1) + self%c(2) + 2.0_wp * self%c(3)
+    real(wp) :: stiffness, damping, weight
+    integer :: j
+    stiffness = 0.0_wp
+    damping = 0.0_wp
+    do j = 1, self%n
+      weight = merge(1.0_wp, 2.0_wp, self%body(1, j) == 0)
+      stiffness = stiffness + weight * self%k(j)
+      damping = damping + weight * self%c(j)
+    end do
     self%omega = sqrt(stiffness / min_mass) + damping / min_mass
   end subroutine set_frequency
 
-  !> Stiffness and damping matrices (K, C in M x'' + C x' + K x = f) of n bodies (1 or 2:
-  !> a one-body scene has no body-2 or link element).
+  !> The elements' lane coefficients from their ends (body).
+  pure subroutine set_normals(self)
+    class(springs_type), intent(inout) :: self
+    integer :: j
+    self%normal = 0.0_wp
+    do j = 1, self%n
+      if (self%body(1, j) > 0) self%normal(self%body(1, j), j) = -1.0_wp
+      self%normal(self%body(2, j), j) = 1.0_wp
+    end do
+  end subroutine set_normals
+
+  !> Stiffness and damping matrices (K, C in M x'' + C x' + K x = f) of n bodies.
   pure subroutine linear_part(self, n, k, c)
     class(springs_type), intent(in) :: self
     integer, intent(in) :: n
     real(wp), intent(out) :: k(n, n), c(n, n)
-    call assemble(self%k, k)
-    call assemble(self%c, c)
+    call assemble(self, self%k, k)
+    call assemble(self, self%c, c)
   end subroutine linear_part
 
-  !> The matrix of the three elements' coefficients (to the ground, to the ground, between).
-  pure subroutine assemble(coefficient, matrix)
-    real(wp), intent(in) :: coefficient(n_elements)
+  !> The matrix of the elements' coefficients: each adds its coefficient to its bodies'
+  !> diagonal entries and takes it from their shared off-diagonal ones, in record order.
+  !> (An off-diagonal entry is set, not summed from +0: a link of coefficient 0 gives -0 there,
+  !> as the matrix written out for the tutorial's elements did.)
+  pure subroutine assemble(self, coefficient, matrix)
+    class(springs_type), intent(in) :: self
+    real(wp), intent(in) :: coefficient(pair_elements)
     real(wp), intent(out) :: matrix(:, :)
+    integer :: j
+    logical :: coupled(size(matrix, 1), size(matrix, 1))
     matrix = 0.0_wp
-    matrix(1, 1) = coefficient(1)
-    if (size(matrix, 1) == 1) return
-    matrix(2, 2) = coefficient(2) + coefficient(3)
-    matrix(1, 1) = matrix(1, 1) + coefficient(3)
-    matrix(1, 2) = -coefficient(3)
-    matrix(2, 1) = -coefficient(3)
+    coupled = .false.
+    do j = 1, self%n
+      associate (a => self%body(1, j), b => self%body(2, j))
+        matrix(b, b) = matrix(b, b) + coefficient(j)
+        if (a == 0) cycle
+        matrix(a, a) = matrix(a, a) + coefficient(j)
+        if (coupled(a, b)) then
+          matrix(a, b) = matrix(b, a) - coefficient(j)
+        else
+          matrix(a, b) = -coefficient(j)
+        end if
+        matrix(b, a) = matrix(a, b)
+        coupled(a, b) = .true.
+        coupled(b, a) = .true.
+      end associate
+    end do
   end subroutine assemble
 end module impact1d_springs

@@ -12,10 +12,10 @@ module impact1d_vissim
   use impact1d_kinds, only: wp
   use impact1d_lanes, only: max_lanes, to_lanes
   use impact1d_error, only: error_type, raise, status_simulation, fmt
-  use impact1d_scene, only: scene_type, n_contacts, i_left, i_right, i_slot_min, i_slot_max, &
-    sample_time
+  use impact1d_scene, only: scene_type, sample_time
+  use impact1d_modes, only: pair_rows
   use impact1d_impacts, only: impulse, kinetic_energy
-  use impact1d_output, only: sink_type, run_stats, emit_sample, event_impact, checkpoint
+  use impact1d_output, only: sink_type, run_stats, emit_sample, class_impact, checkpoint
   use impact1d_event_log, only: log_event
   use impact1d_loads, only: applied_force
   implicit none
@@ -31,10 +31,22 @@ contains
     type(error_type), allocatable, intent(out) :: error
     real(wp), dimension(max_lanes) :: x, v, v_prev, x_new, v_new, v_hit
     real(wp) :: t, work, friction_loss, impact_loss
-    real(wp) :: ke0, pe0, h, t_sample, gap_before(n_contacts), dwork, dfriction
+    real(wp) :: ke0, pe0, h, t_sample, gap_before(pair_rows), dwork, dfriction
     real(wp) :: damping_loss, ddamping
-    integer :: j_sample, k
-    integer, parameter :: slot_first(n_contacts) = [i_slot_min, i_slot_max, i_left, i_right]
+    integer :: j_sample, k, n_order, order(pair_rows)
+
+    ! Collisions are taken rows between the bodies first, then ground rows on what they left.
+    n_order = 0
+    do k = 1, scene%n_rows
+      if (scene%row_body(1, k) == 0) cycle
+      n_order = n_order + 1
+      order(n_order) = k
+    end do
+    do k = 1, scene%n_rows
+      if (scene%row_body(1, k) /= 0) cycle
+      n_order = n_order + 1
+      order(n_order) = k
+    end do
 
     ! v is the velocity integrator's state; the diagram passes it through the zero-velocity
     ! threshold before anything uses it (Figure 13), so what moves the bodies is threshold(v).
@@ -55,7 +67,9 @@ contains
       h = min(scene%dt, t_sample - t)
       if (t_sample - t - h <= 1.0e-9_wp * scene%dt) h = t_sample - t
       v_prev = v
-      gap_before = [(gap(k, x), k = 1, n_contacts)]
+      do k = 1, scene%n_rows
+        gap_before(k) = gap(k, x)
+      end do
       call rk4(t, x, v, h, x_new, v_new, dwork, dfriction, ddamping)
       t = t + h
       if (t_sample - t <= 1.0e-9_wp * scene%dt) t = t_sample
@@ -74,23 +88,18 @@ contains
         return
       end if
       ! Collisions seen at the step's end: the slot's first, then the walls on what it left.
-      do k = 1, n_contacts
-        associate (c => slot_first(k))
-          if (.not. scene%row_present(c)) cycle
+      do k = 1, n_order
+        associate (c => order(k))
           if (.not. (gap_before(c) >= 0.0_wp .and. gap(c, x) < 0.0_wp)) cycle
           v_hit = threshold(v)
           ! A wall clamps the body it faces: normal . x + offset = 0.
-          if (c == i_left .or. c == i_right) then
-            associate (i => merge(1, 2, scene%pair%normal(1, c) /= 0.0_wp))
-              x(i) = -scene%row_offset(c) / scene%pair%normal(i, c)
-            end associate
-          end if
+          if (scene%row_body(1, c) == 0) x(scene%row_body(2, c)) = -scene%row_offset(c) / scene%row_normal(2, c)
           call impulse(scene, c, scene%row_restitution(c), threshold(v_prev), v_new)
           where (scene%pair%normal(:, c) == 0.0_wp) v_new = v
           impact_loss = impact_loss + kinetic_energy(scene, threshold(v)) - kinetic_energy(scene, threshold(v_new))
           v = v_new
           v_prev = v
-          call log_event(sink, stats, t, event_impact + c, v_hit, threshold(v))
+          call log_event(scene, sink, stats, t, class_impact, c, v_hit, threshold(v))
         end associate
       end do
       if (t == t_sample) then

@@ -286,14 +286,23 @@ def test_flat_simulate_says_what_room_it_needs():
     scene = impact1d.load_scene(INPUT / "case5.nml")
     expected = impact1d.simulate(scene)
     core = to_core(scene)
-    for rows, events in ((3, 2000), (len(expected.t) + 1, 2)):
-        out = _api.simulate(*core, 0, rows, len(COLUMNS), events)
-        status, n_samples, n_events = int(out[-3]), int(out[5]), int(out[6])
+    # (case 5 has the walls and both slot limits: four rows)
+    for rows, events, contact_rows in ((3, 2000, 8), (len(expected.t) + 1, 2, 8), (len(expected.t) + 1, 2000, 1)):
+        out = _api.simulate(*core, 0, rows, len(COLUMNS), events, contact_rows)
+        status, n_samples, n_events, n_rows = int(out[-3]), int(out[8]), int(out[9]), int(out[10])
         assert status == 3
-        assert (n_samples, n_events) == (len(expected.t), len(expected.events))
-    samples, has_column, *_, status, message, _warnings = _api.simulate(
-        *core, 0, n_samples, len(COLUMNS), n_events)
+        assert (n_samples, n_events, n_rows) == (len(expected.t), len(expected.events), 4)
+    (samples, has_column, event_t, event_class, event_index, event_ends, event_v, row_name_codes,
+     *_, status, message, _warnings) = _api.simulate(*core, 0, n_samples, len(COLUMNS), n_events, n_rows)
     assert int(status) == 0
+    row_names = ["".join(map(chr, row_name_codes[:, k])).strip() for k in range(n_rows)]
+    assert row_names == ["left", "right", "slot_min", "slot_max"]
+    # Events are (class, row or body) reporting bodies (1, 2); Python names them.
+    assert set(event_class) <= {1, 2, 3, 4, 5} and (event_ends == [[1], [2]]).all()
+    assert list(expected.events["kind"][:3]) == [
+        ("", "rest_", "release_")[c - 1] + row_names[i - 1] if c <= 3 else ("stick", "slip")[c - 4] + str(i)
+        for c, i in zip(event_class[:3], event_index[:3])]
+    np.testing.assert_array_equal(event_v[0], expected.events["v1_before"])
     present = [name for name, flag in zip(COLUMNS, has_column) if flag]
     assert present == list(expected.columns)
     for k, name in enumerate(present):

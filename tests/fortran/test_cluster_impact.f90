@@ -7,6 +7,7 @@ program test_cluster_impact
   use impact1d_kinds, only: wp
   use impact1d_scene, only: scene_type
   use impact1d_impacts, only: inelastic_projection
+  use impact1d_modes, only: pair_rows
   use impact1d_lcp, only: lcp_solved
   use impact1d_clusters, only: row_rate
   use impact1d_cluster_impact, only: impact_work_type, impact_reserve, cluster_projection
@@ -39,7 +40,8 @@ contains
   subroutine against_two_body()
     type(scene_type) :: scene
     real(wp) :: u(8), v(2), mine(2), theirs(2), impulse(4), worst
-    logical :: closed(4), pushed(4), their_pushed(4)
+    logical :: closed(4), pushed(4), their_pushed(4), closed_rows(pair_rows), pushed_rows(pair_rows)
+    real(wp) :: rounding_rows(pair_rows)
     character(len=200) :: assignments
     integer :: trial, status, failed, strict, same
     ! The engine's rounding level of a normal velocity of about 10 m/s (64 ulps of it): with
@@ -56,7 +58,13 @@ contains
       call two_body(trim(assignments), scene)
       v = 10.0_wp * u(3:4) - 5.0_wp
       closed = u(5:8) < 0.6_wp
-      call inelastic_projection(scene, closed, v, u_rounding, theirs, their_pushed)
+      ! inelastic_projection's arrays are pair_rows long: the scene's four rows first.
+      closed_rows = .false.
+      closed_rows(1:4) = closed
+      rounding_rows = 0.0_wp
+      rounding_rows(1:4) = u_rounding
+      call inelastic_projection(scene, closed_rows, v, rounding_rows, theirs, pushed_rows)
+      their_pushed = pushed_rows(1:4)
       call cluster_projection(work, scene%pair%mass, v, pair_body, pair_normal, closed, u_rounding, mine, impulse, &
         pushed, status)
       if (status /= lcp_solved) failed = failed + 1

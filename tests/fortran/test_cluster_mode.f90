@@ -5,7 +5,7 @@
 !> random chains of 3 to 8 bodies checked against the conditions that define a mode.
 program test_cluster_mode
   use impact1d_kinds, only: wp
-  use impact1d_modes, only: mode_type, pair_type, solve_mode
+  use impact1d_modes, only: mode_type, pair_type, solve_mode, pair_rows
   use impact1d_clusters, only: row_rate
   use impact1d_cluster_mode, only: cluster_work_type, cluster_reserve, cluster_mode, cluster_solved
   use testing, only: check, finish
@@ -45,7 +45,7 @@ contains
     real(wp) :: f(2), df(2), v(2), a_enum(2), a(2), sgn(2), lambda(4), friction_force(2), scale, worst
     real(wp) :: row_normal(2, 4)
     integer :: row_body(2, 4), n, nr, status, unique, same_set, not_found, bad
-    logical :: candidate(4), active(4), stuck(2), found, resting(2)
+    logical :: candidate(4), active(4), stuck(2), found, resting(2), candidate_rows(pair_rows)
     worst = 0.0_wp
     unique = 0
     same_set = 0
@@ -54,7 +54,10 @@ contains
     do i = 1, trials
       call random_problem(pair, f, df, v, row_body, row_normal, candidate, n, nr)
       resting = v == 0.0_wp .and. pair%static_friction > 0.0_wp
-      call solve_mode(pair, f, df, candidate, resting, merge(0.0_wp, sign(1.0_wp, v), v == 0.0_wp), mode, found)
+      ! The enumerator's arrays are pair_rows long: the problem's rows first, none after.
+      candidate_rows = .false.
+      candidate_rows(1:4) = candidate
+      call solve_mode(pair, f, df, candidate_rows, resting, merge(0.0_wp, sign(1.0_wp, v), v == 0.0_wp), mode, found)
       if (.not. found) then
         not_found = not_found + 1
         cycle
@@ -113,6 +116,7 @@ contains
     call random_number(u)
     n = merge(1, 2, u(1) < 0.3_wp)
     pair%n = n
+    pair%n_rows = 4       ! the four rows random rows are drawn into (unused ones: no normal, never candidates)
     f = 0.0_wp
     df = 0.0_wp
     v = 0.0_wp

@@ -5,18 +5,20 @@ program test_impacts
   use impact1d_scene, only: scene_type, i_left, i_right, i_slot_min, i_slot_max
   use impact1d_impacts, only: impulse, normal_velocity, most_approaching, restitution_of, &
     joint_inelastic, inelastic_projection
-  use testing, only: check, finish, two_body
+  use testing, only: check, finish, two_body, on_rows, row_values
+  use impact1d_modes, only: pair_rows
   implicit none
   ! One impulse is a handful of flops on O(10) numbers: a few ulps of them.
   real(wp), parameter :: tol = 1.0e-13_wp
   type(scene_type) :: scene
   real(wp) :: v(2), v_after(2), r, expected(2)
-  logical :: closed(4), pushed(4)
-  real(wp), parameter :: no_tol(4) = 0.0_wp
+  logical :: closed(pair_rows), pushed(pair_rows)
+  real(wp), parameter :: no_tol(pair_rows) = 0.0_wp
   ! The solver's rounding level of a normal velocity of about 8 m/s (64 ulps of it).
-  real(wp), parameter :: u_rounding(4) = 64.0_wp * epsilon(1.0_wp) * 8.0_wp
+  real(wp), parameter :: u_rounding(pair_rows) = 64.0_wp * epsilon(1.0_wp) * 8.0_wp
   real(wp), parameter :: mass(2) = [1.0_wp, 2.0_wp]
-  ! Every contact: walls either side, a slot between the bodies.
+  ! Every contact: walls either side, a slot between the bodies (rows left, right, slot_min,
+  ! slot_max: i_left .. i_slot_max are their indices).
   character(len=*), parameter :: contacts = 'm2 = 2, x_left = -1, x_right = 5, d_min = 0.5, d_max = 2'
 
   call two_body(contacts, scene)
@@ -38,48 +40,48 @@ program test_impacts
   call impulse(scene, i_slot_min, 0.0_wp, [8.0_wp, 0.0_wp], v_after)
   call check(all(abs(v_after - 8.0_wp / 3.0_wp) < tol), 'perfectly inelastic: common velocity 8/3')
 
-  closed = [.true., .false., .true., .false.]
-  call check(most_approaching(scene, closed, [-1.0_wp, -3.0_wp], [0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp]) == i_slot_min, &
+  closed = on_rows([.true., .false., .true., .false.])
+  call check(most_approaching(scene, closed, [-1.0_wp, -3.0_wp], row_values([0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp])) == i_slot_min, &
     'the fastest approaching closed contact goes first')
-  call check(most_approaching(scene, closed, [1.0_wp, 3.0_wp], [0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp]) == 0, &
+  call check(most_approaching(scene, closed, [1.0_wp, 3.0_wp], row_values([0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp])) == 0, &
     'separating contacts get no impulse')
 
   call two_body(contacts // ', r_left = 1, r_right = 1, r_min = 1, r_max = 1', scene)
-  closed = [.false., .false., .true., .true.]
+  closed = on_rows([.false., .false., .true., .true.])
   call check(restitution_of(scene, i_slot_min, closed) == 0.0_wp, 'a rigid link (both slot limits closed) does not rebound')
 
   ! A body pinned between a wall and a heavier body, every contact perfectly inelastic: the
   ! joint impact stops both at once (sequential impulses only approach it geometrically).
   call two_body(contacts // ', r_left = 0, r_right = 0, r_min = 0, r_max = 0', scene)
-  closed = [.true., .false., .true., .false.]
+  closed = on_rows([.true., .false., .true., .false.])
   call check(joint_inelastic(scene, closed), 'r = 0 everywhere: one joint inelastic impact')
   call inelastic_projection(scene, closed, [0.0_wp, -5.0_wp], no_tol, v_after, pushed)
   call check(all(v_after == 0.0_wp) .and. all(pushed .eqv. closed), &
     'pinned body: both at rest, impulses on the wall and the slot')
   ! The same contacts, body 2 leaving: only the wall acts, body 2 keeps its velocity.
   call inelastic_projection(scene, closed, [-1.0_wp, 3.0_wp], no_tol, v_after, pushed)
-  call check(all(v_after == [0.0_wp, 3.0_wp]) .and. all(pushed .eqv. [.true., .false., .false., .false.]), &
+  call check(all(v_after == [0.0_wp, 3.0_wp]) .and. all(pushed .eqv. on_rows([.true., .false., .false., .false.])), &
     'a leaving body is not held back')
   ! Body 1 slower toward the wall than body 2 follows it: the nearest admissible velocity
   ! in the kinetic-energy metric is the common one (the slot face), not the vertex.
-  closed = [.false., .false., .true., .false.]
+  closed = on_rows([.false., .false., .true., .false.])
   call inelastic_projection(scene, closed, [8.0_wp, 0.0_wp], u_rounding, v_after, pushed)
   call impulse(scene, i_slot_min, 0.0_wp, [8.0_wp, 0.0_wp], expected)
   call check(all(v_after == expected), &
     'one closed contact: the projection is the r = 0 impulse')
   ! A rigid link (both slot limits closed) driven into the left wall: the pair stops as one.
-  closed = [.true., .false., .true., .true.]
+  closed = on_rows([.true., .false., .true., .true.])
   call inelastic_projection(scene, closed, [-2.0_wp, -2.0_wp], no_tol, v_after, pushed)
   call check(all(v_after == 0.0_wp) .and. pushed(i_left), 'a rigid pair against a wall stops as one body')
   ! Nothing approaches: nothing changes.
   call inelastic_projection(scene, closed, [1.0_wp, 1.0_wp], no_tol, v_after, pushed)
   call check(all(v_after == 1.0_wp) .and. .not. any(pushed), 'separating contacts: no impulse')
   call two_body(contacts // ', r_left = 0.5, r_right = 0, r_min = 0, r_max = 0', scene)
-  closed = [.true., .false., .true., .false.]
+  closed = on_rows([.true., .false., .true., .false.])
   call check(.not. joint_inelastic(scene, closed), 'an elastic closed contact: no joint projection')
   call two_body(contacts // ', r_left = 0, r_right = 0, r_min = 0, r_max = 0', scene)
-  call check(.not. joint_inelastic(scene, [.false., .false., .true., .false.]), 'one closed contact: one impulse')
-  call check(.not. joint_inelastic(scene, [.false., .false., .true., .true.]), 'a rigid link alone: one impulse')
+  call check(.not. joint_inelastic(scene, on_rows([.false., .false., .true., .false.])), 'one closed contact: one impulse')
+  call check(.not. joint_inelastic(scene, on_rows([.false., .false., .true., .true.])), 'a rigid link alone: one impulse')
 
   call finish('test_impacts')
 

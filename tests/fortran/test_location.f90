@@ -7,7 +7,7 @@ program test_location
   use impact1d_modes, only: mode_type, solve_mode
   use impact1d_location, only: hold_crossing, first_negative
   use impact1d_state, only: lane_state_type
-  use testing, only: check, finish, two_body
+  use testing, only: check, finish, two_body, on_rows
   implicit none
   ! Bisection stops within 2 eps of the clock: a few ulps of t = 0.5.
   real(wp), parameter :: tol = 8.0_wp * eps_wp
@@ -22,7 +22,7 @@ program test_location
   ramp%t = [0.0_wp, 1.0_wp]
   ramp%f = [0.0_wp, 20.0_wp]
   call two_body('m2 = 2, mu1 = 1, mu2 = 1, g = 10, dt = 0.2', scene, ramp)
-  call solve_mode(scene%pair, [0.0_wp, 0.0_wp], [20.0_wp, 0.0_wp], [.false., .false., .false., .false.], &
+  call solve_mode(scene%pair, [0.0_wp, 0.0_wp], [20.0_wp, 0.0_wp], on_rows([.false., .false., .false., .false.]), &
     [.true., .true.], [0.0_wp, 0.0_wp], mode, found)
   call check(found .and. all(mode%stuck) .and. mode%n_hold > 0, 'both bodies stuck at t = 0')
   a%t = 0.4_wp

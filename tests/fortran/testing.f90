@@ -6,10 +6,12 @@ module testing
   use impact1d_kinds, only: wp
   use impact1d_error, only: error_type
   use impact1d_forcing, only: table_type
-  use impact1d_scene, only: scene_input, scene_type, build_scene, real_names, n_real, i_f1_table, set_text, n_text
+  use impact1d_modes, only: pair_rows
+  use impact1d_scene, only: scene_input, scene_type, build_scene, real_names, n_real, i_f1_table, set_text, n_text, &
+    i_m2, i_x2
   implicit none
   private
-  public :: check, finish, two_body
+  public :: check, finish, two_body, on_rows, row_values, row_of
 
   integer, save :: failures = 0
   !> What two_body starts from: two unit masses a metre apart, a second's run at 1 ms steps.
@@ -33,11 +35,13 @@ contains
 
   !> A scene checked and built by build_scene from 'name = value' assignments in the
   !> namelist's names ('m2 = 2, mu1 = 1, g = 10, x_left = -1'), over base_scene; with
-  !> f1_table, body 1's force table. A scene the validator refuses ends the test.
-  subroutine two_body(assignments, scene, f1_table)
+  !> f1_table, body 1's force table; with one_body, without m2 and x2 (one body). A scene
+  !> the validator refuses ends the test.
+  subroutine two_body(assignments, scene, f1_table, one_body)
     character(len=*), intent(in) :: assignments
     type(scene_type), intent(out) :: scene
     type(table_type), intent(in), optional :: f1_table
+    logical, intent(in), optional :: one_body
     type(scene_input) :: input
     type(table_type) :: tables(2)
     type(error_type), allocatable :: error
@@ -47,6 +51,9 @@ contains
     end do
     call assign(base_scene, input)
     call assign(assignments, input)
+    if (present(one_body)) then
+      if (one_body) input%given([i_m2, i_x2]) = .false.
+    end if
     if (present(f1_table)) then
       call set_text(input, i_f1_table, 'f1_table')
       tables(1) = f1_table
@@ -57,6 +64,29 @@ contains
       error stop 1
     end if
   end subroutine two_body
+
+  !> Flags for a scene's first rows in the kernels' per-row size (pair_rows), the rest false.
+  pure function on_rows(flags) result(padded)
+    logical, intent(in) :: flags(:)
+    logical :: padded(pair_rows)
+    padded = .false.
+    padded(:size(flags)) = flags
+  end function on_rows
+
+  !> Values for a scene's first rows in the kernels' per-row size (pair_rows), the rest 0.
+  pure function row_values(values) result(padded)
+    real(wp), intent(in) :: values(:)
+    real(wp) :: padded(pair_rows)
+    padded = 0.0_wp
+    padded(:size(values)) = values
+  end function row_values
+
+  !> The index of the scene's row with this name ('left', 'slot_min', ...); 0 if none.
+  pure integer function row_of(scene, name)
+    type(scene_type), intent(in) :: scene
+    character(len=*), intent(in) :: name
+    row_of = findloc(scene%row_name, name, dim=1)
+  end function row_of
 
   !> Set the fields named in a comma-separated list of 'name = value'.
   subroutine assign(assignments, input)

@@ -38,6 +38,8 @@ _OVERRIDABLE = tuple(f.name for f in dataclasses.fields(Scene))
 
 # Room for events a run starts with (most runs log fewer), and the most a hint asks for.
 _EVENT_CAPACITY = 256
+# Rows a scene has (the flat API says when it has more): the tutorial's at most four.
+_ROW_CAPACITY = 8
 _EVENT_CAPACITY_MAX = 1 << 22
 _event_capacity = _EVENT_CAPACITY
 
@@ -113,14 +115,29 @@ def _sample_capacity(scene) -> int:
 
 @lru_cache(maxsize=None)
 def event_kinds() -> tuple:
-    """Event kind words; the core's code k is the k-th word (1-based)."""
+    """The event kinds of the tutorial's scenes (one or two bodies, its walls and slot)."""
     return _words(_api.event_kind_names())
 
 
-@lru_cache(maxsize=None)
-def _kind_names() -> np.ndarray:
-    """Event kind words indexed by the core's code (index 0: an unknown code)."""
-    return np.array(("unknown",) + event_kinds())
+# Event classes of the core (1 impact, 2 rest, 3 release of a row; 4 stick, 5 slip of a body)
+# and the words their names start with.
+_ROW_PREFIXES = ("", "rest_", "release_")
+_BODY_PREFIXES = ("stick", "slip")
+
+
+def _event_names(event_class, event_index, row_names, n_bodies) -> np.ndarray:
+    """Each event's kind, '<row>', 'rest_<row>', 'release_<row>', 'stick<i>' or 'slip<i>':
+    through a table of the run's 3 n_rows + 2 N names, one lookup per event."""
+    n_rows = len(row_names)
+    table = np.array([p + name for p in _ROW_PREFIXES for name in row_names]
+                     + [f"{p}{i}" for p in _BODY_PREFIXES for i in range(1, n_bodies + 1)]
+                     + ["unknown"])
+    row_event = (event_class >= 1) & (event_class <= 3) & (event_index >= 1) & (event_index <= n_rows)
+    body_event = (event_class >= 4) & (event_class <= 5) & (event_index >= 1) & (event_index <= n_bodies)
+    where = np.where(row_event, (event_class - 1) * n_rows + event_index - 1,
+                     np.where(body_event, 3 * n_rows + (event_class - 4) * n_bodies + event_index - 1,
+                              len(table) - 1))
+    return table[where]
 
 
 def _empty():
@@ -229,15 +246,16 @@ def simulate(scene: Scene, *, progress: bool = False, **overrides) -> Result:
     # The core fills arrays made for this call (no state is kept between calls, so threads
     # may run at once); when a guess at their size is short it says what is needed.
     global _event_capacity
-    sample_capacity, event_capacity = _sample_capacity(scene), _event_capacity
+    sample_capacity, event_capacity, row_capacity = _sample_capacity(scene), _event_capacity, _ROW_CAPACITY
     while True:
-        (samples, has_column, event_t, event_kind, event_v, n_samples, n_events, steps,
-         energy_residual, status, message, warnings) = _api.simulate(values, given, *texts,
-                                          1 if progress else 0, sample_capacity, len(COLUMNS),
-                                          event_capacity)
+        (samples, has_column, event_t, event_class, event_index, _event_ends, event_v, row_name_codes,
+         n_samples, n_events, n_rows, steps, energy_residual, status, message,
+         warnings) = _api.simulate(values, given, *texts, 1 if progress else 0, sample_capacity,
+                                   len(COLUMNS), event_capacity, row_capacity)
         if int(status) != _STATUS_TOO_SMALL:
             break
         sample_capacity, event_capacity = max(int(n_samples), 1), max(int(n_events), 1)
+        row_capacity = max(int(n_rows), 1)
     raise_for_status(status, message)
 
     n_samples, n_events = int(n_samples), int(n_events)
@@ -246,10 +264,10 @@ def simulate(scene: Scene, *, progress: bool = False, **overrides) -> Result:
     names, one_body = _column_layout(has_column.tobytes())
     events = np.empty(n_events, dtype=ONE_BODY_EVENT_DTYPE if one_body else EVENT_DTYPE)
     if n_events > 0:
-        kind = np.asarray(event_kind[:n_events])
-        kinds = _kind_names()
+        row_names = [decode(row_name_codes[:, k].astype(np.uint8)) for k in range(int(n_rows))]
         events["t"] = event_t[:n_events]
-        events["kind"] = kinds[np.where((kind >= 1) & (kind < len(kinds)), kind, 0)]
+        events["kind"] = _event_names(np.asarray(event_class[:n_events]), np.asarray(event_index[:n_events]),
+                                      row_names, 1 if one_body else 2)
         events["v1_before"], events["v1_after"] = event_v[0, :n_events], event_v[2, :n_events]
         if not one_body:
             events["v2_before"], events["v2_after"] = event_v[1, :n_events], event_v[3, :n_events]

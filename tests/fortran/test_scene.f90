@@ -1,0 +1,79 @@
+!> The model's contact records and the rows made from them (docs/nbody-plan.md section 1):
+!> the tutorial's walls and slot in record order, their rows in the order the engine's ties
+!> need (left, right, slot_min, slot_max), gaps with the tutorial's signs, names, partners.
+program test_scene
+  use impact1d_kinds, only: wp
+  use impact1d_scene, only: scene_type
+  use impact1d_contacts, only: snap
+  use impact1d_state, only: lane_state_type
+  use testing, only: check, finish, two_body, on_rows, row_of
+  implicit none
+  type(scene_type) :: scene
+  type(lane_state_type) :: s
+  real(wp) :: k(2, 2), c(2, 2), f(2)
+
+  call two_body('m2 = 2, x_left = -1, r_left = 0.5, x_right = 5, d_min = 0.25, d_max = 2, r_max = 0.75', scene)
+  call check(scene%n_contacts == 3, 'walls and slot: three records')
+  call check(all(scene%contact_name == [character(len=8) :: 'left', 'right', 'slot']), 'record names')
+  call check(all(scene%contact_body == reshape([0, 1, 0, 2, 1, 2], [2, 3])), 'record ends')
+  call check(all(scene%contact_has .eqv. reshape([.true., .false., .false., .true., .true., .true.], [2, 3])), &
+    'limits present: left lower, right upper, slot both')
+  call check(scene%n_rows == 4, 'four rows')
+  call check(all(scene%row_name == [character(len=8) :: 'left', 'right', 'slot_min', 'slot_max']), 'row names')
+  call check(all(scene%row_normal == reshape([0.0_wp, 1.0_wp, 0.0_wp, -1.0_wp, -1.0_wp, 1.0_wp, 1.0_wp, -1.0_wp], &
+    [2, 4])), 'row normals: ground ends 0, lower (-1, 1), upper (1, -1)')
+  call check(all(scene%row_offset == [1.0_wp, 5.0_wp, -0.25_wp, 2.0_wp]), 'row offsets: -x_left, x_right, -d_min, d_max')
+  call check(all(scene%row_restitution == [0.5_wp, 1.0_wp, 1.0_wp, 0.75_wp]), 'row restitutions, 1 by default')
+  call check(all(scene%row_contact == [1, 2, 3, 3]), 'rows name their records')
+  call check(all(scene%row_partner == 0), 'no rigid link: no partners')
+
+  ! Two bodies with nothing named: the slot's meeting alone, still suffixed.
+  call two_body('', scene)
+  call check(scene%n_contacts == 1 .and. scene%n_rows == 1, 'two bodies: the meeting only')
+  call check(scene%row_name(1) == 'slot_min' .and. scene%row_offset(1) == 0.0_wp, 'the meeting: slot_min, d_min = 0')
+
+  ! A rigid link: its limits are each other's partner.
+  call two_body('d_min = 1, d_max = 1', scene)
+  call check(all(scene%row_partner == [2, 1]), 'rigid link: partners')
+
+  ! One body: the right wall holds body 1; no slot.
+  call two_body('x_right = 3', scene, one_body=.true.)
+  call check(scene%n_contacts == 1 .and. all(scene%contact_body(:, 1) == [0, 1]), 'one body: right wall on body 1')
+  call check(scene%row_name(1) == 'right' .and. all(scene%row_normal(:, 1) == [0.0_wp, -1.0_wp]), &
+    'one body: the right row')
+  ! The kernels' view: the row's coefficient on body 1's lane, none on the idle lane.
+  call check(scene%pair%n_rows == 1 .and. all(scene%pair%normal(:, 1) == [-1.0_wp, 0.0_wp]), &
+    'one body: the right wall on lane 1')
+  s%x = [3.25_wp, 0.0_wp]
+  call snap(scene, 1, on_rows([.true.]), s)
+  call check(s%x(1) == 3.0_wp, 'one body: snap puts it on the right wall')
+
+  ! Snap on a row between the bodies moves the end no closed wall holds: body 2 when only
+  ! the left wall holds body 1, body 1 when the right wall holds body 2.
+  call two_body('x_left = -1, x_right = 5, d_min = 0.5', scene)
+  s%x = [-1.0_wp, -0.25_wp]
+  s%x_lo = 0.0_wp
+  call snap(scene, row_of(scene, 'slot_min'), on_rows([.true., .false., .true.]), s)
+  call check(all(s%x == [-1.0_wp, -0.5_wp]), 'slot_min snap moves body 2 off a held body 1')
+  s%x = [4.25_wp, 5.0_wp]
+  call snap(scene, row_of(scene, 'slot_min'), on_rows([.false., .true., .true.]), s)
+  call check(all(s%x == [4.5_wp, 5.0_wp]), 'slot_min snap moves body 1 when the right wall holds body 2')
+
+  ! Elements: records in the order k1, k2, k12 where the scene names them; K and C from them.
+  call two_body('k1 = 2, x1_rest = 0.5, k12 = 3, d_rest = 1, c12 = 0.25, c2 = 0.5', scene)
+  call check(scene%n_elements == 3 .and. all(scene%element_body == reshape([0, 1, 0, 2, 1, 2], [2, 3])), &
+    'elements k1, k2 (a damper alone), k12 in order')
+  call check(all(scene%element_k == [2.0_wp, 0.0_wp, 3.0_wp]) .and. all(scene%element_c == [0.0_wp, 0.5_wp, 0.25_wp]) &
+    .and. all(scene%element_rest == [0.5_wp, 0.0_wp, 1.0_wp]), 'element coefficients and rest lengths')
+  call scene%springs%linear_part(2, k, c)
+  call check(all(k == reshape([5.0_wp, -3.0_wp, -3.0_wp, 3.0_wp], [2, 2])), 'K from the records')
+  call check(all(c == reshape([0.25_wp, -0.25_wp, -0.25_wp, 0.75_wp], [2, 2])), 'C from the records')
+  ! Forces at x = (1, 2.5), at rest: k1 pulls body 1 back by 2 (1 - 0.5), the link (stretched
+  ! by 0.5) pulls the bodies together by 1.5.
+  f = 0.0_wp
+  call scene%springs%add_force([1.0_wp, 2.5_wp], [0.0_wp, 0.0_wp], [0.0_wp, 0.0_wp], f)
+  call check(all(f == [0.5_wp, -1.5_wp]), 'spring forces from the records')
+  call two_body('', scene)
+  call check(scene%n_elements == 0 .and. .not. scene%springs%present, 'no springs: no elements')
+  call finish('test_scene')
+end program test_scene
