@@ -16,7 +16,7 @@ module impact1d_chain
     a_f_table, mechanism_records
   implicit none
   private
-  public :: settle_chain, validate_chain, input_records, mechanism_records, n_bodies_of
+  public :: settle_chain, validate_chain, input_records, mechanism_records, n_bodies_of, slot_of
   public :: id_arrays, id_r_meet, id_contact, id_spring, n_ids, field_name, field_is_text, assign_number, &
     assign_text, scene_assignments
 

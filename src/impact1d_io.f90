@@ -11,7 +11,7 @@ module impact1d_io
   use impact1d_forcing, only: table_type
   use impact1d_fields, only: n_arrays, array_names, array_groups, array_is_text, n_contact_fields, contact_fields, &
     n_spring_fields, spring_fields, r_name, record_input, text_item
-  use impact1d_chain, only: settle_chain, validate_chain, id_arrays, id_r_meet, id_contact, id_spring, n_ids
+  use impact1d_chain, only: settle_chain, validate_chain, slot_of, id_arrays, id_r_meet, id_contact, id_spring, n_ids
   use impact1d_files, only: check_input_file
   implicit none
   private
@@ -680,12 +680,7 @@ contains
       return
     end if
     if (index(', ' // trim(group_variables(group)) // ',', ', ' // name // ',') > 0) then
-      do k = 1, n_real
-        if (real_names(k) == name) field_index = k
-      end do
-      do k = 1, n_text
-        if (text_names(k) == name) field_index = n_real + k
-      end do
+      field_index = slot_of(name)
     else if (name == 'r_meet' .and. known_groups(group) == 'link') then
       field_index = id_r_meet
     else
