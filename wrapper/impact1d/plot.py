@@ -664,9 +664,11 @@ class _Row(NamedTuple):
     record: int         # the record it comes from (a slot's two rows share one)
 
 
-def _tutorial_records(result, n):
+def _tutorial_records(result, n, joined=False):
     """Today's walls and slot as contact records (docs/nbody-plan.md, 'Today's scene in
-    records'): left (0, 1) lower, right (0, N) upper, the slot (1, 2) with its meeting."""
+    records'): left (0, 1) lower, right (0, N) upper, the slot (1, 2) with its meeting
+    (none when a record joins the bodies, `joined`, and the scene gives no d_min: the
+    record replaces the meeting, as in the engine)."""
     value = {name: _float_or_none(_scene_value(result, name))
              for name in ("x_left", "x_right", "d_min", "d_max")}
     records = []
@@ -675,8 +677,13 @@ def _tutorial_records(result, n):
     if value["x_right"] is not None:
         records.append(dict(a=0, b=n, d_max=value["x_right"], name="right"))
     if n == 2:
-        records.append(dict(a=1, b=2, d_min=value["d_min"] or 0.0, d_max=value["d_max"],
-                            name="slot", name_min="slot_min", name_max="slot_max"))
+        slot = dict(a=1, b=2, name="slot", name_min="slot_min", name_max="slot_max")
+        if value["d_min"] is not None or not joined:
+            slot["d_min"] = value["d_min"] or 0.0
+        if value["d_max"] is not None:
+            slot["d_max"] = value["d_max"]
+        if "d_min" in slot or "d_max" in slot:
+            records.append(slot)
     return records
 
 
@@ -701,11 +708,14 @@ def _record_rows(j, record):
 
 
 def _rows(result, n):
+    """The contact rows in the engine's order: today's walls and slot (a one- or two-body
+    scene's), then the scene's records (unnamed: contact<j>, j counting the records)."""
     scene = getattr(result, "scene", None)
-    records = None if scene is None else _field(scene, "contacts")
-    if records is None:
-        records = _tutorial_records(result, n)
-    return [row for j, record in enumerate(records) for row in _record_rows(j, record)]
+    records = (None if scene is None else _field(scene, "contacts")) or []
+    joined = any(sorted((int(_field(r, "a", 0)), int(_field(r, "b", 0)))) == [1, 2] for r in records)
+    tutorial = _tutorial_records(result, n, joined)
+    return [row for record in tutorial for row in _record_rows(0, record)] + \
+        [row for j, record in enumerate(records) for row in _record_rows(j, record)]
 
 
 class _Event(NamedTuple):
