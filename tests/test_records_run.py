@@ -300,3 +300,41 @@ def test_pictures_draw_the_tutorial_contacts_and_the_records():
     rows = plot._rows(res, 2)
     assert [row.name for row in rows] == ["left", "slot_max", "stop", "wall1"]
     assert set(res.events["kind"]) <= {row.name for row in rows} | {"rest_" + row.name for row in rows}
+
+
+@pytest.mark.parametrize("x_rest, force, r", [(0.4, 0.0, 0.9), (0.5, -2.0, 0.7)])
+def test_spring_and_wall_records_against_the_impact_oscillator(x_rest, force, r):
+    """A one-body impact oscillator written as a &spring and a &contact record (turned
+    round: b = 0), against its closed form (tests/exact_springs.py), and the same bits as
+    the scene in the tutorial's names (k1, x_left)."""
+    import exact_springs as ex
+    m, k, x_left = 0.8, 15.0, 0.05
+    ref = ex.impact_oscillator(m, k, x_rest, x_left, r, x0=0.6, v0=-2.5, t_end=6.0, force=force)
+    base = dict(m1=m, x1=0.6, v1=-2.5, f1=force, t_end=6.0, dt=1e-3)
+    records = impact1d.simulate(impact1d.Scene(**base, springs=[dict(a=1, b=0, k=k, d_rest=-x_rest)],
+                                               contacts=[dict(a=1, b=0, d_max=-x_left, r_max=r, name="left")]))
+    tutorial = impact1d.simulate(impact1d.Scene(**base, k1=k, x1_rest=x_rest, x_left=x_left, r_left=r))
+    assert records.samples.tobytes() == tutorial.samples.tobytes()
+    assert records.events.tobytes() == tutorial.events.tobytes()
+    want = [(float(e.t), e.kind) for e in ref.events if e.kind in ("left", "rest_left")]
+    assert len(want) >= 3 and list(records.events["kind"]) == [kind for _, kind in want]
+    # RK4 at w dt = 4e-3: the event times within 1.7e-11 s here
+    assert max(abs(t - float(e)) for (e, _), t in zip(want, records.events["t"])) < 1e-8
+
+
+def test_chain_shorthand_of_two_bodies_with_records_runs_as_the_tutorial_names(tmp_path):
+    """Arrays of two bodies with a &contact record: the same run as the tutorial's names."""
+    contacts = [dict(a=1, b=2, d_min=0.5, r_min=0.6, name="stop")]
+    by_arrays = impact1d.Scene(m=[1.0, 2.0], x=[0.0, 1.0], v=[1.0, 0.0], f=[0.5, -1.0], d_max=[1.5],
+                               t_end=3.0, dt=1e-3, contacts=contacts)
+    by_names = impact1d.Scene(m1=1.0, m2=2.0, x1=0.0, x2=1.0, v1=1.0, f1=0.5, f2=-1.0, d_max=1.5,
+                              t_end=3.0, dt=1e-3, contacts=contacts)
+    path = tmp_path / "chain.nml"
+    path.write_text("&bodies m = 1.0, 2.0 /\n&initial x = 0.0, 1.0, v = 1.0, 0.0 /\n&forces f = 0.5, -1.0 /\n"
+                    "&link d_max = 1.5 /\n&contact a = 1, b = 2, d_min = 0.5, r_min = 0.6, name = 'stop' /\n"
+                    "&run t_end = 3.0, dt = 1e-3 /\n")
+    runs = [impact1d.simulate(s) for s in (by_arrays, by_names, impact1d.load_scene(path))]
+    assert "stop" in list(runs[0].events["kind"])
+    for other in runs[1:]:
+        assert other.events.tobytes() == runs[0].events.tobytes()
+        assert other.samples.tobytes() == runs[0].samples.tobytes()

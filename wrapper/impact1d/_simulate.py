@@ -38,7 +38,8 @@ _OVERRIDABLE = tuple(f.name for f in dataclasses.fields(Scene))
 
 # Room for events a run starts with (most runs log fewer), and the most a hint asks for.
 _EVENT_CAPACITY = 256
-# Rows a scene has (the flat API says when it has more): the tutorial's at most four.
+# Rows a scene has (the flat API says when it has more): at most pair_rows = 8 (the
+# tutorial's four, and records on one or two bodies).
 _ROW_CAPACITY = 8
 _EVENT_CAPACITY_MAX = 1 << 22
 _event_capacity = _EVENT_CAPACITY
