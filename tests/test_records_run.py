@@ -16,6 +16,7 @@ from __future__ import annotations
 import dataclasses
 import random
 import subprocess
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -37,6 +38,7 @@ MAX_EVENTS, SERIES_GAP = 12, 1e-4
 # An impact that changes no velocity by this much (m/s) is a grazing touch.
 GRAZING = 1e-6
 RESERVED = ("rest_", "release_", "stick", "slip")
+INPUT = Path(__file__).resolve().parent.parent / "input"
 
 
 def engine_scene(scene: dict, dt: float) -> impact1d.Scene:
@@ -338,3 +340,17 @@ def test_chain_shorthand_of_two_bodies_with_records_runs_as_the_tutorial_names(t
     for other in runs[1:]:
         assert other.events.tobytes() == runs[0].events.tobytes()
         assert other.samples.tobytes() == runs[0].samples.tobytes()
+
+
+def test_figure_impact_panel_has_a_row_per_record(tmp_path):
+    """The two-body figure's impact panel: the tutorial's contacts, then a row per record
+    row (its impacts as ticks, its rests as bars), named as the events are."""
+    import matplotlib
+    matplotlib.use("Agg")
+    from impact1d import plot
+    res = impact1d.simulate(impact1d.load_scene(INPUT / "inner_stop.nml"))
+    fig = plot.figure(res)
+    gids = {artist.get_gid() for ax in fig.axes for artist in ax.get_children()}
+    assert {"tick:stop", "tick:wall1", "rest:stop", "tick:left"} <= gids
+    labels = [label.get_text() for ax in fig.axes if ax.get_ylabel() == "impacts" for label in ax.get_yticklabels()]
+    assert labels == ["wall1", "stop", "slot max", "left wall"]

@@ -153,7 +153,8 @@ def _event_times(events, kind):
 
 
 def _contacts_present(result, events):
-    """Contacts drawn in the impact panel: those the scene has, plus any that had events."""
+    """Contacts drawn in the impact panel: the tutorial's the scene has, plus any that had
+    events, then the rows of its &contact records."""
     limits = {
         "left": "x_left",
         "right": "x_right",
@@ -165,7 +166,24 @@ def _contacts_present(result, events):
         for c in CONTACTS:
             if kind in (c, "rest_" + c, "release_" + c):
                 seen.add(c)
-    return [c for c in CONTACTS if c in seen or _float_or_none(_scene_value(result, limits[c])) is not None]
+    tutorial = [c for c in CONTACTS if c in seen or _float_or_none(_scene_value(result, limits[c])) is not None]
+    # The rows of the scene's &contact records (one or two bodies), after the tutorial's.
+    scene = getattr(result, "scene", None)
+    records = (None if scene is None else _field(scene, "contacts")) or []
+    extra = [row.name for j, record in enumerate(records) for row in _record_rows(j, record)]
+    return tutorial + [name for name in dict.fromkeys(extra) if name not in tutorial]
+
+
+# Colours of the records' rows (impact panel), after the tutorial's four, in turn.
+_RECORD_COLORS = ("tab:pink", "tab:olive", "tab:cyan", "tab:gray", "gold", "navy", "teal", "maroon")
+
+
+def _contact_color(contact, contacts):
+    """A tutorial contact's own colour; a record's row one of _RECORD_COLORS by its place."""
+    if contact in _CONTACT_COLOR:
+        return _CONTACT_COLOR[contact]
+    extra = [c for c in contacts if c not in _CONTACT_COLOR]
+    return _RECORD_COLORS[extra.index(contact) % len(_RECORD_COLORS)]
 
 
 def _rest_intervals(events, contact, t_start, t_end):
@@ -526,7 +544,7 @@ def _draw_impacts(ax, result, events):
     n = len(contacts)
     for row, contact in enumerate(contacts):
         y = n - 1 - row  # first contact on top
-        color = _CONTACT_COLOR[contact]
+        color = _contact_color(contact, contacts)
         # A rest that began before the window still shows in it: bars from every event.
         bars = _rest_intervals(result.events, contact, *result.run)
         if bars:
@@ -543,7 +561,7 @@ def _draw_impacts(ax, result, events):
         ax.text(0.5, 0.5, "no walls, no slot", transform=ax.transAxes, ha="center",
                 va="center", fontsize="small", color="0.5")
     ax.set_yticks(range(n))
-    ax.set_yticklabels([_CONTACT_LABEL[c] for c in reversed(contacts)])
+    ax.set_yticklabels([_CONTACT_LABEL.get(c, c) for c in reversed(contacts)])
     ax.set_ylim(-0.6, n - 0.4 if n else 0.6)
     ax.set_ylabel("impacts")
     _finish_time_axis(ax, result)
