@@ -309,8 +309,13 @@ def _packed(numbers, texts):
 def record_assignments(scene: Scene):
     """The scene's &contact and &spring records as the api's simulate takes them (_packed;
     none: counts 0). The rest of the scene goes as to_core's flat fields."""
+    if scene.contacts is None and scene.springs is None:
+        return _NO_RECORDS      # (a run of 50 us spent 9 us packing nothing)
     numbers, texts = to_assignments(Scene(contacts=scene.contacts, springs=scene.springs))
     return _packed(numbers, texts)
+
+
+_NO_RECORDS = _packed([], [])
 
 
 def _settled(scene: Scene):
