@@ -344,13 +344,14 @@ def test_chain_shorthand_of_two_bodies_with_records_runs_as_the_tutorial_names(t
 
 def test_figure_impact_panel_has_a_row_per_record(tmp_path):
     """The two-body figure's impact panel: the tutorial's contacts, then a row per record
-    row (its impacts as ticks, its rests as bars), named as the events are."""
+    row (its impacts as ticks, its rests as bars), named as the events are; the positions
+    panel marks the records' impacts on the bodies they hold."""
     import matplotlib
     matplotlib.use("Agg")
     from impact1d import plot
     res = impact1d.simulate(impact1d.load_scene(INPUT / "inner_stop.nml"))
     fig = plot.figure(res)
     gids = {artist.get_gid() for ax in fig.axes for artist in ax.get_children()}
-    assert {"tick:stop", "tick:wall1", "rest:stop", "tick:left"} <= gids
+    assert {"tick:stop", "tick:wall1", "rest:stop", "tick:left", "impact:stop", "impact:wall1"} <= gids
     labels = [label.get_text() for ax in fig.axes if ax.get_ylabel() == "impacts" for label in ax.get_yticklabels()]
     assert labels == ["wall1", "stop", "slot max", "left wall"]

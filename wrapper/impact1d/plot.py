@@ -454,22 +454,26 @@ def _draw_positions(ax, result, events):
         ax.plot(t, x2, color=_BODY_COLOR[2], linewidth=1.4, gid="x2", label="x2 (body 2)")
 
     # Smaller markers when impacts crowd (long runs), so the paths stay visible.
-    n_impacts = sum(1 for _, k in events if k in CONTACTS)
+    contacts = _contacts_present(result, result.events)
+    n_impacts = sum(1 for _, k in events if k in contacts)
     size = 5 if n_impacts <= 150 else 3
-    for contact in CONTACTS:
+    # The bodies a record's row involves (its ends but the ground).
+    bodies = {row.name: tuple(e for e in (row.a, row.b) if e > 0) for row in _rows(result, 2 if x2.size else 1)}
+    bodies.update(_CONTACT_BODIES)
+    for contact in CONTACTS + tuple(c for c in contacts if c not in CONTACTS):
         times = _event_times(events, contact)
         if times.size == 0:
             continue
         xs, ys = [], []
         # One body: both walls hold body 1.
-        for body in (_CONTACT_BODIES[contact] if x2.size else (1,)):
+        for body in (bodies[contact] if x2.size else (1,)):
             pos = x1 if body == 1 else x2
             xs.append(times)
             ys.append(np.interp(times, t, pos))
         ax.plot(np.concatenate(xs), np.concatenate(ys), linestyle="none", marker="o",
                 markersize=size, markerfacecolor="none", markeredgewidth=1.2,
-                color=_CONTACT_COLOR[contact], gid=f"impact:{contact}", zorder=5,
-                label=f"impact, {_CONTACT_LABEL[contact]}")
+                color=_contact_color(contact, contacts), gid=f"impact:{contact}", zorder=5,
+                label=f"impact, {_CONTACT_LABEL.get(contact, contact)}")
 
     ax.set_ylim(*ylim)
     ax.set_ylabel("position (m)")
