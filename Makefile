@@ -17,8 +17,10 @@ export MPLBACKEND ?= Agg
 # Persistent meson build dir shared by `pip install` and `meson test`: one
 # compile serves the wheel and the Fortran unit tests, and re-runs are no-ops.
 BUILDDIR := $(CURDIR)/build/py
-# The tutorial's six cases, then the mechanisms beyond it (springs, dampers, static friction).
-SCENES   := case1 case2 case3 case4 case5 case6 impact_oscillator stick_slip gear_rattle breakaway mounted_stop
+# The tutorial's six cases, then the mechanisms beyond it (springs, dampers, static friction,
+# contact records).
+SCENES   := case1 case2 case3 case4 case5 case6 impact_oscillator stick_slip gear_rattle breakaway mounted_stop \
+            inner_stop
 
 # What the installed package is made of: a change re-installs it (folders too,
 # so that a deleted file counts).
@@ -32,7 +34,8 @@ INSTALL_STAMP := $(VENV)/.installed
 
 help:
 	@echo "make setup   gfortran (apt, if missing), .venv, pip install .[test]"
-	@echo "make demo    run the scenes in input/ (the six cases, springs, stick-slip, rattle, break-away),"
+	@echo "make demo    run the scenes in input/ (the six cases, springs, stick-slip, rattle, break-away,"
+	@echo "             contact records),"
 	@echo "             plot them, animate case 3 (docs/case3.gif)"
 	@echo "make test    Fortran unit tests (meson test), then pytest"
 	@echo "make study   case 5's rest time over (r_left, r_right), the impact oscillator's bifurcation diagram"

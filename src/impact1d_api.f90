@@ -115,9 +115,10 @@ contains
   !> A scene given as assignments (read_scene's form; texts as one blob, text k ending at
   !> text_end(k)), checked as a file's is, in the tutorial's flat fields (simulate's): values,
   !> given and the texts (text_codes(:text_lengths(k), k), in field_names' order) of a scene
-  !> of one or two bodies without records.
-  !> Arrays of one or two bodies fold into the tutorial's fields; a scene that needs the
-  !> N-body engine is an input error (status 1) until the engine has records.
+  !> of one or two bodies (its &contact and &spring records, checked here, are not in them:
+  !> simulate takes them as assignments of their own). Arrays of one or two bodies fold
+  !> into the tutorial's fields; more than two bodies are an input error (status 1) until
+  !> the cluster solver runs them.
   subroutine settle_scene(n_numbers, n_texts, number_room, field, index, value, text_room_in, text_field, &
       text_index, text_end, text_blob, n, text_room, values, given, text_codes, text_lengths, status, message)
     !f2py threadsafe
@@ -136,39 +137,19 @@ contains
     character(len=16384), intent(out) :: message    ! 16384: message_length (f2py needs the number)
     type(scene_input) :: input
     type(error_type), allocatable :: error
-    integer :: k, start
+    integer :: k
 
     values = 0.0_c_double
     given = 0
     text_codes = ichar(' ')
     text_lengths = 0
     if (.not. field_count_ok(n, status, message)) return
-    if (n_numbers > number_room .or. n_texts > text_room_in) then
-      status = status_input
-      message = 'internal: more assignments counted than given'
-      return
-    end if
-    ! (an array's element or a record is counted from 1; a scalar's index is 0)
-    if (any(field(:n_numbers) < 1 .or. field(:n_numbers) > n_ids .or. index(:n_numbers) < 0 .or. &
-        (field(:n_numbers) > id_arrays .and. field(:n_numbers) /= id_r_meet .and. index(:n_numbers) < 1)) .or. &
-        any(text_field(:n_texts) < 1 .or. text_field(:n_texts) > n_ids .or. &
-        (text_field(:n_texts) > id_arrays .and. text_index(:n_texts) < 1)) .or. &
-        any(text_end(:n_texts) < 0 .or. text_end(:n_texts) > len(text_blob))) then
-      status = status_input
-      message = 'internal: a field id, index or text end out of range'
-      return
-    end if
     do k = 1, n_text
       call set_text(input, k, '')
     end do
-    do k = 1, n_numbers
-      call assign_number(input, field(k), index(k), real(value(k), wp))
-    end do
-    start = 1
-    do k = 1, n_texts
-      call assign_text(input, text_field(k), text_index(k), text_blob(start:text_end(k)))
-      start = text_end(k) + 1
-    end do
+    call apply_assignments(input, .false., n_numbers, n_texts, field, index, value, text_field, text_index, &
+      text_end, text_blob, error)
+    if (failed(error, status, message)) return
     call settle_chain(input, error)
     if (.not. allocated(error)) call validate(input, .false., error)
     if (.not. allocated(error)) call validate_chain(input, error)
@@ -186,7 +167,9 @@ contains
     end if
   end subroutine settle_scene
 
-  !> Check and run a scene given as flat fields. The samples fill samples(:n_samples, :) and
+  !> Check and run a scene given as flat fields, its &contact and &spring records as
+  !> assignments (settle_scene's form, record fields only; n_numbers = n_texts = 0: none).
+  !> The samples fill samples(:n_samples, :) and
   !> the events the event arrays up to n_events; the run's row names fill row_name_codes(:,
   !> :n_rows) as character codes (blank-padded); when any needs more room than the caller
   !> gave (max_samples, max_events, max_rows), status is 3 and n_samples, n_events, n_rows
@@ -198,7 +181,8 @@ contains
   !> stick, 5 slip of body index ('stick', 'slip' and the body's number); it reports the
   !> bodies event_ends(:, j) (0: none; (1, 2) with two bodies, (1, 0) with one) with the
   !> velocities event_v(:, j) = [v_a before, v_b before, v_a after, v_b after].
-  subroutine simulate(n, values, given, title, f1_table, f2_table, method, substeps, events, progress, max_samples, &
+  subroutine simulate(n, values, given, title, f1_table, f2_table, method, substeps, events, n_numbers, n_texts, &
+      number_room, field, index, value, text_room_in, text_field, text_index, text_end, text_blob, progress, max_samples, &
       n_cols, max_events, max_rows, samples, has_column, event_t, event_class, event_index, event_ends, event_v, &
       row_name_codes, n_samples, n_events, n_rows, steps, energy_residual, status, message, warnings)
     !f2py threadsafe
@@ -206,6 +190,11 @@ contains
     real(c_double), intent(in) :: values(n)
     integer(c_int), intent(in) :: given(n)
     character(len=*), intent(in) :: title, f1_table, f2_table, method, substeps, events
+    integer(c_int), intent(in) :: n_numbers, n_texts, number_room, text_room_in
+    integer(c_int), intent(in) :: field(number_room), index(number_room), text_field(text_room_in), &
+      text_index(text_room_in), text_end(text_room_in)
+    real(c_double), intent(in) :: value(number_room)
+    character(len=*), intent(in) :: text_blob
     integer(c_int), intent(in) :: progress    !< non-zero: show progress on stderr after 1 s
     integer(c_int), intent(in) :: max_samples, n_cols, max_events, max_rows
     real(c_double), intent(out), target :: samples(max_samples, n_cols)
@@ -242,7 +231,9 @@ contains
       return
     end if
     input = flat_input(values, given, title, f1_table, f2_table, method, substeps, events)
-    call prepare_scene(input, scene, error)
+    call apply_assignments(input, .true., n_numbers, n_texts, field, index, value, text_field, text_index, &
+      text_end, text_blob, error)
+    if (.not. allocated(error)) call prepare_scene(input, scene, error)
     if (failed(error, status, message)) return
     warnings = scene%warnings
     call catch_interrupts()
@@ -285,18 +276,24 @@ contains
     end do
   end subroutine simulate
 
-  !> Run one scene n_runs times, run j with the real fields over_index(:) (1-based, in the
+  !> Run one scene (its records as simulate takes them) n_runs times, run j with the real fields over_index(:) (1-based, in the
   !> order of field_names) set to over_values(:, j), keeping only each run's summary (a
   !> summary_sink: no samples): summary(:, j) in the order of summary_names, status(j) and
   !> message_codes(:, j) (the message's character codes, blank-padded) say how it ended. A
   !> failing run is a status, never the end of the batch.
-  subroutine simulate_summaries(n, values, given, title, f1_table, f2_table, method, substeps, events, n_over, &
+  subroutine simulate_summaries(n, values, given, title, f1_table, f2_table, method, substeps, events, n_numbers, &
+      n_texts, number_room, field, index, value, text_room_in, text_field, text_index, text_end, text_blob, n_over, &
       over_index, n_runs, over_values, n_summary, summary, status, message_codes)
     !f2py threadsafe
     integer(c_int), intent(in) :: n, n_over, n_runs, n_summary
     real(c_double), intent(in) :: values(n), over_values(n_over, n_runs)
     integer(c_int), intent(in) :: given(n), over_index(n_over)
     character(len=*), intent(in) :: title, f1_table, f2_table, method, substeps, events
+    integer(c_int), intent(in) :: n_numbers, n_texts, number_room, text_room_in
+    integer(c_int), intent(in) :: field(number_room), index(number_room), text_field(text_room_in), &
+      text_index(text_room_in), text_end(text_room_in)
+    real(c_double), intent(in) :: value(number_room)
+    character(len=*), intent(in) :: text_blob
     real(c_double), intent(out) :: summary(n_summary, n_runs)
     integer(c_int), intent(out) :: status(n_runs)
     integer(c_int), intent(out) :: message_codes(512, n_runs)   ! 512 per run: see message_length
@@ -321,6 +318,13 @@ contains
       return
     end if
     base = flat_input(values, given, title, f1_table, f2_table, method, substeps, events)
+    call apply_assignments(base, .true., n_numbers, n_texts, field, index, value, text_field, text_index, &
+      text_end, text_blob, error)
+    if (allocated(error)) then
+      status = int(error%status, c_int)
+      call put_codes(error%message, message_codes(:, 1))
+      return
+    end if
     call catch_interrupts()
     do j = 1, n_runs
       input = base
@@ -349,6 +353,42 @@ contains
       if (scene%n_bodies == 1) summary(3:4, j) = ieee_value(1.0_c_double, ieee_quiet_nan)
     end do
   end subroutine simulate_summaries
+
+  !> Assignments (read_scene's form; texts as one blob, text k ending at text_end(k)) made
+  !> to input, their ids, indices and ends checked first; with records_only, only the
+  !> &contact and &spring record fields may be assigned (simulate's records).
+  subroutine apply_assignments(input, records_only, n_numbers, n_texts, field, index, value, text_field, &
+      text_index, text_end, text_blob, error)
+    type(scene_input), intent(inout) :: input
+    logical, intent(in) :: records_only
+    integer(c_int), intent(in) :: n_numbers, n_texts, field(:), index(:), text_field(:), text_index(:), text_end(:)
+    real(c_double), intent(in) :: value(:)
+    character(len=*), intent(in) :: text_blob
+    type(error_type), allocatable, intent(out) :: error
+    integer :: k, start, first
+    if (n_numbers > size(field) .or. n_texts > size(text_field)) then
+      call raise(error, status_input, 'internal: more assignments counted than given')
+      return
+    end if
+    ! (an array's element or a record is counted from 1; a scalar's index is 0)
+    first = merge(id_r_meet + 1, 1, records_only)
+    if (any(field(:n_numbers) < first .or. field(:n_numbers) > n_ids .or. index(:n_numbers) < 0 .or. &
+        (field(:n_numbers) > id_arrays .and. field(:n_numbers) /= id_r_meet .and. index(:n_numbers) < 1)) .or. &
+        any(text_field(:n_texts) < first .or. text_field(:n_texts) > n_ids .or. &
+        (text_field(:n_texts) > id_arrays .and. text_index(:n_texts) < 1)) .or. &
+        any(text_end(:n_texts) < 0 .or. text_end(:n_texts) > len(text_blob))) then
+      call raise(error, status_input, 'internal: a field id, index or text end out of range')
+      return
+    end if
+    do k = 1, n_numbers
+      call assign_number(input, field(k), index(k), real(value(k), wp))
+    end do
+    start = 1
+    do k = 1, n_texts
+      call assign_text(input, text_field(k), text_index(k), text_blob(start:text_end(k)))
+      start = text_end(k) + 1
+    end do
+  end subroutine apply_assignments
 
   !> Names of simulate_summaries' rows, space separated.
   subroutine summary_column_names(names)

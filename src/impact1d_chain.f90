@@ -7,7 +7,7 @@ module impact1d_chain
   use impact1d_kinds, only: wp, eps_wp
   use impact1d_error, only: error_type, raise, status_input, fmt
   use impact1d_scene, only: scene_input, real_names, text_names, n_real, n_text, set_text, name_of, value_or, &
-    positive_value, nonnegative_value, unit_interval, i_m1, i_m2, i_x_left, i_r_left, i_x_right, i_r_right, &
+    positive_value, nonnegative_value, unit_interval, resolvable, i_m1, i_m2, i_x_left, i_r_left, i_x_right, i_r_right, &
     i_r_min, i_d_min, i_g, default_gravity
   use impact1d_fields, only: n_arrays, array_names, array_is_link, array_is_text, alias_name, name_len, &
     record_input, a_m, a_mu, a_mus, a_x, a_f_amp, a_f_period, a_f_phase, a_k, a_x_rest, a_c, a_d_min, a_r_min, &
@@ -495,12 +495,13 @@ contains
   end subroutine check_names
 
   !> The initial positions satisfy every contact's limits (within the rounding of the
-  !> numbers the gap is made of, as for the tutorial's contacts).
+  !> numbers the gap is made of, as for the tutorial's contacts), and every limit, width
+  !> and initial gap is resolvable (impact1d_scene's resolvable, as the tutorial's are).
   subroutine check_start(input, records, error)
     type(scene_input), intent(in) :: input
     type(mechanism_records), intent(in) :: records
     type(error_type), allocatable, intent(inout) :: error
-    real(wp) :: x(0:n_bodies_of(input)), d, limit, scale
+    real(wp) :: x(0:n_bodies_of(input)), d, limit, scale, gap
     integer :: k, side
     character(len=:), allocatable :: what
     x(0) = 0.0_wp
@@ -516,13 +517,24 @@ contains
           if (.not. records%contact_has(side, k)) cycle
           limit = records%contact_limit(side, k)
           scale = max(abs(x(a)), abs(x(b)), abs(limit))
-          if (merge(d - limit, limit - d, side == 1) >= -16.0_wp * eps_wp * scale) cycle
-          call raise(error, status_input, 'the initial state violates the contact ''' // &
-            trim(records%contact_name(k)) // ''': ' // what // ' = ' // trim(fmt(d)) // ' is ' // &
-            trim(merge('below', 'above', side == 1)) // ' its ' // trim(merge('lower', 'upper', side == 1)) // &
-            ' limit ' // trim(fmt(limit)))
-          return
+          gap = merge(d - limit, limit - d, side == 1)
+          if (gap < -16.0_wp * eps_wp * scale) then
+            call raise(error, status_input, 'the initial state violates the contact ''' // &
+              trim(records%contact_name(k)) // ''': ' // what // ' = ' // trim(fmt(d)) // ' is ' // &
+              trim(merge('below', 'above', side == 1)) // ' its ' // trim(merge('lower', 'upper', side == 1)) // &
+              ' limit ' // trim(fmt(limit)))
+            return
+          end if
+          ! (within the rounding of its numbers a gap is contact, as in validate_bodies)
+          if (gap > 16.0_wp * eps_wp * scale) call resolvable('the initial gap of the contact ''' // &
+            trim(records%contact_name(k)) // ''' (' // what // ')', gap, scale, error)
+          if (a > 0) call resolvable('the contact ''' // trim(records%contact_name(k)) // '''s ' // &
+            trim(merge('d_min', 'd_max', side == 1)), limit, scale, error)
         end do
+        if (all(records%contact_has(:, k))) call resolvable('the contact ''' // &
+          trim(records%contact_name(k)) // '''s width d_max - d_min', &
+          records%contact_limit(2, k) - records%contact_limit(1, k), scale, error)
+        if (allocated(error)) return
       end associate
     end do
   end subroutine check_start

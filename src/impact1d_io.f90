@@ -11,7 +11,8 @@ module impact1d_io
   use impact1d_forcing, only: table_type
   use impact1d_fields, only: n_arrays, array_names, array_groups, array_is_text, n_contact_fields, contact_fields, &
     n_spring_fields, spring_fields, r_name, record_input, text_item
-  use impact1d_chain, only: settle_chain, validate_chain, slot_of, id_arrays, id_r_meet, id_contact, id_spring, n_ids
+  use impact1d_chain, only: settle_chain, validate_chain, slot_of, input_records, mechanism_records, id_arrays, id_r_meet, &
+    id_contact, id_spring, n_ids
   use impact1d_files, only: check_input_file
   implicit none
   private
@@ -84,12 +85,14 @@ contains
     if (allocated(error)) error%message = trim(path) // ': ' // error%message
   end subroutine read_scene_file
 
-  !> Read the force tables a checked input names, then build the model.
+  !> Read the force tables an input names, check it whole (its records too: a scene from
+  !> the flat API has not been read from a file), then build the model from its records.
   subroutine prepare_scene(input, scene, error)
     type(scene_input), intent(in) :: input
     type(scene_type), intent(out) :: scene
     type(error_type), allocatable, intent(out) :: error
     type(table_type) :: tables(2)
+    type(mechanism_records) :: records
     integer :: i
     do i = 1, 2
       if (len_trim(input%text(i_f1_table + i - 1)%s) == 0) cycle
@@ -99,7 +102,13 @@ contains
         return
       end if
     end do
-    call build_scene(input, tables, scene, error)
+    ! The records' ends index the bodies: checked (validate_chain) before they are made,
+    ! after the scene's values (validate, as build_scene does: its messages come first).
+    call validate(input, .true., error)
+    if (.not. allocated(error)) call validate_chain(input, error)
+    if (allocated(error)) return
+    call input_records(input, records)
+    call build_scene(input, tables, records, scene, error)
   end subroutine prepare_scene
 
   !> A namelist scene, read by its own parser: gfortran's namelist reader took an '&initial'

@@ -9,7 +9,8 @@ module impact1d_output
   use impact1d_interrupt, only: interrupt_count
   use impact1d_scene, only: scene_input, real_names, n_real, i_title, i_method, i_g, i_dt_out, &
     events_all, events_impacts, events_none, events_kept, name_len, &
-    i_dt, default_gravity, i_k1, i_k2, i_k12, i_c1, i_c2, i_c12, i_m2
+    i_dt, default_gravity, i_m2, springs_named
+  use impact1d_fields, only: n_contact_fields, contact_fields, n_spring_fields, spring_fields, r_name
   use impact1d_files, only: output_target, make_temporary, resolve_output, lock_folders, unlock_folders, write_text, &
     lock_timed_out, lock_wait
   implicit none
@@ -254,8 +255,7 @@ contains
     integer :: k
     keep = .true.
     keep([4, 5]) = input%given(i_m2)           ! x2, v2: only with a second body
-    keep(i_pe) = any(input%given([i_k1, i_k2, i_k12]))
-    keep(i_damping_loss) = any(input%given([i_c1, i_c2, i_c12]))
+    keep([i_pe, i_damping_loss]) = springs_named(input)
     columns = pack([(k, k = 1, n_columns)], keep)
   end function present_columns
 
@@ -600,6 +600,7 @@ contains
         call self%put_line(self%unit, '# dt_out = ' // trim(fmt(input%value(i_dt))))
       end if
     end do
+    call put_records(self, input)
     call names_of(self%columns, header)
     call self%put_line(self%unit, '#' // header)
     if (self%events == events_none) return
@@ -647,6 +648,39 @@ contains
     if (ios /= 0) self%write_failure = self%event_path // ': ' // trim(reason(message))
     self%bytes(2) = self%bytes(2) + self%event_bytes
   end subroutine file_put_event
+
+  !> The scene's &contact and &spring records in the header, a line per given field in the
+  !> form of the others ('# contact.2.d_min = 0.5', '# spring.1.k = 40.0'), so that a reader
+  !> rebuilds the scene (impact1d.read_output: Scene.contacts, springs).
+  subroutine put_records(self, input)
+    class(file_sink), intent(inout) :: self
+    type(scene_input), intent(in) :: input
+    integer :: r, f
+    character(len=32) :: key
+    if (allocated(input%chain%contacts)) then
+      do r = 1, size(input%chain%contacts)
+        associate (rec => input%chain%contacts(r))
+          do f = 1, n_contact_fields
+            write(key, '("contact.", i0, ".", a)') r, trim(contact_fields(f))
+            if (f /= r_name .and. rec%given(f)) call self%put_line(self%unit, '# ' // trim(key) // ' = ' // &
+              trim(fmt(rec%value(f))))
+          end do
+          if (allocated(rec%name)) then
+            write(key, '("contact.", i0, ".name")') r
+            if (len_trim(rec%name) > 0) call self%put_line(self%unit, '# ' // trim(key) // ' = ' // rec%name)
+          end if
+        end associate
+      end do
+    end if
+    if (.not. allocated(input%chain%springs)) return
+    do r = 1, size(input%chain%springs)
+      do f = 1, n_spring_fields
+        write(key, '("spring.", i0, ".", a)') r, trim(spring_fields(f))
+        if (input%chain%springs(r)%given(f)) call self%put_line(self%unit, '# ' // trim(key) // ' = ' // &
+          trim(fmt(input%chain%springs(r)%value(f))))
+      end do
+    end do
+  end subroutine put_records
 
   !> A header line, checked like every row.
   subroutine put_line(self, unit, text)

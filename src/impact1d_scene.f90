@@ -8,7 +8,7 @@ module impact1d_scene
   use impact1d_forcing, only: forcing_type, table_type
   use impact1d_springs, only: springs_type, pair_elements
   use impact1d_modes, only: pair_type, pair_rows
-  use impact1d_fields, only: chain_input
+  use impact1d_fields, only: chain_input, mechanism_records, r_k, r_c
   use impact1d_stability, only: linear_modes, stable_step, mode_error, coarse_rate
   implicit none
   private
@@ -22,7 +22,7 @@ module impact1d_scene
   public :: positive_value, nonnegative_value, unit_interval, resolvable
   public :: i_title, i_f1_table, i_f2_table, i_method, i_substeps, i_events, default_gravity
   public :: events_all, events_impacts, events_none
-  public :: name_len, set_rows, allocate_contacts, set_springs
+  public :: name_len, set_rows, allocate_contacts, set_springs, springs_named
 
   integer, parameter :: n_real = 44, n_text = 6
   !> Names of the real inputs, as in the namelist and in Python's Scene, in this order.
@@ -45,12 +45,11 @@ module impact1d_scene
   !> What only a second body can have: refused in a one-body scene (no m2).
   integer, parameter :: body2_fields(18) = [i_x2, i_v2, i_mu2, i_mus2, i_f2, i_f2_amp, i_f2_period, &
     i_f2_phase, i_k2, i_x2_rest, i_c2, i_k12, i_d_rest, i_c12, i_d_min, i_r_min, i_d_max, i_r_max]
-  !> The tutorial's spring elements (records in this order, docs/nbody-plan.md B5): body 1
-  !> to the ground, body 2 to the ground, between the bodies; each one's stiffness (its rest
-  !> position and damping follow it) and ends.
+  !> The tutorial's spring elements (body 1 to the ground, body 2 to the ground, between the
+  !> bodies: impact1d_chain's input_records makes their records, in this order); each one's
+  !> stiffness (its rest position and damping follow it).
   integer, parameter :: n_tutorial_elements = 3
   integer, parameter :: spring_index(n_tutorial_elements) = [i_k1, i_k2, i_k12]
-  integer, parameter :: tutorial_element_body(2, n_tutorial_elements) = reshape([0, 1, 0, 2, 1, 2], [2, 3])
   integer, parameter :: i_title = 1, i_f1_table = 2, i_f2_table = 3, i_method = 4, i_substeps = 5, &
     i_events = 6
   !> What the event log keeps (&run events): every event, the impacts only, nothing. The
@@ -58,7 +57,7 @@ module impact1d_scene
   integer, parameter :: events_all = 0, events_impacts = 1, events_none = 2
 
   !> The tutorial's four optional limits (left, right, slot_min, slot_max: the rows of its
-  !> scenes in this order, which validate checks and set_contacts turns into records).
+  !> scenes in this order, which validate checks; input_records makes their records).
   integer, parameter :: n_limits = 4, i_left = 1, i_right = 2, i_slot_min = 3, i_slot_max = 4
   character(len=*), parameter :: contact_names(n_limits) = [character(len=8) :: &
     'left', 'right', 'slot_min', 'slot_max']
@@ -71,17 +70,11 @@ module impact1d_scene
 
   !> Longest name of a contact record or row ('slot_max', a user's '<name>_min').
   integer, parameter :: name_len = 32
-  !> The tutorial's contact records, in the order of docs/nbody-plan.md B4: 'left' (the
-  !> ground and body 1, lower limit x_left), 'right' (the ground and body N, upper limit
-  !> x_right), 'slot' (bodies 1 and 2, lower limit d_min or their meeting, upper d_max); and
-  !> which record and end (1 lower, 2 upper) each of the four tutorial limits is.
-  character(len=*), parameter :: tutorial_records(3) = [character(len=5) :: 'left', 'right', 'slot']
-  integer, parameter :: limit_record(n_limits) = [1, 2, 3, 3], limit_end(n_limits) = [1, 2, 1, 2]
 
   real(wp), parameter :: default_gravity = 9.80665_wp
-  !> What a scene that needs the N-body engine gets until the engine has records (is_nbody).
-  character(len=*), parameter :: nbody_refusal = 'scenes of more than two bodies, and &contact or &spring ' // &
-    'records, need the N-body engine (issue 19, stage 2-4): this build reads and checks them but cannot run them yet'
+  !> What a scene of more than two bodies gets until the cluster solver runs it (is_nbody).
+  character(len=*), parameter :: nbody_refusal = 'more than two bodies need the cluster solver (issue 19, ' // &
+    'stage 4): this build reads and checks such scenes but cannot run them yet'
   !> The tutorial's zero-velocity threshold, used by the vissim method only.
   real(wp), parameter :: default_zero_velocity = 0.005_wp
   !> Output rows a run may produce: beyond this the user almost surely meant a larger dt_out.
@@ -454,13 +447,11 @@ contains
     if (len_trim(input%spelled(i)) > 0) name = input%spelled(i)
   end function name_of
 
-  !> Whether the scene needs the N-body engine: more than two bodies (written as arrays),
-  !> or &contact / &spring records.
+  !> Whether the scene needs the N-body engine: more than two bodies (written as arrays).
+  !> Records on one or two bodies run on the two-body kernels.
   pure logical function is_nbody(input)
     type(scene_input), intent(in) :: input
     is_nbody = input%chain%n_bodies > 2
-    if (allocated(input%chain%contacts)) is_nbody = is_nbody .or. size(input%chain%contacts) > 0
-    if (allocated(input%chain%springs)) is_nbody = is_nbody .or. size(input%chain%springs) > 0
   end function is_nbody
 
   !> What the event log of a run of this input keeps (&run events; all by default).
@@ -628,17 +619,18 @@ contains
     offset_of = offset_sign(k) * limit_value(input, k)
   end function offset_of
 
-  !> Validate and build the model. tables(i) holds f_i's table when the input names one.
-  subroutine build_scene(input, tables, scene, error)
+  !> Validate and build the model. tables(i) holds f_i's table when the input names one;
+  !> records are the scene's contacts and elements (impact1d_chain's input_records).
+  subroutine build_scene(input, tables, records, scene, error)
     type(scene_input), intent(in) :: input
     type(table_type), intent(in) :: tables(2)
+    type(mechanism_records), intent(in) :: records
     type(scene_type), intent(out) :: scene
     type(error_type), allocatable, intent(out) :: error
-    integer :: k
 
     call validate(input, .true., error)
     if (allocated(error)) return
-    ! The records of such a scene (impact1d_chain's input_records) wait for the engine's.
+    ! Up to two bodies the two-body kernels run any records (set_rows counts their rows).
     if (is_nbody(input)) then
       call raise(error, status_input, nbody_refusal)
       return
@@ -648,10 +640,9 @@ contains
     scene%method = 'event'
     if (len_trim(input%text(i_method)%s) > 0) scene%method = trim(input%text(i_method)%s)
     call set_bodies(input, tables, scene)
-    call set_contacts(input, scene)
+    call set_records(input, records, scene)
     call set_rows(scene, error)
     if (allocated(error)) return
-    call set_elements(input, scene)
     call set_springs(scene, error)
     if (allocated(error)) return
 
@@ -727,71 +718,44 @@ contains
     call scene%forcing%set_varies()
   end subroutine set_bodies
 
-  !> The tutorial's walls and slot as contact records (docs/nbody-plan.md section 1): a wall
-  !> when the scene names it, the slot whenever there are two bodies (they cannot pass each
-  !> other: the meeting d_min = 0 unless d_min is given). With one body the right wall holds
-  !> body 1. A limit of -0 enters as +0 (docs/architecture.md, "Signed zeros").
-  subroutine set_contacts(input, scene)
+  !> The model's contact and element records: impact1d_chain's input_records (the walls,
+  !> the slot, then the &contact records; the springs k1, k2, k12, then the &spring records:
+  !> the orders of docs/nbody-plan.md B4, B5). A limit of -0 enters as +0 (docs/architecture.md,
+  !> "Signed zeros"). Which of the elements the scene names as springs or dampers sets the
+  !> output's pe and damping_loss columns (springs%has_spring, has_damper).
+  subroutine set_records(input, records, scene)
     type(scene_input), intent(in) :: input
+    type(mechanism_records), intent(in) :: records
     type(scene_type), intent(inout) :: scene
-    integer :: j, k, r, nc
-    integer :: record_of(size(tutorial_records))
-    logical :: present(size(tutorial_records))
-    present = [(any([(has_limit(input, k) .and. limit_record(k) == r, k = 1, n_limits)]), &
-      r = 1, size(tutorial_records))]
-    nc = count(present)
-    call allocate_contacts(scene, nc)
-    j = 0
-    record_of = 0
-    do r = 1, size(tutorial_records)
-      if (.not. present(r)) cycle
-      j = j + 1
-      record_of(r) = j
-      scene%contact_name(j) = tutorial_records(r)
-    end do
-    if (record_of(1) > 0) scene%contact_body(:, record_of(1)) = [0, 1]
-    if (record_of(2) > 0) scene%contact_body(:, record_of(2)) = [0, scene%n_bodies]
-    if (record_of(3) > 0) scene%contact_body(:, record_of(3)) = [1, 2]
-    do k = 1, n_limits
-      if (.not. has_limit(input, k)) cycle
-      associate (e => limit_end(k), j => record_of(limit_record(k)))
-        scene%contact_has(e, j) = .true.
-        scene%contact_limit(e, j) = limit_value(input, k) + 0.0_wp
-        scene%contact_restitution(e, j) = value_or(input, limit_index(k) + 1, 1.0_wp)
-      end associate
-    end do
-  end subroutine set_contacts
+    logical :: named(2)
+    call allocate_contacts(scene, records%n_contacts)
+    scene%contact_body = records%contact_body
+    scene%contact_has = records%contact_has
+    scene%contact_limit = records%contact_limit + 0.0_wp
+    scene%contact_restitution = records%contact_restitution
+    scene%contact_name = records%contact_name
+    scene%n_elements = records%n_elements
+    scene%element_body = records%element_body
+    scene%element_k = records%element_k
+    scene%element_c = records%element_c
+    scene%element_rest = records%element_rest
+    named = springs_named(input)
+    scene%springs%has_spring = named(1)
+    scene%springs%has_damper = named(2)
+  end subroutine set_records
 
-  !> The tutorial's springs and dampers as element records, in the order k1, k2, k12 (the
-  !> order of the sums, docs/nbody-plan.md B5): one where the scene names its stiffness or
-  !> its damping (a damper alone has k = 0, rest 0). Which of them the scene names sets the
-  !> output's PE and damping_loss columns (springs%has_spring, has_damper).
-  subroutine set_elements(input, scene)
+  !> Whether the scene names a stiffness, and a damping: the tutorial's k1, k2, k12 (c1, c2,
+  !> c12) or a &spring record's k (c). They decide the pe and damping_loss columns.
+  pure function springs_named(input) result(named)
     type(scene_input), intent(in) :: input
-    type(scene_type), intent(inout) :: scene
-    integer :: j, k, ne
-    logical :: named(n_tutorial_elements)
-    named = input%given(spring_index) .or. input%given(spring_index + 2)
-    ne = count(named)
-    scene%n_elements = ne
-    allocate(scene%element_body(2, ne), scene%element_k(ne), scene%element_c(ne), scene%element_rest(ne))
-    scene%element_k = 0.0_wp
-    scene%element_c = 0.0_wp
-    scene%element_rest = 0.0_wp
-    j = 0
-    do k = 1, n_tutorial_elements
-      if (.not. named(k)) cycle
-      j = j + 1
-      scene%element_body(:, j) = tutorial_element_body(:, k)
-      if (input%given(spring_index(k))) then
-        scene%element_k(j) = input%value(spring_index(k))
-        scene%element_rest(j) = input%value(spring_index(k) + 1)
-      end if
-      if (input%given(spring_index(k) + 2)) scene%element_c(j) = input%value(spring_index(k) + 2)
+    logical :: named(2)
+    integer :: r
+    named = [any(input%given(spring_index)), any(input%given(spring_index + 2))]
+    if (.not. allocated(input%chain%springs)) return
+    do r = 1, size(input%chain%springs)
+      named = named .or. input%chain%springs(r)%given([r_k, r_c])
     end do
-    scene%springs%has_spring = any(input%given(spring_index))
-    scene%springs%has_damper = any(input%given(spring_index + 2))
-  end subroutine set_elements
+  end function springs_named
 
   !> The element records as the two-body kernels see them (their ends as lanes: body i is
   !> lane i, the ground 0), and the rate bound that samples their motion.

@@ -281,11 +281,11 @@ def test_flat_simulate_says_what_room_it_needs():
     """The flat API writes a run's rows straight into the caller's array; when that array
     (or the event arrays) is too small it says so with the sizes needed (status 3), and a
     call with those sizes gives the rows simulate() returns."""
-    from impact1d._scene import _api, to_core
+    from impact1d._scene import _api, to_core, record_assignments
     from impact1d._simulate import COLUMNS
     scene = impact1d.load_scene(INPUT / "case5.nml")
     expected = impact1d.simulate(scene)
-    core = to_core(scene)
+    core = (*to_core(scene), *record_assignments(scene))
     # (case 5 has the walls and both slot limits: four rows)
     for rows, events, contact_rows in ((3, 2000, 8), (len(expected.t) + 1, 2, 8), (len(expected.t) + 1, 2000, 1)):
         out = _api.simulate(*core, 0, rows, len(COLUMNS), events, contact_rows)

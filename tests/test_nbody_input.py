@@ -25,6 +25,10 @@ CHAIN = """&bodies  m = 5*1.0, mu = 5*0.1, mus = 5*0.15, g = 9.81 /
 """ + RUN
 
 
+# What a scene of more than two bodies gets until the cluster solver runs it.
+REFUSAL = "more than two bodies need the cluster solver (issue 19, stage 4)"
+
+
 def scene_file(tmp_path, text, name="scene.nml"):
     path = tmp_path / name
     path.write_text(text)
@@ -32,7 +36,7 @@ def scene_file(tmp_path, text, name="scene.nml"):
 
 
 def refused(tmp_path, text, match):
-    """Refused when read, or (a scene that needs the N-body engine) when run."""
+    """Refused when read, or (more than two bodies) when run."""
     with pytest.raises(impact1d.InputError, match=match) as caught:
         impact1d.simulate(impact1d.load_scene(scene_file(tmp_path, text)))
     assert "\n" not in str(caught.value)
@@ -128,13 +132,17 @@ def test_record_faults(tmp_path, record, match):
 def test_records_are_repeatable_and_given_twice_is_per_record(tmp_path):
     """Two &contact groups are two records (another group given twice is still refused)."""
     text = CHAIN.replace("&spring ", "&spring a = 2, b = 4, c = 1.0 /\n&spring ")
-    refused(tmp_path, text, "need the N-body engine")
+    refused(tmp_path, text, "more than two bodies need the cluster solver")
     refused(tmp_path, CHAIN + "&walls x_left = -2 /\n", r"&walls is given twice")
 
 
 @pytest.mark.parametrize("extra", ["&contact a = 1, b = 2, d_min = -1 /", "&spring a = 0, b = 1, k = 1, d_rest = 1 /"])
-def test_records_on_two_bodies_wait_for_the_engine(tmp_path, extra):
-    refused(tmp_path, CASE3 + extra + "\n", re.escape("need the N-body engine (issue 19, stage 2-4)"))
+def test_records_on_two_bodies_run(tmp_path, extra):
+    """Records on one or two bodies run on the two-body kernels (tests/test_records_run.py
+    checks what they give); the scene read back keeps them."""
+    scene = impact1d.load_scene(scene_file(tmp_path, CASE3 + extra + "\n"))
+    res = impact1d.simulate(scene)
+    assert res.events.size > 0 and (res.scene.contacts or res.scene.springs)
 
 
 def test_chain_is_read_checked_and_refused_by_the_cli(tmp_path):
@@ -142,17 +150,24 @@ def test_chain_is_read_checked_and_refused_by_the_cli(tmp_path):
     done = subprocess.run([cli, str(scene_file(tmp_path, CHAIN)), "-o", str(tmp_path / "out.dat")],
                           capture_output=True, text=True, timeout=60)
     assert done.returncode == 1
-    assert "need the N-body engine (issue 19, stage 2-4)" in done.stderr
+    assert REFUSAL in done.stderr
     assert not (tmp_path / "out.dat").exists()
 
 
 def test_the_documented_examples_pass_every_check(tmp_path):
-    """docs/formats.md's chain and record examples are scenes that only wait for the engine."""
+    """docs/formats.md's examples: the two-body scene with records runs (its events named
+    by the records, as the text says), the chain and records of five bodies wait for the
+    cluster solver."""
     doc = (Path(__file__).resolve().parent.parent / "docs" / "formats.md").read_text()
     section = doc[doc.index("### Scenes of N bodies"):doc.index("## VisSim-style parameter file")]
-    lines = [line.strip() for line in section.splitlines() if line.startswith("    &")]
-    assert len(lines) == 9
-    refused(tmp_path, "\n".join(lines) + "\n" + RUN, re.escape("need the N-body engine (issue 19, stage 2-4)"))
+    blocks = [[line.strip() for line in block.splitlines() if line.startswith("    &")]
+              for block in section.split("\n\n")]
+    blocks = [block for block in blocks if block]
+    two_body, chain = blocks[0], [line for block in blocks[1:] for line in block]
+    assert len(two_body) == 7 and len(chain) == 9
+    res = impact1d.simulate(impact1d.load_scene(scene_file(tmp_path, "\n".join(two_body) + "\n", "two.nml")))
+    assert {"stop", "rest_stop", "wall1"} <= set(res.events["kind"])
+    refused(tmp_path, "\n".join(chain) + "\n" + RUN, re.escape(REFUSAL))
 
 
 # --- Python: Scene arrays and records, through the core's assignments ------------------
@@ -180,7 +195,7 @@ def test_load_scene_of_a_chain_gives_arrays_and_records(tmp_path):
     assert scene.contacts == [{"a": 0, "b": 3, "d_min": -1.0, "r_min": 0.8, "name": "stop3"},
                               {"a": 2, "b": 5, "d_min": 0.1, "r_min": 0.5, "d_max": 1.0, "r_max": 0.0}]
     assert scene.springs == [{"a": 1, "b": 3, "k": 40.0, "d_rest": 0.5, "c": 0.1}]
-    with pytest.raises(impact1d.InputError, match=re.escape("need the N-body engine (issue 19, stage 2-4)")):
+    with pytest.raises(impact1d.InputError, match=re.escape(REFUSAL)):
         impact1d.simulate(scene)
     # The same checks as a file's, on what Python changed.
     bad = dataclasses.replace(scene, contacts=scene.contacts + [{"a": 1, "b": 6, "d_min": 0.0}])

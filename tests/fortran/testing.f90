@@ -9,6 +9,7 @@ module testing
   use impact1d_modes, only: pair_rows
   use impact1d_scene, only: scene_input, scene_type, build_scene, real_names, n_real, i_f1_table, set_text, n_text, &
     i_m2, i_x2
+  use impact1d_chain, only: input_records, mechanism_records
   implicit none
   private
   public :: check, finish, two_body, on_rows, row_values, row_of
@@ -44,6 +45,7 @@ contains
     logical, intent(in), optional :: one_body
     type(scene_input) :: input
     type(table_type) :: tables(2)
+    type(mechanism_records) :: records
     type(error_type), allocatable :: error
     integer :: k
     do k = 1, n_text
@@ -58,7 +60,8 @@ contains
       call set_text(input, i_f1_table, 'f1_table')
       tables(1) = f1_table
     end if
-    call build_scene(input, tables, scene, error)
+    call input_records(input, records)
+    call build_scene(input, tables, records, scene, error)
     if (allocated(error)) then
       print '(a)', 'two_body(''' // assignments // '''): ' // error%message
       error stop 1

@@ -7,7 +7,7 @@ the event log (t, kind, velocities before/after) with tests/golden/hashes.json.
 
 The scenes: the seed cases input/case*.nml at their own dt, at dt = 0.1 and under
 method='vissim'; the other input/*.nml scenes (springs, dampers, static friction, one
-body); the bench scenes bench/scenes/*.nml; the one-body and spring/damper scenes of
+body, contact records); the bench scenes bench/scenes/*.nml; the one-body and spring/damper scenes of
 SCENES (from tests/test_model_widening.py and tests/test_exact_springs.py); and
 GENERATED scenes of tests/test_reference.py (its own generator, fixed indices) at two
 steps.  A refactoring that must change no result runs this on every commit; --update

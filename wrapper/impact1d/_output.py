@@ -7,7 +7,8 @@ import os
 
 import numpy as np
 
-from ._scene import REAL_FIELDS, TEXT_FIELDS, Scene, InputError, load_scene, is_nbody_form, from_core, to_core
+from ._scene import (REAL_FIELDS, TEXT_FIELDS, Scene, InputError, load_scene, is_nbody_form, from_core, to_core,
+                     _put)
 from ._files import check_input
 from ._simulate import (COLUMNS, OPTIONAL_COLUMNS, EVENT_DTYPE, ONE_BODY_EVENT_DTYPE, Result,
                         result_from_columns)
@@ -100,6 +101,12 @@ def read_output(path, scene=None) -> Result:
     for name in TEXT_FIELDS:
         if name in header:
             kwargs[name] = header[name]
+    # The records: '# contact.2.d_min = 0.5', '# spring.1.k = 40.0' (in record order).
+    for key, value in header.items():
+        group, _, rest = key.partition(".")
+        number, _, field = rest.partition(".")
+        if group in ("contact", "spring") and number.isdigit() and field:
+            _put(kwargs, f"{group}.{field}", int(number), value if field == "name" else float(value))
     header_scene = Scene(**kwargs, source=header.get("scene"))
 
     events_file = events_path(path)

@@ -10,7 +10,7 @@ from typing import Optional
 import numpy as np
 
 from ._scene import (REAL_FIELDS, Scene, InputError, SimulationError, decode, raise_for_status, to_core, _words, _api,
-                     from_core, is_nbody_form,
+                     from_core, is_nbody_form, record_assignments,
                      _STATUS_INTERRUPTED)
 from ._scene import STATUS_TOO_SMALL as _STATUS_TOO_SMALL
 
@@ -38,7 +38,8 @@ _OVERRIDABLE = tuple(f.name for f in dataclasses.fields(Scene))
 
 # Room for events a run starts with (most runs log fewer), and the most a hint asks for.
 _EVENT_CAPACITY = 256
-# Rows a scene has (the flat API says when it has more): the tutorial's at most four.
+# Rows a scene has (the flat API says when it has more): at most pair_rows = 8 (the
+# tutorial's four, and records on one or two bodies).
 _ROW_CAPACITY = 8
 _EVENT_CAPACITY_MAX = 1 << 22
 _event_capacity = _EVENT_CAPACITY
@@ -63,7 +64,8 @@ def run_summaries(scene: Scene, overrides: list):
     index = np.array([REAL_FIELDS.index(name) + 1 for name in names], dtype=np.int32)
     matrix = np.array([[run[name] for name in names] for run in overrides],
                       dtype=np.float64).reshape(len(overrides), len(names)).T
-    summary, status, codes = _api.simulate_summaries(*to_core(_with_overrides(scene, {})),
+    scene = _with_overrides(scene, {})
+    summary, status, codes = _api.simulate_summaries(*to_core(scene), *record_assignments(scene),
                                                      index, matrix, len(_summary_names()))
     errors = [""] * len(overrides)
     for j in np.flatnonzero(status):
@@ -239,9 +241,12 @@ def simulate(scene: Scene, *, progress: bool = False, **overrides) -> Result:
                          f"(known: {', '.join(_OVERRIDABLE)})")
     scene = _with_overrides(scene, overrides)
     values, given, *texts = to_core(scene)
+    records = record_assignments(scene)
     if is_nbody_form(scene):
-        # (written with arrays: the Result's scene is the one run, in the tutorial's names)
-        scene = from_core(values, given, *texts, source=scene.source)
+        # (written with arrays: the Result's scene is the one run, in the tutorial's names,
+        # with its records)
+        scene = dataclasses.replace(from_core(values, given, *texts, source=scene.source),
+                                    contacts=scene.contacts, springs=scene.springs)
 
     # The core fills arrays made for this call (no state is kept between calls, so threads
     # may run at once); when a guess at their size is short it says what is needed.
@@ -250,7 +255,7 @@ def simulate(scene: Scene, *, progress: bool = False, **overrides) -> Result:
     while True:
         (samples, has_column, event_t, event_class, event_index, _event_ends, event_v, row_name_codes,
          n_samples, n_events, n_rows, steps, energy_residual, status, message,
-         warnings) = _api.simulate(values, given, *texts, 1 if progress else 0, sample_capacity,
+         warnings) = _api.simulate(values, given, *texts, *records, 1 if progress else 0, sample_capacity,
                                    len(COLUMNS), event_capacity, row_capacity)
         if int(status) != _STATUS_TOO_SMALL:
             break

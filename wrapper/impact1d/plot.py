@@ -153,7 +153,8 @@ def _event_times(events, kind):
 
 
 def _contacts_present(result, events):
-    """Contacts drawn in the impact panel: those the scene has, plus any that had events."""
+    """Contacts drawn in the impact panel: the tutorial's the scene has, plus any that had
+    events, then the rows of its &contact records."""
     limits = {
         "left": "x_left",
         "right": "x_right",
@@ -165,7 +166,24 @@ def _contacts_present(result, events):
         for c in CONTACTS:
             if kind in (c, "rest_" + c, "release_" + c):
                 seen.add(c)
-    return [c for c in CONTACTS if c in seen or _float_or_none(_scene_value(result, limits[c])) is not None]
+    tutorial = [c for c in CONTACTS if c in seen or _float_or_none(_scene_value(result, limits[c])) is not None]
+    # The rows of the scene's &contact records (one or two bodies), after the tutorial's.
+    scene = getattr(result, "scene", None)
+    records = (None if scene is None else _field(scene, "contacts")) or []
+    extra = [row.name for j, record in enumerate(records) for row in _record_rows(j, record)]
+    return tutorial + [name for name in dict.fromkeys(extra) if name not in tutorial]
+
+
+# Colours of the records' rows (impact panel), after the tutorial's four, in turn.
+_RECORD_COLORS = ("tab:pink", "tab:olive", "tab:cyan", "tab:gray", "gold", "navy", "teal", "maroon")
+
+
+def _contact_color(contact, contacts):
+    """A tutorial contact's own colour; a record's row one of _RECORD_COLORS by its place."""
+    if contact in _CONTACT_COLOR:
+        return _CONTACT_COLOR[contact]
+    extra = [c for c in contacts if c not in _CONTACT_COLOR]
+    return _RECORD_COLORS[extra.index(contact) % len(_RECORD_COLORS)]
 
 
 def _rest_intervals(events, contact, t_start, t_end):
@@ -436,22 +454,26 @@ def _draw_positions(ax, result, events):
         ax.plot(t, x2, color=_BODY_COLOR[2], linewidth=1.4, gid="x2", label="x2 (body 2)")
 
     # Smaller markers when impacts crowd (long runs), so the paths stay visible.
-    n_impacts = sum(1 for _, k in events if k in CONTACTS)
+    contacts = _contacts_present(result, result.events)
+    n_impacts = sum(1 for _, k in events if k in contacts)
     size = 5 if n_impacts <= 150 else 3
-    for contact in CONTACTS:
+    # The bodies a record's row involves (its ends but the ground).
+    bodies = {row.name: tuple(e for e in (row.a, row.b) if e > 0) for row in _rows(result, 2 if x2.size else 1)}
+    bodies.update(_CONTACT_BODIES)
+    for contact in CONTACTS + tuple(c for c in contacts if c not in CONTACTS):
         times = _event_times(events, contact)
         if times.size == 0:
             continue
         xs, ys = [], []
         # One body: both walls hold body 1.
-        for body in (_CONTACT_BODIES[contact] if x2.size else (1,)):
+        for body in (bodies[contact] if x2.size else (1,)):
             pos = x1 if body == 1 else x2
             xs.append(times)
             ys.append(np.interp(times, t, pos))
         ax.plot(np.concatenate(xs), np.concatenate(ys), linestyle="none", marker="o",
                 markersize=size, markerfacecolor="none", markeredgewidth=1.2,
-                color=_CONTACT_COLOR[contact], gid=f"impact:{contact}", zorder=5,
-                label=f"impact, {_CONTACT_LABEL[contact]}")
+                color=_contact_color(contact, contacts), gid=f"impact:{contact}", zorder=5,
+                label=f"impact, {_CONTACT_LABEL.get(contact, contact)}")
 
     ax.set_ylim(*ylim)
     ax.set_ylabel("position (m)")
@@ -526,7 +548,7 @@ def _draw_impacts(ax, result, events):
     n = len(contacts)
     for row, contact in enumerate(contacts):
         y = n - 1 - row  # first contact on top
-        color = _CONTACT_COLOR[contact]
+        color = _contact_color(contact, contacts)
         # A rest that began before the window still shows in it: bars from every event.
         bars = _rest_intervals(result.events, contact, *result.run)
         if bars:
@@ -543,7 +565,7 @@ def _draw_impacts(ax, result, events):
         ax.text(0.5, 0.5, "no walls, no slot", transform=ax.transAxes, ha="center",
                 va="center", fontsize="small", color="0.5")
     ax.set_yticks(range(n))
-    ax.set_yticklabels([_CONTACT_LABEL[c] for c in reversed(contacts)])
+    ax.set_yticklabels([_CONTACT_LABEL.get(c, c) for c in reversed(contacts)])
     ax.set_ylim(-0.6, n - 0.4 if n else 0.6)
     ax.set_ylabel("impacts")
     _finish_time_axis(ax, result)
@@ -664,9 +686,11 @@ class _Row(NamedTuple):
     record: int         # the record it comes from (a slot's two rows share one)
 
 
-def _tutorial_records(result, n):
+def _tutorial_records(result, n, joined=False):
     """Today's walls and slot as contact records (docs/nbody-plan.md, 'Today's scene in
-    records'): left (0, 1) lower, right (0, N) upper, the slot (1, 2) with its meeting."""
+    records'): left (0, 1) lower, right (0, N) upper, the slot (1, 2) with its meeting
+    (none when a record joins the bodies, `joined`, and the scene gives no d_min: the
+    record replaces the meeting, as in the engine)."""
     value = {name: _float_or_none(_scene_value(result, name))
              for name in ("x_left", "x_right", "d_min", "d_max")}
     records = []
@@ -675,8 +699,13 @@ def _tutorial_records(result, n):
     if value["x_right"] is not None:
         records.append(dict(a=0, b=n, d_max=value["x_right"], name="right"))
     if n == 2:
-        records.append(dict(a=1, b=2, d_min=value["d_min"] or 0.0, d_max=value["d_max"],
-                            name="slot", name_min="slot_min", name_max="slot_max"))
+        slot = dict(a=1, b=2, name="slot", name_min="slot_min", name_max="slot_max")
+        if value["d_min"] is not None or not joined:
+            slot["d_min"] = value["d_min"] or 0.0
+        if value["d_max"] is not None:
+            slot["d_max"] = value["d_max"]
+        if "d_min" in slot or "d_max" in slot:
+            records.append(slot)
     return records
 
 
@@ -701,11 +730,14 @@ def _record_rows(j, record):
 
 
 def _rows(result, n):
+    """The contact rows in the engine's order: today's walls and slot (a one- or two-body
+    scene's), then the scene's records (unnamed: contact<j>, j counting the records)."""
     scene = getattr(result, "scene", None)
-    records = None if scene is None else _field(scene, "contacts")
-    if records is None:
-        records = _tutorial_records(result, n)
-    return [row for j, record in enumerate(records) for row in _record_rows(j, record)]
+    records = (None if scene is None else _field(scene, "contacts")) or []
+    joined = any(sorted((int(_field(r, "a", 0)), int(_field(r, "b", 0)))) == [1, 2] for r in records)
+    tutorial = _tutorial_records(result, n, joined)
+    return [row for record in tutorial for row in _record_rows(0, record)] + \
+        [row for j, record in enumerate(records) for row in _record_rows(j, record)]
 
 
 class _Event(NamedTuple):
