@@ -8,7 +8,7 @@ module impact1d_api
   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
   use impact1d_kinds, only: wp
   use impact1d_error, only: error_type, status_ok, status_input, status_interrupted, raise
-  use impact1d_interrupt, only: catch_interrupts
+  use impact1d_interrupt, only: catch_interrupts, interrupt_count
   use impact1d_scene, only: scene_input, scene_type, validate, is_nbody, nbody_refusal, n_real, n_text, real_names, text_names, &
     i_title, i_f1_table, i_f2_table, i_method, i_substeps, i_events, set_text
   use impact1d_io, only: read_scene_file, prepare_scene
@@ -22,7 +22,7 @@ module impact1d_api
   implicit none
   private
   public :: field_names, column_names, event_kind_names, read_scene, simulate, simulate_summaries, &
-    summary_column_names, input_field_names, settle_scene
+    summary_column_names, input_field_names, settle_scene, interrupt_epoch_now
 
   integer(c_int), parameter :: status_too_small = 3   !< arrays too small: sizes needed returned
   !> Room for a message: whole for any message the core builds from the paths and texts it
@@ -184,8 +184,9 @@ contains
   subroutine simulate(n, values, given, title, f1_table, f2_table, method, substeps, events, n_numbers, n_texts, &
       number_room, field, index, value, text_room_in, text_field, text_index, text_end, text_blob, progress, max_samples, &
       n_cols, max_events, max_rows, samples, has_column, event_t, event_class, event_index, event_ends, event_v, &
-      row_name_codes, n_samples, n_events, n_rows, steps, energy_residual, status, message, warnings)
+      row_name_codes, n_samples, n_events, n_rows, steps, energy_residual, status, message, warnings, interrupt_epoch)
     !f2py threadsafe
+    !f2py integer(c_int) optional, intent(in) :: interrupt_epoch = -1
     integer(c_int), intent(in) :: n
     real(c_double), intent(in) :: values(n)
     integer(c_int), intent(in) :: given(n)
@@ -207,6 +208,7 @@ contains
     integer(c_int), intent(out) :: status
     character(len=16384), intent(out) :: message    ! 16384: message_length (f2py needs the number)
     character(len=1024), intent(out) :: warnings   !< the scene's warnings, one per line
+    integer(c_int), intent(in) :: interrupt_epoch   !< from interrupt_epoch_now (-1: the count at the run's start)
     type(scene_input) :: input
     type(scene_type) :: scene
     type(run_stats) :: stats
@@ -249,7 +251,7 @@ contains
     sink%show_progress = progress /= 0
     sink%events = scene%events
     sink%max_events = scene%max_events
-    call run(scene, sink, stats, error)
+    call run(scene, sink, stats, error, int(interrupt_epoch))
     call sink%end_progress()
     if (failed(error, status, message)) return
     ! A log cut at max_events says so beside the scene's warnings (Result.warnings).
@@ -283,8 +285,9 @@ contains
   !> failing run is a status, never the end of the batch.
   subroutine simulate_summaries(n, values, given, title, f1_table, f2_table, method, substeps, events, n_numbers, &
       n_texts, number_room, field, index, value, text_room_in, text_field, text_index, text_end, text_blob, n_over, &
-      over_index, n_runs, over_values, n_summary, summary, status, message_codes)
+      over_index, n_runs, over_values, n_summary, summary, status, message_codes, interrupt_epoch)
     !f2py threadsafe
+    !f2py integer(c_int) optional, intent(in) :: interrupt_epoch = -1
     integer(c_int), intent(in) :: n, n_over, n_runs, n_summary
     real(c_double), intent(in) :: values(n), over_values(n_over, n_runs)
     integer(c_int), intent(in) :: given(n), over_index(n_over)
@@ -297,6 +300,7 @@ contains
     real(c_double), intent(out) :: summary(n_summary, n_runs)
     integer(c_int), intent(out) :: status(n_runs)
     integer(c_int), intent(out) :: message_codes(512, n_runs)   ! 512 per run: see message_length
+    integer(c_int), intent(in) :: interrupt_epoch   !< for every run: see simulate
     type(scene_input) :: base, input
     type(scene_type) :: scene
     type(run_stats) :: stats
@@ -333,7 +337,7 @@ contains
       call prepare_scene(input, scene, error)
       if (.not. allocated(error)) then
         sink = summary_sink()
-        call run(scene, sink, stats, error)
+        call run(scene, sink, stats, error, int(interrupt_epoch))
       end if
       if (failed(error, status(j), message)) then
         call put_codes(message, message_codes(:, j))
@@ -389,6 +393,15 @@ contains
       start = text_end(k) + 1
     end do
   end subroutine apply_assignments
+
+  !> Catch SIGINT from now on (impact1d_interrupt) and return the interrupts counted so far:
+  !> the epoch a caller passes to the runs it starts (a sweep, to those its workers start),
+  !> so that an interrupt after this call ends them even if it comes before they start.
+  subroutine interrupt_epoch_now(epoch)
+    integer(c_int), intent(out) :: epoch
+    call catch_interrupts()
+    epoch = interrupt_count()
+  end subroutine interrupt_epoch_now
 
   !> Names of simulate_summaries' rows, space separated.
   subroutine summary_column_names(names)

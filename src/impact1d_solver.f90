@@ -40,11 +40,15 @@ contains
 
   !> Run a scene from t = 0 to t_end, sending every dt_out sample and every event to sink
   !> (with method 'vissim', the tutorial's fixed-step scheme instead).
-  subroutine run(scene, sink, stats, error)
+  subroutine run(scene, sink, stats, error, interrupt_epoch)
     type(scene_type), intent(in) :: scene
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(out) :: stats
     type(error_type), allocatable, intent(out) :: error
+    !> The interrupt count its caller started with (a sweep's, for every run of it: a run
+    !> its worker starts after the interrupt ends at its first checkpoint); absent or
+    !> negative: the count now.
+    integer, intent(in), optional :: interrupt_epoch
 
     ! The run's state: N long as the model (its start, s0), in lanes from then on (s). While
     ! N <= max_lanes the whole run keeps it in lanes: loading it into lanes and storing it
@@ -63,6 +67,9 @@ contains
     integer :: window_events
 
     stats%interrupt_epoch = interrupt_count()
+    if (present(interrupt_epoch)) then
+      if (interrupt_epoch >= 0) stats%interrupt_epoch = interrupt_epoch
+    end if
     ! What the sink calls the events on each row; nothing counted yet.
     sink%row_names = scene%row_name
     call start_counts(stats, scene%n_rows, scene%n_bodies)

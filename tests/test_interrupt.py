@@ -33,7 +33,7 @@ import os, signal, threading, time
 import impact1d
 scene = impact1d.load_scene({scene!r})
 {setup}
-threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT)).start()
+{interrupt}
 start = time.perf_counter()
 try:
     {call}
@@ -44,9 +44,14 @@ print("next run", len(impact1d.simulate(scene).events))
 """
 
 
-def run_child(call, setup=""):
-    code = textwrap.dedent(CHILD).format(scene=str(ROOT / "input" / "case3.nml"), call=call, setup=setup)
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+# The process signals itself half a second into the call.
+TIMER = "threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT)).start()"
+
+
+def run_child(call, setup="", interrupt=TIMER, timeout=300):
+    code = textwrap.dedent(CHILD).format(scene=str(ROOT / "input" / "case3.nml"), call=call, setup=setup,
+                                         interrupt=interrupt)
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=timeout)
     assert out.returncode == 0, out.stderr
     return out.stdout.split("\n")
 
@@ -74,3 +79,32 @@ def test_a_custom_handler_still_runs_and_the_call_raises():
                       setup="signal.signal(signal.SIGINT, lambda *a: print('handler'))")
     assert lines[0] == "handler", lines
     assert lines[1].split()[0] == "interrupted", lines
+
+
+# Each chunk of the sweep signals its own thread just before its runs start: the interrupt is
+# counted (and Python's flag set) after the sweep began but before any of its runs took its
+# start, the order a loaded machine made once (a worker starting its chunk while the signal
+# came in). The thread-directed signal is handled before pthread_kill returns, so the order
+# is certain.
+LATE_INTERRUPT = """
+import signal, sys, threading
+sweep_module = sys.modules["impact1d.sweep"]
+run_chunk = sweep_module.run_chunk
+def interrupted_chunk(*args, **kwargs):
+    signal.pthread_kill(threading.get_ident(), signal.SIGINT)
+    return run_chunk(*args, **kwargs)
+sweep_module.run_chunk = interrupted_chunk
+"""
+
+
+@pytest.mark.parametrize("first", ["first call", "after a run"])
+@pytest.mark.parametrize("name", ["sweep two threads", "sweep keeping results"])
+def test_a_sweep_run_that_starts_after_an_interrupt_ends(name, first):
+    """A run that a sweep's worker starts after the interrupt ends at its first checkpoint:
+    the sweep's runs take the interrupt count of the sweep's start, not their own (a run
+    that took its own ran its minutes, and the interpreter waited for it at exit). As the
+    first call of the process too, when the sweep must catch SIGINT before its workers do."""
+    setup = LATE_INTERRUPT + ("impact1d.simulate(scene)" if first == "after a run" else "")
+    lines = run_child(CALLS[name], setup=setup, interrupt="", timeout=120)
+    assert lines[0].split()[0] == "interrupted", lines
+    assert lines[1] == "next run 41", lines

@@ -56,17 +56,27 @@ def _with_overrides(scene: Scene, overrides: dict) -> Scene:
     return changed
 
 
-def run_summaries(scene: Scene, overrides: list):
+def interrupt_epoch_now() -> int:
+    """Catch SIGINT from now on and return the interrupts counted so far (src/impact1d_interrupt.c):
+    runs given this epoch end at their next checkpoint once an interrupt came after it, even
+    one that came before they started (a sweep's worker starting a chunk)."""
+    return int(_api.interrupt_epoch_now())
+
+
+def run_summaries(scene: Scene, overrides: list, interrupt_epoch: Optional[int] = None):
     """Run `scene` once per override dict in one core call, keeping each run's summary only
     (no samples: O(1) memory per run). The dicts must override the same real fields with
-    numbers. Returns ({column: float64 array}, [error message or '' per run])."""
+    numbers. Returns ({column: float64 array}, [error message or '' per run]).
+    interrupt_epoch: the caller's (interrupt_epoch_now); None: taken now."""
+    epoch = interrupt_epoch_now() if interrupt_epoch is None else interrupt_epoch
     names = list(overrides[0]) if overrides else []
     index = np.array([REAL_FIELDS.index(name) + 1 for name in names], dtype=np.int32)
     matrix = np.array([[run[name] for name in names] for run in overrides],
                       dtype=np.float64).reshape(len(overrides), len(names)).T
     scene = _with_overrides(scene, {})
     summary, status, codes = _api.simulate_summaries(*to_core(scene), *record_assignments(scene),
-                                                     index, matrix, len(_summary_names()))
+                                                     index, matrix, len(_summary_names()),
+                                                     interrupt_epoch=epoch)
     errors = [""] * len(overrides)
     for j in np.flatnonzero(status):
         errors[j] = decode(np.asarray(codes[:, j], dtype=np.uint8).tobytes())
@@ -228,11 +238,16 @@ def result_from_columns(samples: np.ndarray, events: np.ndarray, names=COLUMNS, 
     return Result(**columns, events=events, **extra)
 
 
-def simulate(scene: Scene, *, progress: bool = False, **overrides) -> Result:
+def simulate(scene: Scene, *, progress: bool = False, _interrupt_epoch: Optional[int] = None,
+             **overrides) -> Result:
     """Run `scene` with keyword overrides of any Scene field (typically dt, t_end,
     dt_out, method; None makes a field absent).  Raises InputError for a bad scene
     and SimulationError for a run that cannot go on.  With progress=True a run that
-    takes more than a second shows a progress line on stderr, as the CLI does."""
+    takes more than a second shows a progress line on stderr, as the CLI does.
+    (_interrupt_epoch: a sweep's, for the runs its workers start: interrupt_epoch_now.)"""
+    # Taken before the core call: an interrupt after this line ends the run (one in the
+    # call's own set-up, before the run took the count, did not).
+    epoch = interrupt_epoch_now() if _interrupt_epoch is None else _interrupt_epoch
     if not isinstance(scene, Scene):
         raise InputError(f"simulate() needs an impact1d.Scene, got {type(scene).__name__}")
     unknown = [name for name in overrides if name not in _OVERRIDABLE]
@@ -256,7 +271,8 @@ def simulate(scene: Scene, *, progress: bool = False, **overrides) -> Result:
         (samples, has_column, event_t, event_class, event_index, _event_ends, event_v, row_name_codes,
          n_samples, n_events, n_rows, steps, energy_residual, status, message,
          warnings) = _api.simulate(values, given, *texts, *records, 1 if progress else 0, sample_capacity,
-                                   len(COLUMNS), event_capacity, row_capacity)
+                                   len(COLUMNS), event_capacity, row_capacity,
+                                   interrupt_epoch=epoch)
         if int(status) != _STATUS_TOO_SMALL:
             break
         sample_capacity, event_capacity = max(int(n_samples), 1), max(int(n_events), 1)

@@ -21,7 +21,7 @@ from typing import Optional
 import numpy as np
 
 from ._scene import REAL_FIELDS, InputError, Scene, SimulationError
-from ._simulate import _OVERRIDABLE, run_summaries, simulate
+from ._simulate import _OVERRIDABLE, interrupt_epoch_now, run_summaries, simulate
 
 __all__ = ["sweep", "SUMMARY_COLUMNS", "STEADY_COLUMNS", "summarize", "steady_state", "run_chunk"]
 
@@ -168,15 +168,19 @@ def _batchable(overrides: list) -> bool:
                for run in overrides)
 
 
-def run_chunk(scene: Scene, overrides: list, keep_results: bool = False, settle: Optional[float] = None):
+def run_chunk(scene: Scene, overrides: list, keep_results: bool = False, settle: Optional[float] = None,
+              interrupt_epoch: Optional[int] = None):
     """Run the scene once per override dict: ({column: array} of summaries, error
     messages[, Results]). A plain function of plain data, so that a Dask worker can run it
     and send back a few arrays. Without Results or steady-state measures (settle) wanted,
     runs that only change numbers go to the core in one call (no per-run glue); with
-    settle, each run's Result is measured (steady_state) and dropped unless kept."""
+    settle, each run's Result is measured (steady_state) and dropped unless kept.
+    interrupt_epoch: the interrupt count the sweep started with, in this process (its
+    runs end at their first checkpoint when an interrupt came after it); None: each run's
+    start."""
     names = SUMMARY_COLUMNS + (STEADY_COLUMNS if settle is not None else ())
     if not keep_results and settle is None and _batchable(overrides):
-        columns, errors = run_summaries(scene, overrides)
+        columns, errors = run_summaries(scene, overrides, interrupt_epoch)
         return {name: np.asarray(columns[name], dtype=np.float64) for name in SUMMARY_COLUMNS}, errors
     rows, errors, results = [], [], []
     for changes in overrides:
@@ -186,7 +190,7 @@ def run_chunk(scene: Scene, overrides: list, keep_results: bool = False, settle:
         cap = changes.get("max_events", scene.max_events)
         whole = {"events": None, "max_events": _WHOLE_LOG if _is_count(cap) else cap}
         try:
-            result = simulate(scene, **{**changes, **whole})
+            result = simulate(scene, _interrupt_epoch=interrupt_epoch, **{**changes, **whole})
         except (InputError, SimulationError) as error:
             rows.append(_failed_row(names))
             errors.append(str(error))
@@ -297,6 +301,11 @@ def sweep(scene: Scene, params, *, workers: Optional[int] = None, client=None,
     size = _chunk_size(len(runs), workers)
     chunks = [runs[i:i + size] for i in range(0, len(runs), size)]
     bar = _Progress(len(runs), progress)
+    # Every local run takes the interrupt count of the sweep's start: one that a worker
+    # starts after an interrupt (it came while the worker took its chunk) ends at its first
+    # checkpoint; with its own count it ran to its end, and the interpreter waited for it at
+    # exit. (A Dask worker's process counts its own: its runs take theirs.)
+    epoch = interrupt_epoch_now()
     try:
         if client is not None:
             if keep_results:
@@ -319,14 +328,14 @@ def sweep(scene: Scene, params, *, workers: Optional[int] = None, client=None,
         elif workers == 1:
             outputs = []
             for chunk in chunks:
-                outputs.append(run_chunk(scene, chunk, keep_results, settle))
+                outputs.append(run_chunk(scene, chunk, keep_results, settle, epoch))
                 bar.update(len(chunk))
         else:
             with ThreadPoolExecutor(max_workers=workers) as pool:
                 outputs = []
                 try:
                     for chunk, output in zip(chunks, pool.map(
-                            lambda c: run_chunk(scene, c, keep_results, settle), chunks)):
+                            lambda c: run_chunk(scene, c, keep_results, settle, epoch), chunks)):
                         outputs.append(output)
                         bar.update(len(chunk))
                 except KeyboardInterrupt:
