@@ -211,7 +211,7 @@ contains
             dot_product(scene%pair%normal(:, k), acc) > dot_product(abs(scene%pair%normal(:, k)), tol_a) .or. &
             (dot_product(scene%pair%normal(:, k), acc) >= -dot_product(abs(scene%pair%normal(:, k)), tol_a) &
             .and. dot_product(scene%pair%normal(:, k), matmul(new_mode%gain, df)) > &
-            1.0e3_wp * eps_wp * sum(abs(df)) / minval(scene%pair%mass))) then
+            1.0e3_wp * eps_wp * sum(abs(df)) / minval(scene%body_mass))) then
           if (event_log%pending_rest(k) < huge(1.0_wp)) then
             call log_event(scene, sink, stats, s%t, class_rest, k, s%v, s%v)
             event_log%pending_rest(k) = huge(1.0_wp)

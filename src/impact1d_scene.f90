@@ -776,8 +776,8 @@ contains
     scene%springs%rest(:ne) = scene%element_rest
     call scene%springs%set_normals()
     scene%springs%present = ne > 0
-    ! The lightest mass as the kernel sees it (the phantom's 1 with one body).
-    call scene%springs%set_frequency(minval(scene%pair%mass))
+    ! The lightest body's mass (the scene's own: not the kernels' one-body phantom).
+    call scene%springs%set_frequency(minval(scene%body_mass))
   end subroutine set_springs
 
   !> Room for nc contact records, none of their limits present yet.

@@ -75,5 +75,9 @@ program test_scene
   call check(all(f == [0.5_wp, -1.5_wp]), 'spring forces from the records')
   call two_body('', scene)
   call check(scene%n_elements == 0 .and. .not. scene%springs%present, 'no springs: no elements')
+  ! One body of 4 kg on a spring of 16 N/m: the rate bound is its own sqrt(k/m) = 2 rad/s, not
+  ! the kernels' one-body phantom's (unit mass: 4 rad/s; docs/nbody-plan.md B8).
+  call two_body('m1 = 4, k1 = 16, x1_rest = 0', scene, one_body=.true.)
+  call check(scene%springs%omega == 2.0_wp, 'one body: the springs'' rate bound from its own mass')
   call finish('test_scene')
 end program test_scene
