@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import threading
 from dataclasses import dataclass, field
 from functools import lru_cache
 from typing import Optional
@@ -10,7 +11,7 @@ from typing import Optional
 import numpy as np
 
 from ._scene import (REAL_FIELDS, Scene, InputError, SimulationError, decode, raise_for_status, to_core, _words, _api,
-                     from_core, is_nbody_form,
+                     from_core, is_nbody_form, CoreForm, core_form,
                      _STATUS_INTERRUPTED)
 from ._scene import STATUS_TOO_SMALL as _STATUS_TOO_SMALL
 
@@ -36,12 +37,34 @@ if _words(_api.column_names()) != COLUMNS:
 
 _OVERRIDABLE = tuple(f.name for f in dataclasses.fields(Scene))
 
-# Room for events a run starts with (most runs log fewer), and the most a hint asks for.
+# Room for events a run starts with (most runs log fewer); a thread's buffers grown past the
+# most kept go back to this after the run (their memory is kept between calls).
 _EVENT_CAPACITY = 256
+_EVENT_CAPACITY_KEPT = 1 << 16
 # Rows a scene has (the flat API says when it has more): the tutorial's at most four.
 _ROW_CAPACITY = 8
-_EVENT_CAPACITY_MAX = 1 << 22
-_event_capacity = _EVENT_CAPACITY
+# Room for the message and the warnings (the api's message_length).
+_TEXT_ROOM = 16384
+
+
+class _Buffers(threading.local):
+    """What simulate's core call fills besides the samples, made once per thread and reused
+    (read out into the Result before the next call: no run keeps them)."""
+
+    def __init__(self):
+        self.make(_EVENT_CAPACITY, _ROW_CAPACITY)
+
+    def make(self, events: int, rows: int) -> None:
+        self.has_column = np.zeros(len(COLUMNS), dtype=np.int32)
+        self.event_real = np.zeros((5, events), dtype=np.float64, order="F")
+        self.event_int = np.zeros((4, events), dtype=np.int32, order="F")
+        self.row_name_codes = np.zeros((32, rows), dtype=np.int32, order="F")
+        self.info = np.zeros(7, dtype=np.int32)
+        self.energy_residual = np.zeros(1, dtype=np.float64)
+        self.text_codes = np.zeros((_TEXT_ROOM, 2), dtype=np.int32, order="F")
+
+
+_buffers = _Buffers()
 
 
 def _with_overrides(scene: Scene, overrides: dict) -> Scene:
@@ -63,7 +86,7 @@ def run_summaries(scene: Scene, overrides: list):
     index = np.array([REAL_FIELDS.index(name) + 1 for name in names], dtype=np.int32)
     matrix = np.array([[run[name] for name in names] for run in overrides],
                       dtype=np.float64).reshape(len(overrides), len(names)).T
-    summary, status, codes = _api.simulate_summaries(*to_core(_with_overrides(scene, {})),
+    summary, status, codes = _api.simulate_summaries(*core_form(scene, {}, _make_form).core,
                                                      index, matrix, len(_summary_names()))
     errors = [""] * len(overrides)
     for j in np.flatnonzero(status):
@@ -226,6 +249,22 @@ def result_from_columns(samples: np.ndarray, events: np.ndarray, names=COLUMNS, 
     return Result(**columns, events=events, **extra)
 
 
+def _make_form(scene: Scene, overrides: dict) -> CoreForm:
+    """A scene with overrides in the core's form (core_form keeps it for the next call)."""
+    scene = _with_overrides(scene, overrides)
+    form = CoreForm()
+    form.core = to_core(scene)
+    if is_nbody_form(scene):
+        # (written with arrays: the Result's scene is the one run, in the tutorial's names)
+        scene = from_core(*form.core, source=scene.source)
+    texts = form.core[2:]
+    form.blob = b"".join(texts) or b" "           # (f2py refuses an empty string)
+    form.text_end = np.cumsum([len(text) for text in texts], dtype=np.int32)
+    form.fields = vars(scene)
+    form.sample_capacity = _sample_capacity(scene)
+    return form
+
+
 def simulate(scene: Scene, *, progress: bool = False, **overrides) -> Result:
     """Run `scene` with keyword overrides of any Scene field (typically dt, t_end,
     dt_out, method; None makes a field absent).  Raises InputError for a bad scene
@@ -237,41 +276,54 @@ def simulate(scene: Scene, *, progress: bool = False, **overrides) -> Result:
     if unknown:
         raise InputError(f"unknown scene field(s) in overrides: {', '.join(unknown)} "
                          f"(known: {', '.join(_OVERRIDABLE)})")
-    scene = _with_overrides(scene, overrides)
-    values, given, *texts = to_core(scene)
-    if is_nbody_form(scene):
-        # (written with arrays: the Result's scene is the one run, in the tutorial's names)
-        scene = from_core(values, given, *texts, source=scene.source)
-
-    # The core fills arrays made for this call (no state is kept between calls, so threads
-    # may run at once); when a guess at their size is short it says what is needed.
-    global _event_capacity
-    sample_capacity, event_capacity, row_capacity = _sample_capacity(scene), _event_capacity, _ROW_CAPACITY
+    form = core_form(scene, overrides, _make_form)
+    values, given = form.core[0], form.core[1]
+    # The samples are made for this call (the Result's columns are views of them); the rest
+    # is the thread's buffers, read out below (so threads may run at once).
+    buffers = _buffers
+    samples = np.empty((form.sample_capacity, len(COLUMNS)), dtype=np.float64, order="F")
     while True:
-        (samples, has_column, event_t, event_class, event_index, _event_ends, event_v, row_name_codes,
-         n_samples, n_events, n_rows, steps, energy_residual, status, message,
-         warnings) = _api.simulate(values, given, *texts, 1 if progress else 0, sample_capacity,
-                                   len(COLUMNS), event_capacity, row_capacity)
-        if int(status) != _STATUS_TOO_SMALL:
+        _api.simulate(values, given, form.blob, form.text_end, 1 if progress else 0, samples, buffers.has_column,
+                      buffers.event_real, buffers.event_int, buffers.row_name_codes, buffers.info,
+                      buffers.energy_residual, buffers.text_codes)
+        status, n_samples, n_events, n_rows, steps, message_length, warnings_length = buffers.info.tolist()
+        if status != _STATUS_TOO_SMALL:
             break
-        sample_capacity, event_capacity = max(int(n_samples), 1), max(int(n_events), 1)
-        row_capacity = max(int(n_rows), 1)
-    raise_for_status(status, message)
-
-    n_samples, n_events = int(n_samples), int(n_events)
-    # Event-heavy scenes tend to come in series (sweeps): start the next one with room.
-    _event_capacity = max(_EVENT_CAPACITY, min(n_events + n_events // 8, _EVENT_CAPACITY_MAX))
-    names, one_body = _column_layout(has_column.tobytes())
+        if n_samples > samples.shape[0]:
+            samples = np.empty((n_samples, len(COLUMNS)), dtype=np.float64, order="F")
+        buffers.make(max(n_events, buffers.event_int.shape[1]), max(n_rows, buffers.row_name_codes.shape[1]))
+    if status:
+        raise_for_status(status, _codes_text(buffers.text_codes[:message_length, 0]))
+    names, one_body = _column_layout(buffers.has_column.tobytes())
     events = np.empty(n_events, dtype=ONE_BODY_EVENT_DTYPE if one_body else EVENT_DTYPE)
     if n_events > 0:
-        row_names = [decode(row_name_codes[:, k].astype(np.uint8)) for k in range(int(n_rows))]
-        events["t"] = event_t[:n_events]
-        events["kind"] = _event_names(np.asarray(event_class[:n_events]), np.asarray(event_index[:n_events]),
-                                      row_names, 1 if one_body else 2)
-        events["v1_before"], events["v1_after"] = event_v[0, :n_events], event_v[2, :n_events]
-        if not one_body:
-            events["v2_before"], events["v2_after"] = event_v[1, :n_events], event_v[3, :n_events]
-    # The present columns come first in the core's array.
-    return result_from_columns(samples[:n_samples, :len(names)], events, names,
-                               energy_residual=float(energy_residual), steps=int(steps), scene=scene,
-                               warnings=_lines(warnings))
+        _fill_events(events, buffers, n_events, n_rows, one_body)
+    if buffers.event_int.shape[1] > _EVENT_CAPACITY_KEPT:
+        buffers.make(_EVENT_CAPACITY, buffers.row_name_codes.shape[1])
+    # The Result made without dataclass __init__ (every field set here): a short run's time.
+    result = object.__new__(Result)
+    columns = vars(result)
+    columns.update(_ABSENT)
+    columns.update(zip(names, samples[:n_samples, :len(names)].T))
+    run_scene = object.__new__(Scene)
+    vars(run_scene).update(form.fields)
+    columns.update(events=events, energy_residual=float(buffers.energy_residual[0]), steps=steps,
+                   scene=run_scene, forces_known=True,
+                   warnings=_lines(_codes_text(buffers.text_codes[:warnings_length, 1])) if warnings_length else ())
+    return result
+
+
+def _codes_text(codes) -> bytes:
+    """The api's character codes (int32) as bytes."""
+    return codes.astype(np.uint8).tobytes()
+
+
+def _fill_events(events, buffers, n_events, n_rows, one_body) -> None:
+    """The event log from the core's event arrays (the kinds named by _event_names)."""
+    row_names = [decode(_codes_text(buffers.row_name_codes[:, k])) for k in range(n_rows)]
+    event_real, event_int = buffers.event_real, buffers.event_int
+    events["t"] = event_real[0, :n_events]
+    events["kind"] = _event_names(event_int[0, :n_events], event_int[1, :n_events], row_names, 1 if one_body else 2)
+    events["v1_before"], events["v1_after"] = event_real[1, :n_events], event_real[3, :n_events]
+    if not one_body:
+        events["v2_before"], events["v2_after"] = event_real[2, :n_events], event_real[4, :n_events]
