@@ -191,8 +191,9 @@ contains
   !> outputs made by f2py, 16 kB of message among them, the call cost ~10 us against ~2 us
   !> of Fortran work for a short run). The texts are text_blob, text k ending at
   !> text_end(k) (field_names' order). The samples fill samples(:n_samples, :), the events
-  !> event_real(:, :n_events) = [t, v_a before, v_b before, v_a after, v_b after] and
-  !> event_int(:, :n_events) = [class, index, end a, end b]: class 1 impact, 2 rest, 3
+  !> event_real(:n_events, :) = [t, v_a before, v_b before, v_a after, v_b after] and
+  !> event_int(:n_events, :) = [class, index, end a, end b] (a column each: what Python
+  !> reads, contiguous): class 1 impact, 2 rest, 3
   !> release of row index (named '', 'rest_', 'release_' and the row's name), 4 stick, 5 slip
   !> of body index ('stick', 'slip' and the body's number), reporting the bodies (end a, end
   !> b) (0: none; (1, 2) with two bodies, (1, 0) with one). The run's row names fill
@@ -213,8 +214,8 @@ contains
     character(len=*), intent(in) :: text_blob
     integer(c_int), intent(in) :: progress    !< non-zero: show progress on stderr after 1 s
     real(c_double), intent(inout), target :: samples(max_samples, n_cols)
-    integer(c_int), intent(inout) :: has_column(n_cols), event_int(4, max_events), info(7)
-    real(c_double), intent(inout) :: event_real(5, max_events), energy_residual(1)
+    integer(c_int), intent(inout) :: has_column(n_cols), event_int(max_events, 4), info(7)
+    real(c_double), intent(inout) :: event_real(max_events, 5), energy_residual(1)
     integer(c_int), intent(inout) :: row_name_codes(32, max_rows)   ! 32: name_len (f2py needs the number)
     integer(c_int), intent(inout) :: text_codes(text_room, 2)
     type(scene_input) :: input
@@ -271,11 +272,11 @@ contains
     info(7) = len(warnings)
     call put_codes(warnings, text_codes(:len(warnings), 2))
     ! The present columns first, in order (has_column says which they are): already there.
-    event_real(1, :n_events) = sink%event_time(:n_events)
-    event_real(2:5, :n_events) = sink%event_v(:, :n_events)
-    event_int(1, :n_events) = sink%event_class(:n_events)
-    event_int(2, :n_events) = sink%event_index(:n_events)
-    event_int(3:4, :n_events) = sink%event_ends(:, :n_events)
+    event_real(:n_events, 1) = sink%event_time(:n_events)
+    event_real(:n_events, 2:5) = transpose(sink%event_v(:, :n_events))
+    event_int(:n_events, 1) = sink%event_class(:n_events)
+    event_int(:n_events, 2) = sink%event_index(:n_events)
+    event_int(:n_events, 3:4) = transpose(sink%event_ends(:, :n_events))
     do k = 1, n_rows
       call put_codes(trim(scene%row_name(k)), row_name_codes(:, k))
     end do

@@ -286,7 +286,7 @@ def _flat_run(core, rows, events, row_room):
     from impact1d._simulate import COLUMNS
     texts = core[2:]
     out = dict(samples=np.zeros((rows, len(COLUMNS)), order="F"), has_column=np.zeros(len(COLUMNS), np.int32),
-               event_real=np.zeros((5, events), order="F"), event_int=np.zeros((4, events), np.int32, order="F"),
+               event_real=np.zeros((events, 5), order="F"), event_int=np.zeros((events, 4), np.int32, order="F"),
                row_name_codes=np.zeros((32, row_room), np.int32, order="F"), info=np.zeros(7, np.int32),
                energy_residual=np.zeros(1), text_codes=np.zeros((16384, 2), np.int32, order="F"))
     _api.simulate(core[0], core[1], b"".join(texts) or b" ", np.cumsum([len(t) for t in texts], dtype=np.int32), 0,
@@ -314,12 +314,12 @@ def test_flat_simulate_says_what_room_it_needs():
     row_names = ["".join(map(chr, out["row_name_codes"][:, k])).strip() for k in range(n_rows)]
     assert row_names == ["left", "right", "slot_min", "slot_max"]
     # Events are (class, row or body) reporting bodies (1, 2); Python names them.
-    event_class, event_index = out["event_int"][0], out["event_int"][1]
-    assert set(event_class) <= {1, 2, 3, 4, 5} and (out["event_int"][2:] == [[1], [2]]).all()
+    event_class, event_index = out["event_int"][:, 0], out["event_int"][:, 1]
+    assert set(event_class) <= {1, 2, 3, 4, 5} and (out["event_int"][:, 2:] == [1, 2]).all()
     assert list(expected.events["kind"][:3]) == [
         ("", "rest_", "release_")[c - 1] + row_names[i - 1] if c <= 3 else ("stick", "slip")[c - 4] + str(i)
         for c, i in zip(event_class[:3], event_index[:3])]
-    np.testing.assert_array_equal(out["event_real"][1], expected.events["v1_before"])
+    np.testing.assert_array_equal(out["event_real"][:, 1], expected.events["v1_before"])
     present = [name for name, flag in zip(COLUMNS, out["has_column"]) if flag]
     assert present == list(expected.columns)
     for k, name in enumerate(present):
@@ -399,3 +399,17 @@ def test_results_do_not_share_arrays():
     second.scene.m1 = 99.0
     np.testing.assert_array_equal(first.x1, kept["x1"])
     assert first.scene.m1 == scene.m1 and impact1d.simulate(scene).scene.m1 == scene.m1
+
+
+def test_event_kinds_come_from_the_runs_rows_and_bodies():
+    """Event (class, index) is named from the run's rows (1 impact, 2 rest, 3 release) and
+    bodies (4 stick, 5 slip); anything outside them is 'unknown', never another's name."""
+    from impact1d._simulate import _event_names
+    codes = np.full((32, 2), ord(" "), dtype=np.int32, order="F")
+    for k, name in enumerate(("left", "slot_max")):
+        codes[:len(name), k] = [ord(c) for c in name]
+    event_class = np.array([1, 2, 3, 1, 4, 5, 5, 0, 6, 1, 1, 4, -1], dtype=np.int32)
+    event_index = np.array([1, 2, 1, 2, 1, 2, 1, 1, 1, 0, 3, 3, 1], dtype=np.int32)
+    assert list(_event_names(event_class, event_index, codes, 2)) == [
+        "left", "rest_slot_max", "release_left", "slot_max", "stick1", "slip2", "slip1",
+        "unknown", "unknown", "unknown", "unknown", "unknown", "unknown"]

@@ -246,10 +246,10 @@ class CoreForm:
     __slots__ = ("core", "blob", "text_end", "fields", "sample_capacity")
 
 
-# Core forms by the scene's field values (marshal's bytes, version 2: each value's type and
-# bits, so -0.0 is not 0.0, and a list's items as they are now, mutated or not): a scene
-# run again with the same values is not converted again. A value marshal cannot write (a
-# path object, a numpy scalar) makes the form afresh each call.
+# Core forms by the scene's field values and the overrides (marshal's bytes, version 2: each
+# value's type and bits, so -0.0 is not 0.0, and a list's items as they are now, mutated or
+# not): a scene run again with the same values is not converted again. A value marshal
+# cannot write (a path object, a numpy scalar) makes the form afresh each call.
 _CORE_FORMS: dict = {}
 _CORE_FORMS_MAX = 256
 
@@ -258,7 +258,7 @@ def core_form(scene: Scene, overrides: dict, make) -> CoreForm:
     """The CoreForm of `scene` with `overrides` (known Scene fields): from the cache when a
     scene had these values before, else make(scene, overrides) (not kept when it raises)."""
     try:
-        key = marshal.dumps(tuple({**vars(scene), **overrides}.values()), 2)
+        key = marshal.dumps((tuple(vars(scene).values()), overrides), 2)
     except ValueError:
         return make(scene, overrides)
     form = _CORE_FORMS.get(key)

@@ -36,6 +36,7 @@ if _words(_api.column_names()) != COLUMNS:
                       f"core has {_words(_api.column_names())}")
 
 _OVERRIDABLE = tuple(f.name for f in dataclasses.fields(Scene))
+_OVERRIDABLE_SET = frozenset(_OVERRIDABLE)
 
 # Room for events a run starts with (most runs log fewer); a thread's buffers grown past the
 # most kept go back to this after the run (their memory is kept between calls).
@@ -56,8 +57,8 @@ class _Buffers(threading.local):
 
     def make(self, events: int, rows: int) -> None:
         self.has_column = np.zeros(len(COLUMNS), dtype=np.int32)
-        self.event_real = np.zeros((5, events), dtype=np.float64, order="F")
-        self.event_int = np.zeros((4, events), dtype=np.int32, order="F")
+        self.event_real = np.zeros((events, 5), dtype=np.float64, order="F")
+        self.event_int = np.zeros((events, 4), dtype=np.int32, order="F")
         self.row_name_codes = np.zeros((32, rows), dtype=np.int32, order="F")
         self.info = np.zeros(7, dtype=np.int32)
         self.energy_residual = np.zeros(1, dtype=np.float64)
@@ -148,19 +149,33 @@ _ROW_PREFIXES = ("", "rest_", "release_")
 _BODY_PREFIXES = ("stick", "slip")
 
 
-def _event_names(event_class, event_index, row_names, n_bodies) -> np.ndarray:
-    """Each event's kind, '<row>', 'rest_<row>', 'release_<row>', 'stick<i>' or 'slip<i>':
-    through a table of the run's 3 n_rows + 2 N names, one lookup per event."""
-    n_rows = len(row_names)
+@lru_cache(maxsize=64)
+def _kind_table(row_name_codes: bytes, n_rows: int, n_bodies: int):
+    """A run's 3 n_rows + 2 N event kinds, '<row>', 'rest_<row>', 'release_<row>',
+    'stick<i>', 'slip<i>', then 'unknown', and where event (class, index) finds its kind
+    (class 1 to 3 a row's, 4 and 5 a body's; rows' names as the core's codes, 32 a row): made
+    once per layout (scenes come in series), not per call."""
+    codes = np.frombuffer(row_name_codes, dtype=np.int32).reshape(n_rows, 32)
+    row_names = [decode(row.astype(np.uint8).tobytes()) for row in codes]
     table = np.array([p + name for p in _ROW_PREFIXES for name in row_names]
                      + [f"{p}{i}" for p in _BODY_PREFIXES for i in range(1, n_bodies + 1)]
-                     + ["unknown"])
-    row_event = (event_class >= 1) & (event_class <= 3) & (event_index >= 1) & (event_index <= n_rows)
-    body_event = (event_class >= 4) & (event_class <= 5) & (event_index >= 1) & (event_index <= n_bodies)
-    where = np.where(row_event, (event_class - 1) * n_rows + event_index - 1,
-                     np.where(body_event, 3 * n_rows + (event_class - 4) * n_bodies + event_index - 1,
-                              len(table) - 1))
-    return table[where]
+                     + ["unknown"], dtype=EVENT_DTYPE["kind"])
+    position = np.full((6, max(n_rows, n_bodies) + 1), len(table) - 1)
+    for c in (1, 2, 3):
+        position[c, 1:n_rows + 1] = (c - 1) * n_rows + np.arange(n_rows)
+    for c in (4, 5):
+        position[c, 1:n_bodies + 1] = 3 * n_rows + (c - 4) * n_bodies + np.arange(n_bodies)
+    return table, position
+
+
+def _event_names(event_class, event_index, row_name_codes, n_bodies) -> np.ndarray:
+    """Each event's kind (_kind_table's names), one lookup per event; an event outside the
+    run's rows and bodies is 'unknown'."""
+    n_rows = row_name_codes.shape[1]
+    table, position = _kind_table(np.ascontiguousarray(row_name_codes.T).tobytes(), n_rows, n_bodies)
+    # (as unsigned, a negative class or index is out of range too: two comparisons, not four)
+    known = (event_class.view(np.uint32) < 6) & (event_index.view(np.uint32) < position.shape[1])
+    return table[np.where(known, position[event_class * known, event_index * known], len(table) - 1)]
 
 
 def _empty():
@@ -272,8 +287,8 @@ def simulate(scene: Scene, *, progress: bool = False, **overrides) -> Result:
     takes more than a second shows a progress line on stderr, as the CLI does."""
     if not isinstance(scene, Scene):
         raise InputError(f"simulate() needs an impact1d.Scene, got {type(scene).__name__}")
-    unknown = [name for name in overrides if name not in _OVERRIDABLE]
-    if unknown:
+    if not overrides.keys() <= _OVERRIDABLE_SET:
+        unknown = [name for name in overrides if name not in _OVERRIDABLE]
         raise InputError(f"unknown scene field(s) in overrides: {', '.join(unknown)} "
                          f"(known: {', '.join(_OVERRIDABLE)})")
     form = core_form(scene, overrides, _make_form)
@@ -291,20 +306,21 @@ def simulate(scene: Scene, *, progress: bool = False, **overrides) -> Result:
             break
         if n_samples > samples.shape[0]:
             samples = np.empty((n_samples, len(COLUMNS)), dtype=np.float64, order="F")
-        buffers.make(max(n_events, buffers.event_int.shape[1]), max(n_rows, buffers.row_name_codes.shape[1]))
+        buffers.make(max(n_events, buffers.event_int.shape[0]), max(n_rows, buffers.row_name_codes.shape[1]))
     if status:
         raise_for_status(status, _codes_text(buffers.text_codes[:message_length, 0]))
     names, one_body = _column_layout(buffers.has_column.tobytes())
     events = np.empty(n_events, dtype=ONE_BODY_EVENT_DTYPE if one_body else EVENT_DTYPE)
     if n_events > 0:
         _fill_events(events, buffers, n_events, n_rows, one_body)
-    if buffers.event_int.shape[1] > _EVENT_CAPACITY_KEPT:
+    if buffers.event_int.shape[0] > _EVENT_CAPACITY_KEPT:
         buffers.make(_EVENT_CAPACITY, buffers.row_name_codes.shape[1])
     # The Result made without dataclass __init__ (every field set here): a short run's time.
     result = object.__new__(Result)
     columns = vars(result)
     columns.update(_ABSENT)
-    columns.update(zip(names, samples[:n_samples, :len(names)].T))
+    # (the present columns first: zip stops at the last name)
+    columns.update(zip(names, (samples if n_samples == len(samples) else samples[:n_samples]).T))
     run_scene = object.__new__(Scene)
     vars(run_scene).update(form.fields)
     columns.update(events=events, energy_residual=float(buffers.energy_residual[0]), steps=steps,
@@ -320,10 +336,10 @@ def _codes_text(codes) -> bytes:
 
 def _fill_events(events, buffers, n_events, n_rows, one_body) -> None:
     """The event log from the core's event arrays (the kinds named by _event_names)."""
-    row_names = [decode(_codes_text(buffers.row_name_codes[:, k])) for k in range(n_rows)]
     event_real, event_int = buffers.event_real, buffers.event_int
-    events["t"] = event_real[0, :n_events]
-    events["kind"] = _event_names(event_int[0, :n_events], event_int[1, :n_events], row_names, 1 if one_body else 2)
-    events["v1_before"], events["v1_after"] = event_real[1, :n_events], event_real[3, :n_events]
+    events["t"] = event_real[:n_events, 0]
+    events["kind"] = _event_names(event_int[:n_events, 0], event_int[:n_events, 1],
+                                  buffers.row_name_codes[:, :n_rows], 1 if one_body else 2)
+    events["v1_before"], events["v1_after"] = event_real[:n_events, 1], event_real[:n_events, 3]
     if not one_body:
-        events["v2_before"], events["v2_after"] = event_real[2, :n_events], event_real[4, :n_events]
+        events["v2_before"], events["v2_after"] = event_real[:n_events, 2], event_real[:n_events, 4]
