@@ -413,3 +413,26 @@ def test_event_kinds_come_from_the_runs_rows_and_bodies():
     assert list(_event_names(event_class, event_index, codes, 2)) == [
         "left", "rest_slot_max", "release_left", "slot_max", "stick1", "slip2", "slip1",
         "unknown", "unknown", "unknown", "unknown", "unknown", "unknown"]
+
+
+@pytest.mark.parametrize("overrides", [
+    {"v1": -8.5}, {"v1": -0.0, "x2": 3.25}, {"t_end": 0.35, "dt": 0.01, "dt_out": 0.05},
+    {"r_left": 0.5, "mu1": 0.2, "f2": -1.5}, {"v1": 1e300}, {"dt": float("nan")}, {"m1": -1.0},
+    {"dt_out": np.float64(0.125)}, {"f1_amp": 2.0, "f1_period": 0.5}, {"k1": 50.0}])
+def test_number_overrides_run_as_the_scene_with_those_values(overrides):
+    """Float overrides of real fields go into the scene's kept core form (no conversion of
+    the whole scene): the run, its Result.scene, or its error are those of a scene made with
+    the values."""
+    scene = impact1d.load_scene(INPUT / "case3.nml")
+    impact1d.simulate(scene, t_end=0.1)                   # (its form kept)
+
+    def outcome(run):
+        try:
+            result = run()
+        except (InputError, SimulationError) as error:
+            return type(error), str(error)
+        fields = {name: value for name, value in vars(result.scene).items()}
+        return result.samples.tobytes(), result.events.tobytes(), result.warnings, repr(fields)
+
+    assert outcome(lambda: impact1d.simulate(scene, **overrides)) == \
+        outcome(lambda: impact1d.simulate(dataclasses.replace(scene, **overrides)))

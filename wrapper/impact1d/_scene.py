@@ -241,9 +241,10 @@ class CoreForm:
     """A scene (with its overrides) as the core takes it, made once: `core` is to_core's
     (values, given, *texts), `blob` and `text_end` the texts as simulate takes them,
     `fields` the Scene fields of the scene run (Result.scene), `sample_capacity` the rows
-    its run will emit."""
+    its run will emit, `flat` whether the scene is in the tutorial's fields (not settled
+    from arrays or records)."""
 
-    __slots__ = ("core", "blob", "text_end", "fields", "sample_capacity")
+    __slots__ = ("core", "blob", "text_end", "fields", "sample_capacity", "flat")
 
 
 # Core forms by the scene's field values and the overrides (marshal's bytes, version 2: each

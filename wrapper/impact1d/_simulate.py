@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import threading
 from dataclasses import dataclass, field
 from functools import lru_cache
@@ -264,19 +265,47 @@ def result_from_columns(samples: np.ndarray, events: np.ndarray, names=COLUMNS, 
     return Result(**columns, events=events, **extra)
 
 
+_REAL_INDEX = {name: k for k, name in enumerate(REAL_FIELDS)}
+
+
 def _make_form(scene: Scene, overrides: dict) -> CoreForm:
-    """A scene with overrides in the core's form (core_form keeps it for the next call)."""
+    """A scene with overrides in the core's form (core_form keeps it for the next call).
+    Numbers for the tutorial's real fields of a flat scene (a fit's or a sweep's calls, each
+    with new values) are put into the scene's own form; anything else is converted whole."""
+    if overrides and overrides.keys() <= _REAL_INDEX.keys() and \
+            all(isinstance(value, float) for value in overrides.values()):
+        base = core_form(scene, {}, _make_form)
+        if base.flat:
+            return _with_reals(base, overrides)
     scene = _with_overrides(scene, overrides)
     form = CoreForm()
     form.core = to_core(scene)
-    if is_nbody_form(scene):
+    form.flat = not is_nbody_form(scene)
+    if not form.flat:
         # (written with arrays: the Result's scene is the one run, in the tutorial's names)
         scene = from_core(*form.core, source=scene.source)
     texts = form.core[2:]
     form.blob = b"".join(texts) or b" "           # (f2py refuses an empty string)
-    form.text_end = np.cumsum([len(text) for text in texts], dtype=np.int32)
+    form.text_end = np.array(list(itertools.accumulate(map(len, texts))), dtype=np.int32)
     form.fields = vars(scene)
     form.sample_capacity = _sample_capacity(scene)
+    return form
+
+
+def _with_reals(base: CoreForm, overrides: dict) -> CoreForm:
+    """`base` with real fields set to the overrides' floats (to_core's values: a float is
+    stored as the same double)."""
+    form = CoreForm()
+    values, given = base.core[0].copy(), base.core[1].copy()
+    for name, value in overrides.items():
+        values[_REAL_INDEX[name]] = value
+        given[_REAL_INDEX[name]] = 1
+    form.core = (values, given, *base.core[2:])
+    form.blob, form.text_end, form.flat = base.blob, base.text_end, True
+    form.fields = {**base.fields, **overrides}
+    run_scene = object.__new__(Scene)
+    vars(run_scene).update(form.fields)
+    form.sample_capacity = _sample_capacity(run_scene)
     return form
 
 
