@@ -36,7 +36,7 @@ program call_stages
       best(stage) = min(best(stage), real(c1 - c0, dp) / real(rate, dp) / calls)
     end do
   end do
-  print '(a, f0.4, a, f0.4, a, f0.4, a)', '{"prepare_us": ', best(1) * 1e6, ', "reserve_us": ', best(2) * 1e6, &
+  print '(a, f10.4, a, f10.4, a, f10.4, a)', '{"prepare_us": ', best(1) * 1e6, ', "reserve_us": ', best(2) * 1e6, &
     ', "run_us": ', best(3) * 1e6, '}'
 
 contains
