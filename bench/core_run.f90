@@ -12,7 +12,7 @@ program core_run
   use impact1d_error, only: error_type
   use impact1d_scene, only: scene_input, scene_type, i_dt, i_dt_out
   use impact1d_io, only: read_scene_file, prepare_scene
-  use impact1d_output, only: memory_sink, present_columns, event_names
+  use impact1d_output, only: memory_sink, present_columns, event_name
   use impact1d_solver, only: run, run_stats
   implicit none
   type(scene_input) :: input
@@ -80,7 +80,7 @@ contains
     write(*, '(a)', advance='no') ' "events": ['
     do k = 1, sink%n_events
       write(*, '(a, es24.16e3, 3a)', advance='no') trim(merge('[  ', ', [', k == 1)), sink%event_time(k), &
-        ', "', trim(event_names(sink%event_kind(k))), '"]'
+        ', "', trim(event_name(sink%row_names, sink%event_class(k), sink%event_index(k))), '"]'
     end do
     write(*, '(a)') ']}'
   end subroutine report

@@ -105,17 +105,17 @@ def build_cvode() -> dict:
     return info
 
 
-def build_core() -> dict:
-    """build/bench/core_run from bench/core_run.f90 and the meson build's core library."""
+def build_core(source=CORE_SOURCE, name="core_run") -> dict:
+    """build/bench/<name> from `source` (bench/core_run.f90) and the meson build's core library."""
     lib = CORE_BUILD / "libimpact1d_core.a"
     mods = CORE_BUILD / "libimpact1d_core.a.p"
     if not lib.exists() or not (mods / "impact1d_solver.mod").exists():
         return {"available": False, "reason": f"{lib} or its module files are missing (run "
                                               "`make setup` first)"}
     BUILD.mkdir(parents=True, exist_ok=True)
-    exe = BUILD / "core_run"
+    exe = BUILD / name
     why = _compile(["gfortran", *CORE_FLAGS, f"-I{mods}", f"-J{BUILD}", "-o", str(exe),
-                    str(CORE_SOURCE), str(lib)], "gfortran")
+                    str(source), str(lib)], "gfortran")
     if why:
         return {"available": False, "reason": why}
     return {"available": True, "exe": str(exe)}
@@ -415,10 +415,10 @@ def performance_section(res, perf=None, siconos=None) -> str:
         + (f", and {t3['best_s']['cvode'] / t3['best_s']['core']:.1f} times as long as "
            "impact1d's core without Python" if "core" in t3["best_s"] else "")
         + f" (its event times {common.fmt(cv3['event_error'])} s off the exact ones, "
-        f"impact1d's {common.fmt(c3['impact1d']['event_error'])} s). Most of a short "
-        "impact1d call is its fixed cost in Python, not its events"
-        + (f": the core runs the same case in {_us(t3['best_s']['core'])} of the "
-           f"{_us(t3['best_s']['impact1d'])}" if "core" in t3["best_s"] else "")
+        f"impact1d's {common.fmt(c3['impact1d']['event_error'])} s)"
+        + (f". The core runs the same case in {_us(t3['best_s']['core'])} of `simulate`'s "
+           f"{_us(t3['best_s']['impact1d'])}: the rest is the call's Python and f2py layer "
+           "and the event log's rebuild (\"The fixed cost of a call\" below)" if "core" in t3["best_s"] else "")
         + (". The core's events and final state are those of `simulate`, bit for bit"
            if c3.get("core_same_output") else "")
         + f". CVODE's {_us(t3['best_s']['cvode'])} are about "

@@ -12,6 +12,7 @@ from __future__ import annotations
 import sys
 import time
 
+import call_profile
 import common
 import convergence
 import cvode_peer
@@ -397,6 +398,8 @@ def main(argv):
         cvode_peer.run()
         print("sweep study ...", flush=True)
         sweep_study.run()
+        print("call profile ...", flush=True)
+        call_profile.run()
         print(f"studies done in {time.perf_counter() - start:.0f} s", flush=True)
     info = common.load_json("machine") if info_path.exists() else common.machine()
     conv, wp, perf = (common.load_json(n) for n in ("convergence", "work_precision", "performance"))
@@ -404,13 +407,15 @@ def main(argv):
     peer = common.load_json("siconos") if (common.RESULTS / "siconos.json").exists() else None
     sweeps = common.load_json("sweep") if (common.RESULTS / "sweep.json").exists() else None
     cvode = common.load_json("cvode") if (common.RESULTS / "cvode.json").exists() else None
+    calls = common.load_json("call_profile") if (common.RESULTS / "call_profile.json").exists() else None
     (common.DOCS / "accuracy.md").write_text(
         accuracy_md(conv, wp, perf, info).rstrip() + "\n\n" + siconos_peer.accuracy_section(peer)
         .rstrip() + "\n\n" + cvode_peer.accuracy_section(cvode))
     (common.DOCS / "performance.md").write_text(
         performance_md(perf, info, cvode, peer).rstrip() + "\n\n"
         + siconos_peer.performance_section(peer).rstrip()
-        + "\n\n" + sweep_study.performance_section(sweeps))
+        + "\n\n" + sweep_study.performance_section(sweeps).rstrip()
+        + "\n\n" + call_profile.performance_section(calls) + "\n")
     print("wrote docs/accuracy.md, docs/performance.md and docs/*.png")
 
 

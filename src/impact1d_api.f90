@@ -167,47 +167,48 @@ contains
     end if
   end subroutine settle_scene
 
-  !> Check and run a scene given as flat fields, its &contact and &spring records as
-  !> assignments (settle_scene's form, record fields only; n_numbers = n_texts = 0: none).
-  !> The samples fill samples(:n_samples, :) and
-  !> the events the event arrays up to n_events; the run's row names fill row_name_codes(:,
-  !> :n_rows) as character codes (blank-padded); when any needs more room than the caller
-  !> gave (max_samples, max_events, max_rows), status is 3 and n_samples, n_events, n_rows
-  !> are the sizes needed: call again with them. has_column(k) is 1 for the columns the
-  !> scene has (column_names lists all of them; x2 and v2 only exist with a second body, pe
-  !> and damping_loss with springs and dampers): they fill samples' first columns, in
-  !> column_names' order. Event j is (event_class(j), event_index(j)): class 1 impact, 2
-  !> rest, 3 release of row index (named '', 'rest_', 'release_' and the row's name), 4
-  !> stick, 5 slip of body index ('stick', 'slip' and the body's number); it reports the
-  !> bodies event_ends(:, j) (0: none; (1, 2) with two bodies, (1, 0) with one) with the
-  !> velocities event_v(:, j) = [v_a before, v_b before, v_a after, v_b after].
-  subroutine simulate(n, values, given, title, f1_table, f2_table, method, substeps, events, n_numbers, n_texts, &
-      number_room, field, index, value, text_room_in, text_field, text_index, text_end, text_blob, progress, max_samples, &
-      n_cols, max_events, max_rows, samples, has_column, event_t, event_class, event_index, event_ends, event_v, &
-      row_name_codes, n_samples, n_events, n_rows, steps, energy_residual, status, message, warnings, interrupt_epoch)
+  !> Check and run a scene given as flat fields (its &contact and &spring records as
+  !> assignments beside them: settle_scene's form, record fields only, n_numbers = n_texts
+  !> = 0 for none; their texts record_blob, text k ending at record_text_end(k)), into arrays the caller owns and may reuse
+  !> (f2py passes intent(inout) arrays through without a copy or a new array: with the
+  !> outputs made by f2py, 16 kB of message among them, the call cost ~10 us against ~2 us
+  !> of Fortran work for a short run). The texts are text_blob, text k ending at
+  !> text_end(k) (field_names' order). The samples fill samples(:n_samples, :), the events
+  !> event_real(:n_events, :) = [t, v_a before, v_b before, v_a after, v_b after] and
+  !> event_int(:n_events, :) = [class, index, end a, end b] (a column each: what Python
+  !> reads, contiguous): class 1 impact, 2 rest, 3
+  !> release of row index (named '', 'rest_', 'release_' and the row's name), 4 stick, 5 slip
+  !> of body index ('stick', 'slip' and the body's number), reporting the bodies (end a, end
+  !> b) (0: none; (1, 2) with two bodies, (1, 0) with one). The run's row names fill
+  !> row_name_codes(:, :n_rows) as character codes (blank-padded). has_column(k) is 1 for
+  !> the columns the scene has (column_names lists all of them; x2 and v2 only exist with a
+  !> second body, pe and damping_loss with springs and dampers): they fill samples' first
+  !> columns, in column_names' order. info = [status, n_samples, n_events, n_rows, steps,
+  !> message length, warnings length] and energy_residual(1) come back; the message and the
+  !> warnings (one per line) fill text_codes(:length, 1) and (:length, 2) as character
+  !> codes. When any array needs more room than the caller gave, status is 3 and n_samples,
+  !> n_events, n_rows are the sizes needed: call again with them.
+  subroutine simulate(n, values, given, text_blob, text_end, n_numbers, n_texts, number_room, field, index, value, &
+      record_text_room, record_text_field, record_text_index, record_text_end, record_blob, progress, max_samples, &
+      n_cols, max_events, max_rows, text_room, samples, has_column, event_real, event_int, row_name_codes, info, &
+      energy_residual, text_codes, interrupt_epoch)
     !f2py threadsafe
     !f2py integer(c_int) optional, intent(in) :: interrupt_epoch = -1
-    integer(c_int), intent(in) :: n
+    integer(c_int), intent(in) :: n, max_samples, n_cols, max_events, max_rows, text_room
     real(c_double), intent(in) :: values(n)
-    integer(c_int), intent(in) :: given(n)
-    character(len=*), intent(in) :: title, f1_table, f2_table, method, substeps, events
-    integer(c_int), intent(in) :: n_numbers, n_texts, number_room, text_room_in
-    integer(c_int), intent(in) :: field(number_room), index(number_room), text_field(text_room_in), &
-      text_index(text_room_in), text_end(text_room_in)
-    real(c_double), intent(in) :: value(number_room)
+    integer(c_int), intent(in) :: given(n), text_end(6)          ! 6: n_text (f2py needs the number)
     character(len=*), intent(in) :: text_blob
     integer(c_int), intent(in) :: progress    !< non-zero: show progress on stderr after 1 s
-    integer(c_int), intent(in) :: max_samples, n_cols, max_events, max_rows
-    real(c_double), intent(out), target :: samples(max_samples, n_cols)
-    integer(c_int), intent(out) :: has_column(n_cols)
-    real(c_double), intent(out) :: event_t(max_events), event_v(4, max_events)
-    integer(c_int), intent(out) :: event_class(max_events), event_index(max_events), event_ends(2, max_events)
-    integer(c_int), intent(out) :: row_name_codes(32, max_rows)   ! 32: name_len (f2py needs the number)
-    integer(c_int), intent(out) :: n_samples, n_events, n_rows, steps
-    real(c_double), intent(out) :: energy_residual
-    integer(c_int), intent(out) :: status
-    character(len=16384), intent(out) :: message    ! 16384: message_length (f2py needs the number)
-    character(len=1024), intent(out) :: warnings   !< the scene's warnings, one per line
+    real(c_double), intent(inout), target :: samples(max_samples, n_cols)
+    integer(c_int), intent(inout) :: has_column(n_cols), event_int(max_events, 4), info(7)
+    real(c_double), intent(inout) :: event_real(max_events, 5), energy_residual(1)
+    integer(c_int), intent(inout) :: row_name_codes(32, max_rows)   ! 32: name_len (f2py needs the number)
+    integer(c_int), intent(inout) :: text_codes(text_room, 2)
+    integer(c_int), intent(in) :: n_numbers, n_texts, number_room, record_text_room
+    integer(c_int), intent(in) :: field(number_room), index(number_room), record_text_field(record_text_room), &
+      record_text_index(record_text_room), record_text_end(record_text_room)
+    real(c_double), intent(in) :: value(number_room)
+    character(len=*), intent(in) :: record_blob
     integer(c_int), intent(in) :: interrupt_epoch   !< from interrupt_epoch_now (-1: the count at the run's start)
     type(scene_input) :: input
     type(scene_type) :: scene
@@ -215,29 +216,25 @@ contains
     type(memory_sink) :: sink
     type(error_type), allocatable :: error
     integer, allocatable :: columns(:)
-    character(len=:), allocatable :: note
-    integer :: k
+    character(len=:), allocatable :: note, warnings
+    integer :: k, n_samples, n_events, n_rows
 
-    n_samples = 0
-    n_events = 0
-    n_rows = 0
+    info = 0
     has_column = 0
-    row_name_codes = ichar(' ')
-    steps = 0
     energy_residual = 0.0_c_double
-    warnings = ''
-    if (.not. field_count_ok(n, status, message)) return
-    if (n_cols /= n_columns) then
-      status = status_input
-      write(message, '(a, i0, a, i0)') 'internal: ', n_cols, ' sample columns asked for, the core has ', n_columns
-      return
+    if (n /= n_real .or. n_cols /= n_columns .or. any(text_end < 0 .or. text_end > len(text_blob)) .or. &
+        any(text_end(2:) < text_end(:5))) then
+      call raise(error, status_input, 'internal: the scene''s fields, texts or sample columns do not match the core')
+      if (put_error(error, info, text_codes)) return
     end if
-    input = flat_input(values, given, title, f1_table, f2_table, method, substeps, events)
-    call apply_assignments(input, .true., n_numbers, n_texts, field, index, value, text_field, text_index, &
-      text_end, text_blob, error)
+    input = flat_input(values, given, text_blob(:text_end(1)), text_blob(text_end(1) + 1:text_end(2)), &
+      text_blob(text_end(2) + 1:text_end(3)), text_blob(text_end(3) + 1:text_end(4)), &
+      text_blob(text_end(4) + 1:text_end(5)), text_blob(text_end(5) + 1:text_end(6)))
+    call apply_assignments(input, .true., n_numbers, n_texts, field, index, value, record_text_field, &
+      record_text_index, record_text_end, record_blob, error)
     if (.not. allocated(error)) call prepare_scene(input, scene, error)
-    if (failed(error, status, message)) return
-    warnings = scene%warnings
+    if (put_error(error, info, text_codes)) return
+    warnings = trim(scene%warnings)
     call catch_interrupts()
     columns = present_columns(input)
     has_column(columns) = 1
@@ -253,30 +250,43 @@ contains
     sink%max_events = scene%max_events
     call run(scene, sink, stats, error, int(interrupt_epoch))
     call sink%end_progress()
-    if (failed(error, status, message)) return
+    if (put_error(error, info, text_codes)) return
     ! A log cut at max_events says so beside the scene's warnings (Result.warnings).
     call sink%cut_note(note)
-    if (len(note) > 0) warnings = trim(warnings) // repeat(new_line('a'), min(len_trim(warnings), 1)) // note
+    if (len(note) > 0) warnings = warnings // repeat(new_line('a'), min(len(warnings), 1)) // note
     n_samples = sink%n_samples
     n_events = sink%n_events
     n_rows = scene%n_rows
-    steps = int(min(stats%steps, int(huge(1_c_int), kind(stats%steps))), c_int)
+    info(2:5) = [n_samples, n_events, n_rows, int(min(stats%steps, int(huge(1_c_int), kind(stats%steps))), c_int)]
     energy_residual = stats%max_residual
-    if (n_samples > max_samples .or. n_events > max_events .or. n_rows > max_rows) then
-      status = status_too_small
-      message = 'internal: the result arrays are too small'
+    if (n_samples > max_samples .or. n_events > max_events .or. n_rows > max_rows .or. len(warnings) > text_room) then
+      info(1) = status_too_small
       return
     end if
+    info(7) = len(warnings)
+    call put_codes(warnings, text_codes(:len(warnings), 2))
     ! The present columns first, in order (has_column says which they are): already there.
-    event_t(:n_events) = sink%event_time(:n_events)
-    event_class(:n_events) = sink%event_class(:n_events)
-    event_index(:n_events) = sink%event_index(:n_events)
-    event_ends(:, :n_events) = sink%event_ends(:, :n_events)
-    event_v(:, :n_events) = sink%event_v(:, :n_events)
+    event_real(:n_events, 1) = sink%event_time(:n_events)
+    event_real(:n_events, 2:5) = transpose(sink%event_v(:, :n_events))
+    event_int(:n_events, 1) = sink%event_class(:n_events)
+    event_int(:n_events, 2) = sink%event_index(:n_events)
+    event_int(:n_events, 3:4) = transpose(sink%event_ends(:, :n_events))
     do k = 1, n_rows
       call put_codes(trim(scene%row_name(k)), row_name_codes(:, k))
     end do
   end subroutine simulate
+
+  !> simulate's error out: info(1) its status, the message in text_codes(:info(6), 1) (cut
+  !> to the room given). True when there was one.
+  logical function put_error(error, info, text_codes)
+    type(error_type), allocatable, intent(in) :: error
+    integer(c_int), intent(inout) :: info(:), text_codes(:, :)
+    put_error = allocated(error)
+    if (.not. put_error) return
+    info(1) = int(error%status, c_int)
+    info(6) = min(len(error%message), size(text_codes, 1))
+    call put_codes(error%message, text_codes(:info(6), 1))
+  end function put_error
 
   !> Run one scene (its records as simulate takes them) n_runs times, run j with the real fields over_index(:) (1-based, in the
   !> order of field_names) set to over_values(:, j), keeping only each run's summary (a

@@ -1,6 +1,7 @@
 """The Python API: Scene, load_scene, simulate, Result, errors (docs/formats.md, the Python API)."""
 
 import dataclasses
+import math
 import re
 import subprocess
 import sys
@@ -277,36 +278,64 @@ def test_progress_only_when_asked(capfd):
     assert res.t[-1] == LONG_RUN["t_end"]
 
 
+def _flat_run(core, rows, events, row_room, records=None):
+    """One call of the flat API's simulate (core: to_core's fields, records: record_assignments';
+    none by default) with arrays of the given room: its info array [status, n_samples,
+    n_events, n_rows, steps, message length, warnings length] and the arrays it filled."""
+    from impact1d._scene import _api, _NO_RECORDS
+    from impact1d._simulate import COLUMNS
+    texts = core[2:]
+    out = dict(samples=np.zeros((rows, len(COLUMNS)), order="F"), has_column=np.zeros(len(COLUMNS), np.int32),
+               event_real=np.zeros((events, 5), order="F"), event_int=np.zeros((events, 4), np.int32, order="F"),
+               row_name_codes=np.zeros((32, row_room), np.int32, order="F"), info=np.zeros(7, np.int32),
+               energy_residual=np.zeros(1), text_codes=np.zeros((16384, 2), np.int32, order="F"))
+    _api.simulate(core[0], core[1], b"".join(texts) or b" ", np.cumsum([len(t) for t in texts], dtype=np.int32),
+                  *(_NO_RECORDS if records is None else records), 0, *out.values())
+    return out["info"], out
+
+
 def test_flat_simulate_says_what_room_it_needs():
     """The flat API writes a run's rows straight into the caller's array; when that array
     (or the event arrays) is too small it says so with the sizes needed (status 3), and a
     call with those sizes gives the rows simulate() returns."""
-    from impact1d._scene import _api, to_core, record_assignments
+    from impact1d._scene import to_core, record_assignments
     from impact1d._simulate import COLUMNS
     scene = impact1d.load_scene(INPUT / "case5.nml")
     expected = impact1d.simulate(scene)
-    core = (*to_core(scene), *record_assignments(scene))
+    core, records = to_core(scene), record_assignments(scene)
     # (case 5 has the walls and both slot limits: four rows)
     for rows, events, contact_rows in ((3, 2000, 8), (len(expected.t) + 1, 2, 8), (len(expected.t) + 1, 2000, 1)):
-        out = _api.simulate(*core, 0, rows, len(COLUMNS), events, contact_rows)
-        status, n_samples, n_events, n_rows = int(out[-3]), int(out[8]), int(out[9]), int(out[10])
-        assert status == 3
-        assert (n_samples, n_events, n_rows) == (len(expected.t), len(expected.events), 4)
-    (samples, has_column, event_t, event_class, event_index, event_ends, event_v, row_name_codes,
-     *_, status, message, _warnings) = _api.simulate(*core, 0, n_samples, len(COLUMNS), n_events, n_rows)
-    assert int(status) == 0
-    row_names = ["".join(map(chr, row_name_codes[:, k])).strip() for k in range(n_rows)]
+        info, _ = _flat_run(core, rows, events, contact_rows, records)
+        assert info[0] == 3
+        assert tuple(info[1:4]) == (len(expected.t), len(expected.events), 4)
+    n_samples, n_events, n_rows = info[1:4]
+    info, out = _flat_run(core, n_samples, n_events, n_rows, records)
+    assert info[0] == 0
+    row_names = ["".join(map(chr, out["row_name_codes"][:, k])).strip() for k in range(n_rows)]
     assert row_names == ["left", "right", "slot_min", "slot_max"]
     # Events are (class, row or body) reporting bodies (1, 2); Python names them.
-    assert set(event_class) <= {1, 2, 3, 4, 5} and (event_ends == [[1], [2]]).all()
+    event_class, event_index = out["event_int"][:, 0], out["event_int"][:, 1]
+    assert set(event_class) <= {1, 2, 3, 4, 5} and (out["event_int"][:, 2:] == [1, 2]).all()
     assert list(expected.events["kind"][:3]) == [
         ("", "rest_", "release_")[c - 1] + row_names[i - 1] if c <= 3 else ("stick", "slip")[c - 4] + str(i)
         for c, i in zip(event_class[:3], event_index[:3])]
-    np.testing.assert_array_equal(event_v[0], expected.events["v1_before"])
-    present = [name for name, flag in zip(COLUMNS, has_column) if flag]
+    np.testing.assert_array_equal(out["event_real"][:, 1], expected.events["v1_before"])
+    present = [name for name, flag in zip(COLUMNS, out["has_column"]) if flag]
     assert present == list(expected.columns)
     for k, name in enumerate(present):
-        np.testing.assert_array_equal(samples[:, k], getattr(expected, name))
+        np.testing.assert_array_equal(out["samples"][:, k], getattr(expected, name))
+
+
+def test_flat_simulate_message_comes_in_its_codes():
+    """A refused scene's status and whole message come back in the caller's buffers (info,
+    text_codes), as simulate() raises them."""
+    from impact1d._scene import to_core
+    scene = dataclasses.replace(impact1d.load_scene(INPUT / "case3.nml"), dt=-1.0)
+    with pytest.raises(impact1d.InputError) as raised:
+        impact1d.simulate(scene)
+    info, out = _flat_run(to_core(scene), 4, 4, 8)
+    assert info[0] == 1
+    assert bytes(out["text_codes"][:info[5], 0].astype(np.uint8)).decode() == str(raised.value)
 
 
 def test_long_messages_come_whole(tmp_path):
@@ -331,3 +360,79 @@ def test_long_messages_come_whole(tmp_path):
     assert str(caught.value).endswith(expected)
     table_rows = impact1d.sweep(scene, {"r_left": [0.5, 0.9]}, workers=1)
     assert [error.endswith(expected) for error in table_rows["error"]] == [True, True]
+
+
+def test_a_scene_changed_after_a_run_runs_as_changed():
+    """simulate keeps a scene's core form between calls (by its field values): a field set
+    after a call, an array changed in place, or a zero of the other sign, runs as it now is."""
+    scene = impact1d.load_scene(INPUT / "case3.nml")
+    first = impact1d.simulate(scene, dt=0.1, dt_out=scene.t_end)
+    scene.v1 = -8.0
+    changed = impact1d.simulate(scene, dt=0.1, dt_out=scene.t_end)
+    assert changed.scene.v1 == -8.0 and changed.events["t"][0] != first.events["t"][0]
+    scene.v1 = -9.0
+    again = impact1d.simulate(scene, dt=0.1, dt_out=scene.t_end)
+    np.testing.assert_array_equal(again.events["t"], first.events["t"])
+    # (-0.0 == 0.0 in Python: the form must tell them apart all the same)
+    assert math.copysign(1.0, impact1d.simulate(scene, t_end=0.1, f1=0.0).scene.f1) == 1.0
+    assert math.copysign(1.0, impact1d.simulate(scene, t_end=0.1, f1=-0.0).scene.f1) == -1.0
+    by_arrays = impact1d.Scene(m=[1.0, 2.0], x=[1.0, 2.5], v=[-9.0, 1.0], x_left=0.0, x_right=10.0,
+                               t_end=1.0, dt=1e-3)
+    before = impact1d.simulate(by_arrays)
+    by_arrays.v[0] = -5.0
+    after = impact1d.simulate(by_arrays)
+    assert before.scene.v1 == -9.0 and after.scene.v1 == -5.0
+    assert after.events["t"][0] != before.events["t"][0]
+
+
+def test_results_do_not_share_arrays():
+    """Each Result owns its arrays: a later run (into the thread's reused event buffers)
+    and a change to one Result leave another as it was, and so does a change to its scene."""
+    scene = impact1d.load_scene(INPUT / "case5.nml")
+    first = impact1d.simulate(scene)
+    kept = {name: getattr(first, name).copy() for name in first.columns + ("events",)}
+    impact1d.simulate(scene, v1=1.0)
+    second = impact1d.simulate(scene)
+    for name, value in kept.items():
+        np.testing.assert_array_equal(getattr(first, name), value)
+    second.x1[:] = 0.0
+    second.scene.m1 = 99.0
+    np.testing.assert_array_equal(first.x1, kept["x1"])
+    assert first.scene.m1 == scene.m1 and impact1d.simulate(scene).scene.m1 == scene.m1
+
+
+def test_event_kinds_come_from_the_runs_rows_and_bodies():
+    """Event (class, index) is named from the run's rows (1 impact, 2 rest, 3 release) and
+    bodies (4 stick, 5 slip); anything outside them is 'unknown', never another's name."""
+    from impact1d._simulate import _event_names
+    codes = np.full((32, 2), ord(" "), dtype=np.int32, order="F")
+    for k, name in enumerate(("left", "slot_max")):
+        codes[:len(name), k] = [ord(c) for c in name]
+    event_class = np.array([1, 2, 3, 1, 4, 5, 5, 0, 6, 1, 1, 4, -1], dtype=np.int32)
+    event_index = np.array([1, 2, 1, 2, 1, 2, 1, 1, 1, 0, 3, 3, 1], dtype=np.int32)
+    assert list(_event_names(event_class, event_index, codes, 2)) == [
+        "left", "rest_slot_max", "release_left", "slot_max", "stick1", "slip2", "slip1",
+        "unknown", "unknown", "unknown", "unknown", "unknown", "unknown"]
+
+
+@pytest.mark.parametrize("overrides", [
+    {"v1": -8.5}, {"v1": -0.0, "x2": 3.25}, {"t_end": 0.35, "dt": 0.01, "dt_out": 0.05},
+    {"r_left": 0.5, "mu1": 0.2, "f2": -1.5}, {"v1": 1e300}, {"dt": float("nan")}, {"m1": -1.0},
+    {"dt_out": np.float64(0.125)}, {"f1_amp": 2.0, "f1_period": 0.5}, {"k1": 50.0}])
+def test_number_overrides_run_as_the_scene_with_those_values(overrides):
+    """Float overrides of real fields go into the scene's kept core form (no conversion of
+    the whole scene): the run, its Result.scene, or its error are those of a scene made with
+    the values."""
+    scene = impact1d.load_scene(INPUT / "case3.nml")
+    impact1d.simulate(scene, t_end=0.1)                   # (its form kept)
+
+    def outcome(run):
+        try:
+            result = run()
+        except (InputError, SimulationError) as error:
+            return type(error), str(error)
+        fields = {name: value for name, value in vars(result.scene).items()}
+        return result.samples.tobytes(), result.events.tobytes(), result.warnings, repr(fields)
+
+    assert outcome(lambda: impact1d.simulate(scene, **overrides)) == \
+        outcome(lambda: impact1d.simulate(dataclasses.replace(scene, **overrides)))

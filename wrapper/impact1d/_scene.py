@@ -7,6 +7,7 @@ moves values between a Scene and the flat arrays of the api layer.
 from __future__ import annotations
 
 import dataclasses
+import marshal
 import os
 from dataclasses import dataclass
 from typing import Optional, Sequence
@@ -234,6 +235,41 @@ def to_core(scene: Scene):
             raise InputError(f"{name} must be text, got {value!r}")
         texts.append(_fortran_text(value))
     return (values, given, *texts)
+
+
+class CoreForm:
+    """A scene (with its overrides) as the core takes it, made once: `core` is to_core's
+    (values, given, *texts), `blob` and `text_end` the texts as simulate takes them,
+    `fields` the Scene fields of the scene run (Result.scene), `sample_capacity` the rows
+    its run will emit, `flat` whether the scene is in the tutorial's fields (not settled
+    from arrays or records), `records` its &contact and &spring records as simulate takes
+    them (record_assignments)."""
+
+    __slots__ = ("core", "blob", "text_end", "fields", "sample_capacity", "flat", "records")
+
+
+# Core forms by the scene's field values and the overrides (marshal's bytes, version 2: each
+# value's type and bits, so -0.0 is not 0.0, and a list's items as they are now, mutated or
+# not): a scene run again with the same values is not converted again. A value marshal
+# cannot write (a path object, a numpy scalar) makes the form afresh each call.
+_CORE_FORMS: dict = {}
+_CORE_FORMS_MAX = 256
+
+
+def core_form(scene: Scene, overrides: dict, make) -> CoreForm:
+    """The CoreForm of `scene` with `overrides` (known Scene fields): from the cache when a
+    scene had these values before, else make(scene, overrides) (not kept when it raises)."""
+    try:
+        key = marshal.dumps((tuple(vars(scene).values()), overrides), 2)
+    except ValueError:
+        return make(scene, overrides)
+    form = _CORE_FORMS.get(key)
+    if form is None:
+        form = make(scene, overrides)
+        if len(_CORE_FORMS) >= _CORE_FORMS_MAX:
+            _CORE_FORMS.clear()        # (a sweep of many variants: start again)
+        _CORE_FORMS[key] = form
+    return form
 
 
 def _number(name, value) -> float:

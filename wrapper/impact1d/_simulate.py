@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import dataclasses
+import itertools
+import threading
 from dataclasses import dataclass, field
 from functools import lru_cache
 from typing import Optional
@@ -10,7 +12,7 @@ from typing import Optional
 import numpy as np
 
 from ._scene import (REAL_FIELDS, Scene, InputError, SimulationError, decode, raise_for_status, to_core, _words, _api,
-                     from_core, is_nbody_form, record_assignments,
+                     from_core, is_nbody_form, CoreForm, core_form, record_assignments,
                      _STATUS_INTERRUPTED)
 from ._scene import STATUS_TOO_SMALL as _STATUS_TOO_SMALL
 
@@ -35,14 +37,37 @@ if _words(_api.column_names()) != COLUMNS:
                       f"core has {_words(_api.column_names())}")
 
 _OVERRIDABLE = tuple(f.name for f in dataclasses.fields(Scene))
+_OVERRIDABLE_SET = frozenset(_OVERRIDABLE)
 
-# Room for events a run starts with (most runs log fewer), and the most a hint asks for.
+# Room for events a run starts with (most runs log fewer); a thread's buffers grown past the
+# most kept go back to this after the run (their memory is kept between calls).
 _EVENT_CAPACITY = 256
+_EVENT_CAPACITY_KEPT = 1 << 16
 # Rows a scene has (the flat API says when it has more): at most pair_rows = 8 (the
 # tutorial's four, and records on one or two bodies).
 _ROW_CAPACITY = 8
-_EVENT_CAPACITY_MAX = 1 << 22
-_event_capacity = _EVENT_CAPACITY
+# Room for the message and the warnings (the api's message_length).
+_TEXT_ROOM = 16384
+
+
+class _Buffers(threading.local):
+    """What simulate's core call fills besides the samples, made once per thread and reused
+    (read out into the Result before the next call: no run keeps them)."""
+
+    def __init__(self):
+        self.make(_EVENT_CAPACITY, _ROW_CAPACITY)
+
+    def make(self, events: int, rows: int) -> None:
+        self.has_column = np.zeros(len(COLUMNS), dtype=np.int32)
+        self.event_real = np.zeros((events, 5), dtype=np.float64, order="F")
+        self.event_int = np.zeros((events, 4), dtype=np.int32, order="F")
+        self.row_name_codes = np.zeros((32, rows), dtype=np.int32, order="F")
+        self.info = np.zeros(7, dtype=np.int32)
+        self.energy_residual = np.zeros(1, dtype=np.float64)
+        self.text_codes = np.zeros((_TEXT_ROOM, 2), dtype=np.int32, order="F")
+
+
+_buffers = _Buffers()
 
 
 def _with_overrides(scene: Scene, overrides: dict) -> Scene:
@@ -73,9 +98,8 @@ def run_summaries(scene: Scene, overrides: list, interrupt_epoch: Optional[int] 
     index = np.array([REAL_FIELDS.index(name) + 1 for name in names], dtype=np.int32)
     matrix = np.array([[run[name] for name in names] for run in overrides],
                       dtype=np.float64).reshape(len(overrides), len(names)).T
-    scene = _with_overrides(scene, {})
-    summary, status, codes = _api.simulate_summaries(*to_core(scene), *record_assignments(scene),
-                                                     index, matrix, len(_summary_names()),
+    form = core_form(scene, {}, _make_form)
+    summary, status, codes = _api.simulate_summaries(*form.core, *form.records, index, matrix, len(_summary_names()),
                                                      interrupt_epoch=epoch)
     errors = [""] * len(overrides)
     for j in np.flatnonzero(status):
@@ -137,19 +161,33 @@ _ROW_PREFIXES = ("", "rest_", "release_")
 _BODY_PREFIXES = ("stick", "slip")
 
 
-def _event_names(event_class, event_index, row_names, n_bodies) -> np.ndarray:
-    """Each event's kind, '<row>', 'rest_<row>', 'release_<row>', 'stick<i>' or 'slip<i>':
-    through a table of the run's 3 n_rows + 2 N names, one lookup per event."""
-    n_rows = len(row_names)
+@lru_cache(maxsize=64)
+def _kind_table(row_name_codes: bytes, n_rows: int, n_bodies: int):
+    """A run's 3 n_rows + 2 N event kinds, '<row>', 'rest_<row>', 'release_<row>',
+    'stick<i>', 'slip<i>', then 'unknown', and where event (class, index) finds its kind
+    (class 1 to 3 a row's, 4 and 5 a body's; rows' names as the core's codes, 32 a row): made
+    once per layout (scenes come in series), not per call."""
+    codes = np.frombuffer(row_name_codes, dtype=np.int32).reshape(n_rows, 32)
+    row_names = [decode(row.astype(np.uint8).tobytes()) for row in codes]
     table = np.array([p + name for p in _ROW_PREFIXES for name in row_names]
                      + [f"{p}{i}" for p in _BODY_PREFIXES for i in range(1, n_bodies + 1)]
-                     + ["unknown"])
-    row_event = (event_class >= 1) & (event_class <= 3) & (event_index >= 1) & (event_index <= n_rows)
-    body_event = (event_class >= 4) & (event_class <= 5) & (event_index >= 1) & (event_index <= n_bodies)
-    where = np.where(row_event, (event_class - 1) * n_rows + event_index - 1,
-                     np.where(body_event, 3 * n_rows + (event_class - 4) * n_bodies + event_index - 1,
-                              len(table) - 1))
-    return table[where]
+                     + ["unknown"], dtype=EVENT_DTYPE["kind"])
+    position = np.full((6, max(n_rows, n_bodies) + 1), len(table) - 1)
+    for c in (1, 2, 3):
+        position[c, 1:n_rows + 1] = (c - 1) * n_rows + np.arange(n_rows)
+    for c in (4, 5):
+        position[c, 1:n_bodies + 1] = 3 * n_rows + (c - 4) * n_bodies + np.arange(n_bodies)
+    return table, position
+
+
+def _event_names(event_class, event_index, row_name_codes, n_bodies) -> np.ndarray:
+    """Each event's kind (_kind_table's names), one lookup per event; an event outside the
+    run's rows and bodies is 'unknown'."""
+    n_rows = row_name_codes.shape[1]
+    table, position = _kind_table(np.ascontiguousarray(row_name_codes.T).tobytes(), n_rows, n_bodies)
+    # (as unsigned, a negative class or index is out of range too: two comparisons, not four)
+    known = (event_class.view(np.uint32) < 6) & (event_index.view(np.uint32) < position.shape[1])
+    return table[np.where(known, position[event_class * known, event_index * known], len(table) - 1)]
 
 
 def _empty():
@@ -238,6 +276,53 @@ def result_from_columns(samples: np.ndarray, events: np.ndarray, names=COLUMNS, 
     return Result(**columns, events=events, **extra)
 
 
+_REAL_INDEX = {name: k for k, name in enumerate(REAL_FIELDS)}
+
+
+def _make_form(scene: Scene, overrides: dict) -> CoreForm:
+    """A scene with overrides in the core's form (core_form keeps it for the next call).
+    Numbers for the tutorial's real fields of a flat scene (a fit's or a sweep's calls, each
+    with new values) are put into the scene's own form; anything else is converted whole."""
+    if overrides and overrides.keys() <= _REAL_INDEX.keys() and \
+            all(isinstance(value, float) for value in overrides.values()):
+        base = core_form(scene, {}, _make_form)
+        if base.flat:
+            return _with_reals(base, overrides)
+    scene = _with_overrides(scene, overrides)
+    form = CoreForm()
+    form.core = to_core(scene)
+    form.flat = not is_nbody_form(scene)
+    form.records = record_assignments(scene)
+    if not form.flat:
+        # (written with arrays: the Result's scene is the one run, in the tutorial's names,
+        # with its records)
+        scene = dataclasses.replace(from_core(*form.core, source=scene.source),
+                                    contacts=scene.contacts, springs=scene.springs)
+    texts = form.core[2:]
+    form.blob = b"".join(texts) or b" "           # (f2py refuses an empty string)
+    form.text_end = np.array(list(itertools.accumulate(map(len, texts))), dtype=np.int32)
+    form.fields = vars(scene)
+    form.sample_capacity = _sample_capacity(scene)
+    return form
+
+
+def _with_reals(base: CoreForm, overrides: dict) -> CoreForm:
+    """`base` with real fields set to the overrides' floats (to_core's values: a float is
+    stored as the same double)."""
+    form = CoreForm()
+    values, given = base.core[0].copy(), base.core[1].copy()
+    for name, value in overrides.items():
+        values[_REAL_INDEX[name]] = value
+        given[_REAL_INDEX[name]] = 1
+    form.core = (values, given, *base.core[2:])
+    form.blob, form.text_end, form.flat, form.records = base.blob, base.text_end, True, base.records
+    form.fields = {**base.fields, **overrides}
+    run_scene = object.__new__(Scene)
+    vars(run_scene).update(form.fields)
+    form.sample_capacity = _sample_capacity(run_scene)
+    return form
+
+
 def simulate(scene: Scene, *, progress: bool = False, _interrupt_epoch: Optional[int] = None,
              **overrides) -> Result:
     """Run `scene` with keyword overrides of any Scene field (typically dt, t_end,
@@ -250,49 +335,59 @@ def simulate(scene: Scene, *, progress: bool = False, _interrupt_epoch: Optional
     epoch = interrupt_epoch_now() if _interrupt_epoch is None else _interrupt_epoch
     if not isinstance(scene, Scene):
         raise InputError(f"simulate() needs an impact1d.Scene, got {type(scene).__name__}")
-    unknown = [name for name in overrides if name not in _OVERRIDABLE]
-    if unknown:
+    if not overrides.keys() <= _OVERRIDABLE_SET:
+        unknown = [name for name in overrides if name not in _OVERRIDABLE]
         raise InputError(f"unknown scene field(s) in overrides: {', '.join(unknown)} "
                          f"(known: {', '.join(_OVERRIDABLE)})")
-    scene = _with_overrides(scene, overrides)
-    values, given, *texts = to_core(scene)
-    records = record_assignments(scene)
-    if is_nbody_form(scene):
-        # (written with arrays: the Result's scene is the one run, in the tutorial's names,
-        # with its records)
-        scene = dataclasses.replace(from_core(values, given, *texts, source=scene.source),
-                                    contacts=scene.contacts, springs=scene.springs)
-
-    # The core fills arrays made for this call (no state is kept between calls, so threads
-    # may run at once); when a guess at their size is short it says what is needed.
-    global _event_capacity
-    sample_capacity, event_capacity, row_capacity = _sample_capacity(scene), _event_capacity, _ROW_CAPACITY
+    form = core_form(scene, overrides, _make_form)
+    values, given = form.core[0], form.core[1]
+    # The samples are made for this call (the Result's columns are views of them); the rest
+    # is the thread's buffers, read out below (so threads may run at once).
+    buffers = _buffers
+    samples = np.empty((form.sample_capacity, len(COLUMNS)), dtype=np.float64, order="F")
     while True:
-        (samples, has_column, event_t, event_class, event_index, _event_ends, event_v, row_name_codes,
-         n_samples, n_events, n_rows, steps, energy_residual, status, message,
-         warnings) = _api.simulate(values, given, *texts, *records, 1 if progress else 0, sample_capacity,
-                                   len(COLUMNS), event_capacity, row_capacity,
-                                   interrupt_epoch=epoch)
-        if int(status) != _STATUS_TOO_SMALL:
+        _api.simulate(values, given, form.blob, form.text_end, *form.records, 1 if progress else 0, samples,
+                      buffers.has_column, buffers.event_real, buffers.event_int, buffers.row_name_codes, buffers.info,
+                      buffers.energy_residual, buffers.text_codes, interrupt_epoch=epoch)
+        status, n_samples, n_events, n_rows, steps, message_length, warnings_length = buffers.info.tolist()
+        if status != _STATUS_TOO_SMALL:
             break
-        sample_capacity, event_capacity = max(int(n_samples), 1), max(int(n_events), 1)
-        row_capacity = max(int(n_rows), 1)
-    raise_for_status(status, message)
-
-    n_samples, n_events = int(n_samples), int(n_events)
-    # Event-heavy scenes tend to come in series (sweeps): start the next one with room.
-    _event_capacity = max(_EVENT_CAPACITY, min(n_events + n_events // 8, _EVENT_CAPACITY_MAX))
-    names, one_body = _column_layout(has_column.tobytes())
+        if n_samples > samples.shape[0]:
+            samples = np.empty((n_samples, len(COLUMNS)), dtype=np.float64, order="F")
+        buffers.make(max(n_events, buffers.event_int.shape[0]), max(n_rows, buffers.row_name_codes.shape[1]))
+    if status:
+        raise_for_status(status, _codes_text(buffers.text_codes[:message_length, 0]))
+    names, one_body = _column_layout(buffers.has_column.tobytes())
     events = np.empty(n_events, dtype=ONE_BODY_EVENT_DTYPE if one_body else EVENT_DTYPE)
     if n_events > 0:
-        row_names = [decode(row_name_codes[:, k].astype(np.uint8)) for k in range(int(n_rows))]
-        events["t"] = event_t[:n_events]
-        events["kind"] = _event_names(np.asarray(event_class[:n_events]), np.asarray(event_index[:n_events]),
-                                      row_names, 1 if one_body else 2)
-        events["v1_before"], events["v1_after"] = event_v[0, :n_events], event_v[2, :n_events]
-        if not one_body:
-            events["v2_before"], events["v2_after"] = event_v[1, :n_events], event_v[3, :n_events]
-    # The present columns come first in the core's array.
-    return result_from_columns(samples[:n_samples, :len(names)], events, names,
-                               energy_residual=float(energy_residual), steps=int(steps), scene=scene,
-                               warnings=_lines(warnings))
+        _fill_events(events, buffers, n_events, n_rows, one_body)
+    if buffers.event_int.shape[0] > _EVENT_CAPACITY_KEPT:
+        buffers.make(_EVENT_CAPACITY, buffers.row_name_codes.shape[1])
+    # The Result made without dataclass __init__ (every field set here): a short run's time.
+    result = object.__new__(Result)
+    columns = vars(result)
+    columns.update(_ABSENT)
+    # (the present columns first: zip stops at the last name)
+    columns.update(zip(names, (samples if n_samples == len(samples) else samples[:n_samples]).T))
+    run_scene = object.__new__(Scene)
+    vars(run_scene).update(form.fields)
+    columns.update(events=events, energy_residual=float(buffers.energy_residual[0]), steps=steps,
+                   scene=run_scene, forces_known=True,
+                   warnings=_lines(_codes_text(buffers.text_codes[:warnings_length, 1])) if warnings_length else ())
+    return result
+
+
+def _codes_text(codes) -> bytes:
+    """The api's character codes (int32) as bytes."""
+    return codes.astype(np.uint8).tobytes()
+
+
+def _fill_events(events, buffers, n_events, n_rows, one_body) -> None:
+    """The event log from the core's event arrays (the kinds named by _event_names)."""
+    event_real, event_int = buffers.event_real, buffers.event_int
+    events["t"] = event_real[:n_events, 0]
+    events["kind"] = _event_names(event_int[:n_events, 0], event_int[:n_events, 1],
+                                  buffers.row_name_codes[:, :n_rows], 1 if one_body else 2)
+    events["v1_before"], events["v1_after"] = event_real[:n_events, 1], event_real[:n_events, 3]
+    if not one_body:
+        events["v2_before"], events["v2_after"] = event_real[:n_events, 2], event_real[:n_events, 4]
