@@ -41,7 +41,7 @@ def _core_call(form):
     buffers = _simulate._buffers
     samples = np.empty((form.sample_capacity, len(_simulate.COLUMNS)), order="F")
     return lambda: _scene._api.simulate(
-        form.core[0], form.core[1], form.blob, form.text_end, 0, samples, buffers.has_column, buffers.event_real,
+        form.core[0], form.core[1], form.blob, form.text_end, *form.records, 0, samples, buffers.has_column, buffers.event_real,
         buffers.event_int, buffers.row_name_codes, buffers.info, buffers.energy_residual, buffers.text_codes)
 
 
