@@ -416,6 +416,32 @@ def test_one_slot_limit_is_a_line():
                                np.clip(res.x1 + res.scene.d_min, 0.0, 10.0))
 
 
+def test_records_limits_are_drawn_in_the_positions_panel():
+    """inner_stop's &contact records drawn where they hold, named: 'stop' (x2 >= x1 + 0.5,
+    between the bodies) a line at x1 + 0.5 in body 2's colour, as the slot's x1 + d is;
+    'wall1' (x1 <= 0.25: a stop of body 1, no wall of the pair) dashed at 0.25 in body 1's;
+    a record bounding body 2 from above (x2 <= 1.75) a wall, as the tutorial's are."""
+    scene = IMPACT1D.load_scene(ROOT / "input" / "inner_stop.nml")
+    scene.t_end = 4.0
+    res = IMPACT1D.simulate(scene)
+    pos = axes_by_label(plot.figure(res))["positions"]
+    stop = artist(pos, "limit:stop")
+    np.testing.assert_array_equal(stop.get_xdata(), res.t)
+    # clipped at the left wall (x = -1), as the slot's lines are
+    np.testing.assert_array_equal(stop.get_ydata(), np.maximum(res.x1 + 0.5, -1.0))
+    assert stop.get_label() == "stop: x2 \u2265 x1 + 0.5 m"
+    assert stop.get_color() == "tab:orange" and stop.get_linestyle() == "-."
+    assert np.all(res.x2 >= stop.get_ydata() - 1e-9)        # x2 never crosses it
+    wall1 = artist(pos, "wall:wall1")
+    assert list(wall1.get_ydata()) == [0.25, 0.25] and wall1.get_label() == "wall1: x1 \u2264 0.25 m"
+    assert wall1.get_color() == "tab:blue" and wall1.get_linestyle() == "--"
+    scene.contacts = scene.contacts + [dict(a=2, b=0, d_min=-1.75, name="lid")]
+    pos = axes_by_label(plot.figure(IMPACT1D.simulate(scene)))["positions"]
+    lid = artist(pos, "wall:lid")
+    assert list(lid.get_ydata()) == [1.75, 1.75] and lid.get_color() == "0.25"
+    assert lid.get_label() == "lid: x2 \u2264 1.75 m" and pos.get_ylim()[1] > 1.75
+
+
 def test_wide_slot_does_not_squash_positions():
     res = case5_like()  # d_max = 50 m, walls 10 m apart
     lo, hi = axes_by_label(plot.figure(res))["positions"].get_ylim()

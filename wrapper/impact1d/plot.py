@@ -21,7 +21,9 @@ this module never touches pyplot's global state or picks a backend:
 Artists carry a ``gid`` so tests and scripts can find them: lines ``x1 x2 v1 v2
 f1 f2 ke pe work friction_loss impact_loss damping_loss ke_change residual``, walls ``wall:left``,
 ``wall:right``, the slot band ``slot_band`` (or ``slot:min``/``slot:max`` when
-only one limit exists), impact markers on the position panel
+only one limit exists), the limits of the scene's &contact records ``wall:<name>``
+(with the ground: a wall, or a dashed stop of one body) and ``limit:<name>`` (between
+the bodies: a line at x_a + d, as the slot's), impact markers on the position panel
 ``impact:<contact>``, impact ticks ``tick:<contact>`` and persistent-contact
 bars ``rest:<contact>`` on the impact panel, friction events ``stick1`` etc. on
 the velocity panel.  Axes are labelled (``Axes.get_label()``) ``positions
@@ -168,9 +170,7 @@ def _contacts_present(result, events):
                 seen.add(c)
     tutorial = [c for c in CONTACTS if c in seen or _float_or_none(_scene_value(result, limits[c])) is not None]
     # The rows of the scene's &contact records (one or two bodies), after the tutorial's.
-    scene = getattr(result, "scene", None)
-    records = (None if scene is None else _field(scene, "contacts")) or []
-    extra = [row.name for j, record in enumerate(records) for row in _record_rows(j, record)]
+    extra = [row.name for row in _scene_record_rows(result)]
     return tutorial + [name for name in dict.fromkeys(extra) if name not in tutorial]
 
 
@@ -398,25 +398,27 @@ def _draw_positions(ax, result, events):
     x1 = np.asarray(result.x1, dtype=float)
     # A one-body scene has no x2: drawn as an empty series.
     x2 = np.asarray(result.x2 if result.x2 is not None else x1[:0], dtype=float)
-    x_left = _float_or_none(_scene_value(result, "x_left"))
-    x_right = _float_or_none(_scene_value(result, "x_right"))
+    n = 2 if x2.size else 1
     d_min = _float_or_none(_scene_value(result, "d_min"))
     d_max = _float_or_none(_scene_value(result, "d_max"))
+    # Walls: the tutorial's, then the records' limits that bound every body (body 1's
+    # lower, body N's upper); the records' other limits are drawn as stops and slots.
+    walls = [(name, w, side, f"{name} wall x = {w:g} m") for name, side, w in
+             (("left", "min", _float_or_none(_scene_value(result, "x_left"))),
+              ("right", "max", _float_or_none(_scene_value(result, "x_right")))) if w is not None]
+    records = _scene_record_rows(result)
+    walls += [(row.name, row.limit, row.side, _row_label(row)) for row in records if _is_wall(row, n)]
 
     # Limits from the bodies and the walls only: a wide slot (case 5 has
     # d_max = 50 m) must not squash the motion.
     lo = [np.min(x1)] + ([np.min(x2)] if x2.size else []) if t.size else [0.0]
     hi = [np.max(x1)] + ([np.max(x2)] if x2.size else []) if t.size else [1.0]
-    for w in (x_left, x_right):
-        if w is not None:
-            lo.append(w)
-            hi.append(w)
-    lo, hi = float(min(lo)), float(max(hi))
+    lo, hi = float(min(lo + [w[1] for w in walls])), float(max(hi + [w[1] for w in walls]))
     pad = 0.06 * (hi - lo) if hi > lo else 0.5
     ylim = (lo - pad, hi + pad)
 
-    wall_lo = -np.inf if x_left is None else x_left
-    wall_hi = np.inf if x_right is None else x_right
+    wall_lo = max((w for _, w, side, _ in walls if side == "min"), default=-np.inf)
+    wall_hi = min((w for _, w, side, _ in walls if side == "max"), default=np.inf)
 
     def inside_walls(y):
         # x2 cannot pass a wall, so neither does the band that says where it may be.
@@ -425,10 +427,10 @@ def _draw_positions(ax, result, events):
     # A slot limit that stays beyond the walls (or out of view) all run never binds before
     # a wall does: drawn, it would only shade the panel (case 5: d_max = 50 m, walls 10 m
     # apart). Such a limit is left out.
-    view_lo, view_hi = max(wall_lo, ylim[0]), min(wall_hi, ylim[1])
-    if d_min is not None and not np.any(x1 + d_min > view_lo):
+    view = (max(wall_lo, ylim[0]), min(wall_hi, ylim[1]))
+    if d_min is not None and not _in_view(x1 + d_min, "min", view):
         d_min = None
-    if d_max is not None and not np.any(x1 + d_max < view_hi):
+    if d_max is not None and not _in_view(x1 + d_max, "max", view):
         d_max = None
 
     if d_min is not None and d_max is not None:
@@ -438,16 +440,14 @@ def _draw_positions(ax, result, events):
     else:
         for name, d in (("min", d_min), ("max", d_max)):
             if d is not None:
-                ax.plot(t, inside_walls(x1 + d), color=_BODY_COLOR[2], linestyle=":", linewidth=1.0,
-                        gid=f"slot:{name}", label=f"slot {name}: x1 + {d:g} m")
+                _draw_slot_line(ax, t, inside_walls(x1 + d), f"slot:{name}", f"slot {name}: x1 + {d:g} m")
+    _draw_record_limits(ax, t, (x1, x2), [row for row in records if not _is_wall(row, n)], view,
+                        inside_walls)
 
-    for name, w, beyond in (("left", x_left, ylim[0] - 1e3 * (pad + 1)),
-                            ("right", x_right, ylim[1] + 1e3 * (pad + 1))):
-        if w is None:
-            continue
+    for name, w, side, label in walls:
+        beyond = ylim[0] - 1e3 * (pad + 1) if side == "min" else ylim[1] + 1e3 * (pad + 1)
         ax.axhspan(min(w, beyond), max(w, beyond), color="0.85", zorder=0)
-        ax.axhline(w, color="0.25", linewidth=1.5, gid=f"wall:{name}",
-                   label=f"{name} wall x = {w:g} m")
+        ax.axhline(w, color="0.25", linewidth=1.5, gid=f"wall:{name}", label=label)
 
     ax.plot(t, x1, color=_BODY_COLOR[1], linewidth=1.4, gid="x1", label="x1 (body 1)")
     if x2.size:
@@ -479,6 +479,33 @@ def _draw_positions(ax, result, events):
     ax.set_ylabel("position (m)")
     _finish_time_axis(ax, result)
     _legend(ax)
+
+
+def _in_view(line, side, view):
+    """Whether a lower ("min") or upper ("max") limit at `line` comes into view (lo, hi)
+    some time in the run: one that never does never binds before a wall does."""
+    return bool(np.any(line > view[0])) if side == "min" else bool(np.any(line < view[1]))
+
+
+def _draw_slot_line(ax, t, line, gid, label, color=_BODY_COLOR[2], linestyle=":"):
+    """A limit between two bodies: where it holds body b, x_a + d, in b's colour."""
+    ax.plot(t, line, color=color, linestyle=linestyle, linewidth=1.0, gid=gid, label=label)
+
+
+def _draw_record_limits(ax, t, positions, rows, view, inside_walls):
+    """The records' limits that are not walls, labelled by name: a stop (a limit of body b
+    with the ground) dashed at its position, a limit between two bodies as the slot's lines;
+    each in the colour of the body it holds (dash-dotted: the slot's lines are dotted),
+    left out as a slot limit is when it stays out of view all run."""
+    for row in rows:
+        line = np.full(t.shape, row.limit) if row.a == 0 else positions[row.a - 1] + row.limit
+        if not _in_view(line, row.side, view):
+            continue
+        if row.a == 0:
+            _draw_stop(ax, row, _BODY_COLOR[row.b])
+        else:
+            _draw_slot_line(ax, t, inside_walls(line), f"limit:{row.name}", _row_label(row),
+                            _BODY_COLOR[row.b], "-.")
 
 
 def _draw_velocities(ax, result, events):
@@ -729,15 +756,24 @@ def _record_rows(j, record):
     return rows
 
 
+def _scene_records(result):
+    """The scene's &contact records (scene.contacts), [] when it has none."""
+    scene = getattr(result, "scene", None)
+    return (None if scene is None else _field(scene, "contacts")) or []
+
+
+def _scene_record_rows(result):
+    """The rows of the scene's &contact records (unnamed: contact<j>, j counting them)."""
+    return [row for j, record in enumerate(_scene_records(result)) for row in _record_rows(j, record)]
+
+
 def _rows(result, n):
     """The contact rows in the engine's order: today's walls and slot (a one- or two-body
-    scene's), then the scene's records (unnamed: contact<j>, j counting the records)."""
-    scene = getattr(result, "scene", None)
-    records = (None if scene is None else _field(scene, "contacts")) or []
-    joined = any(sorted((int(_field(r, "a", 0)), int(_field(r, "b", 0)))) == [1, 2] for r in records)
+    scene's), then the scene's records."""
+    joined = any(sorted((int(_field(r, "a", 0)), int(_field(r, "b", 0)))) == [1, 2]
+                 for r in _scene_records(result))
     tutorial = _tutorial_records(result, n, joined)
-    return [row for record in tutorial for row in _record_rows(0, record)] + \
-        [row for j, record in enumerate(records) for row in _record_rows(j, record)]
+    return [row for record in tutorial for row in _record_rows(0, record)] + _scene_record_rows(result)
 
 
 class _Event(NamedTuple):
@@ -899,18 +935,33 @@ def _draw_ground_rows(ax, mech, colors):
     """Walls (body 1's lower limit, body N's upper one) as today's plot draws them; stops
     of the other bodies as dashed lines in the body's colour."""
     for row in (r for r in mech.rows if r.a == 0):
-        label = _row_label(row)
-        if (row.b, row.side) in ((1, "min"), (mech.n, "max")):
-            ax.axhline(row.limit, color="0.25", linewidth=1.5, gid=f"wall:{row.name}", label=label)
+        if _is_wall(row, mech.n):
+            ax.axhline(row.limit, color="0.25", linewidth=1.5, gid=f"wall:{row.name}",
+                       label=_row_label(row))
         else:
-            ax.axhline(row.limit, color=colors[row.b - 1], linewidth=1.0, linestyle="--",
-                       gid=f"wall:{row.name}", label=label)
+            _draw_stop(ax, row, colors[row.b - 1])
+
+
+def _is_wall(row, n):
+    """Whether a contact row is a wall: a limit with the ground below body 1 or above
+    body n, so that it bounds every body (another limit with the ground is a stop)."""
+    return row.a == 0 and (row.b, row.side) in ((1, "min"), (n, "max"))
+
+
+def _draw_stop(ax, row, color):
+    """A stop: a limit of body b with the ground that is not a wall, dashed in b's colour."""
+    ax.axhline(row.limit, color=color, linewidth=1.0, linestyle="--", gid=f"wall:{row.name}",
+               label=_row_label(row))
 
 
 def _row_label(row):
-    """What a limit with the ground says: 'left: x1 \u2265 0 m'."""
+    """What a limit says: 'left: x1 \u2265 0 m' with the ground, 'stop: x2 \u2265 x1 + 0.5 m'
+    between two bodies."""
     sign = "\u2265" if row.side == "min" else "\u2264"
-    return f"{row.name}: x{row.b} {sign} {row.limit:.4g} m"
+    if row.a == 0:
+        return f"{row.name}: x{row.b} {sign} {row.limit:.4g} m"
+    offset = f"+ {row.limit:.4g}" if row.limit >= 0 else f"\u2212 {-row.limit:.4g}"
+    return f"{row.name}: x{row.b} {sign} x{row.a} {offset} m"
 
 
 def _draw_impact_marks(ax, mech):
@@ -1270,7 +1321,7 @@ class _Stage:
     def _draw_walls(self):
         for row in (r for r in self.mech.rows if r.a == 0):
             edge = row.limit - self.w / 2 if row.side == "min" else row.limit + self.w / 2
-            wall = (row.b, row.side) in ((1, "min"), (self.mech.n, "max"))
+            wall = _is_wall(row, self.mech.n)
             # Stops' labels a line above the walls': a stop may stand near a wall.
             self.ax.text(edge, 0.02 if wall else 0.1, _row_label(row), fontsize="x-small",
                          transform=self.ax.get_xaxis_transform(), color="0.25",
