@@ -401,6 +401,49 @@ def test_results_do_not_share_arrays():
     assert first.scene.m1 == scene.m1 and impact1d.simulate(scene).scene.m1 == scene.m1
 
 
+TUTORIAL_KINDS = ("left", "right", "slot_min", "slot_max", "rest_left", "rest_right", "rest_slot_min",
+                  "rest_slot_max", "release_left", "release_right", "release_slot_min", "release_slot_max",
+                  "stick1", "stick2", "slip1", "slip2")
+
+
+def test_event_kinds_without_a_scene_are_the_tutorials():
+    assert impact1d.event_kinds() == TUTORIAL_KINDS
+    assert impact1d.event_kinds(None) == TUTORIAL_KINDS
+
+
+def test_event_kinds_of_a_scene_are_its_rows_and_bodies_in_the_engines_order():
+    """A scene's kinds: impacts per row (the walls and slot it has, then its records'
+    rows by name), rest_ and release_ per row, stick and slip per body; the same from a
+    Result of it, from its output read back, and in the order the CLI counts them."""
+    scene = impact1d.load_scene(INPUT / "inner_stop.nml")
+    rows = ("left", "slot_max", "stop", "wall1")
+    expected = rows + tuple("rest_" + r for r in rows) + tuple("release_" + r for r in rows) + \
+        ("stick1", "stick2", "slip1", "slip2")
+    assert impact1d.event_kinds(scene) == expected
+    result = impact1d.simulate(scene)
+    assert impact1d.event_kinds(result) == expected
+    assert set(result.events["kind"]) <= set(expected)
+    assert impact1d.event_kinds() == TUTORIAL_KINDS          # (no state left behind)
+    one_body = impact1d.Scene(m1=1.0, x1=0.0, x_left=-1.0, t_end=1.0, dt=1e-3, f1=-1.0,
+                              contacts=[dict(a=1, b=0, d_min=-0.5)])
+    assert impact1d.event_kinds(one_body) == ("left", "contact1", "rest_left", "rest_contact1",
+                                              "release_left", "release_contact1", "stick1", "slip1")
+    # the CLI's summary counts the kinds in this order
+    from tools import find_tool
+    summary = subprocess.run([find_tool("impact1d"), str(INPUT / "inner_stop.nml"), "-o", "-"],
+                             capture_output=True, text=True, check=True).stderr
+    counted = re.search(r"^\s*events\s+(.*)$", summary, re.M).group(1).split()[::2]
+    assert counted == [kind for kind in expected if kind in counted] and len(counted) > 4
+
+
+def test_event_kinds_of_a_bad_scene_raise_as_simulate_does():
+    scene = impact1d.load_scene(INPUT / "inner_stop.nml")
+    with pytest.raises(InputError, match="m1"):
+        impact1d.event_kinds(dataclasses.replace(scene, m1=-1.0))
+    with pytest.raises(InputError, match="Scene or Result"):
+        impact1d.event_kinds("input/inner_stop.nml")
+
+
 def test_event_kinds_come_from_the_runs_rows_and_bodies():
     """Event (class, index) is named from the run's rows (1 impact, 2 rest, 3 release) and
     bodies (4 stick, 5 slip); anything outside them is 'unknown', never another's name."""

@@ -149,9 +149,39 @@ def _sample_capacity(scene) -> int:
         return 1
 
 
+def event_kinds(scene=None) -> tuple:
+    """The event kinds a run can log, in the order the engine counts them: each contact
+    row's impacts ('<row>'), each row's 'rest_<row>', each row's 'release_<row>', each
+    body's 'stick<i>', each body's 'slip<i>'. Without an argument, those of the tutorial's
+    scenes (two bodies, its walls and slot: 16, whichever of them a scene has); with a
+    Scene, or a Result (its scene's), that scene's: its rows as the engine builds them (the
+    walls and slot it has, then its &contact records' rows, by name) and its bodies. The
+    scene is set up by the engine (a run of no length): one it refuses raises InputError
+    as simulate does."""
+    if scene is None:
+        return _tutorial_event_kinds()
+    if isinstance(scene, Result):
+        if scene.scene is None:
+            raise InputError("the result has no scene to take its event kinds from")
+        scene = scene.scene
+    if not isinstance(scene, Scene):
+        raise InputError(f"event_kinds() takes an impact1d.Scene or Result, got {type(scene).__name__}")
+    simulate(scene, t_end=_NO_TIME, dt_out=None)
+    # simulate leaves the run's rows in this thread's buffers until the next call
+    rows, n_rows = _buffers.row_name_codes, int(_buffers.info[3])
+    one_body = _column_layout(_buffers.has_column.tobytes())[1]
+    table, _ = _kind_table(np.ascontiguousarray(rows[:, :n_rows].T).tobytes(), n_rows,
+                           1 if one_body else 2)
+    return tuple(str(kind) for kind in table[:-1])      # (without 'unknown')
+
+
+# The run event_kinds(scene) makes to have the engine build the scene's rows: the shortest
+# (one sample each end), whatever the scene's own t_end.
+_NO_TIME = 1e-300
+
+
 @lru_cache(maxsize=None)
-def event_kinds() -> tuple:
-    """The event kinds of the tutorial's scenes (one or two bodies, its walls and slot)."""
+def _tutorial_event_kinds() -> tuple:
     return _words(_api.event_kind_names())
 
 
