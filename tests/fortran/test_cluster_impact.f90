@@ -11,7 +11,7 @@ program test_cluster_impact
   use impact1d_lcp, only: lcp_solved
   use impact1d_clusters, only: row_rate
   use impact1d_cluster_impact, only: impact_work_type, impact_reserve, cluster_projection
-  use testing, only: check, finish, two_body
+  use testing, only: check, finish, two_body, seed_random
   implicit none
   integer, parameter :: max_n = 8
   !> The two-body scene's rows on their ends: left (0, 1), right (0, 2), slot_min, slot_max.
@@ -19,13 +19,8 @@ program test_cluster_impact
   real(wp), parameter :: pair_normal(2, 4) = reshape([0.0_wp, 1.0_wp, 0.0_wp, -1.0_wp, -1.0_wp, 1.0_wp, &
     1.0_wp, -1.0_wp], [2, 4])
   type(impact_work_type) :: work
-  integer :: seed_size, i
-  integer, allocatable :: seed(:)
 
-  call random_seed(size=seed_size)
-  allocate(seed(seed_size))
-  seed = [(7177 * i + 5, i = 1, seed_size)]
-  call random_seed(put=seed)
+  call seed_random(7177, 5)
   call impact_reserve(work, max_n, 2 * max_n)
   call against_two_body()
   call random_chains()

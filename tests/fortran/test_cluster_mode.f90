@@ -8,7 +8,7 @@ program test_cluster_mode
   use impact1d_modes, only: mode_type, pair_type, solve_mode, pair_rows
   use impact1d_clusters, only: row_rate
   use impact1d_cluster_mode, only: cluster_work_type, cluster_reserve, cluster_mode, cluster_solved
-  use testing, only: check, finish
+  use testing, only: check, finish, seed_random
   implicit none
   integer, parameter :: max_n = 8, trials = 20000
   !> Rows a random problem picks from: ends (a, b) and coefficients (n_a, n_b) on x_b - x_a.
@@ -16,13 +16,9 @@ program test_cluster_mode
   real(wp), parameter :: menu_normal(2, 6) = reshape([0.0_wp, 1.0_wp, 0.0_wp, -1.0_wp, 0.0_wp, 1.0_wp, &
     0.0_wp, -1.0_wp, -1.0_wp, 1.0_wp, 1.0_wp, -1.0_wp], [2, 6])
   type(cluster_work_type) :: work
-  integer :: seed_size, i
-  integer, allocatable :: seed(:)
+  integer :: i
 
-  call random_seed(size=seed_size)
-  allocate(seed(seed_size))
-  seed = [(104729 * i + 3, i = 1, seed_size)]
-  call random_seed(put=seed)
+  call seed_random(104729, 3)
   call cluster_reserve(work, max_n, 2 * max_n)
 
   call against_enumerator()

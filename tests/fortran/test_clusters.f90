@@ -4,18 +4,14 @@
 !> split and joined by hand, with a rigid link's two rows between one pair.
 program test_clusters
   use impact1d_clusters, only: cluster_set_type, clusters_build, clusters_close, clusters_open, uf_join, uf_find
-  use testing, only: check, finish
+  use testing, only: check, finish, seed_random
   implicit none
   integer, parameter :: n = 30, nr = 60, steps = 20000
   type(cluster_set_type) :: set
-  integer :: row_body(2, nr), k, step, seed_size, i, wrong
-  integer, allocatable :: seed(:)
+  integer :: row_body(2, nr), k, step, wrong
   real :: u(3)
 
-  call random_seed(size=seed_size)
-  allocate(seed(seed_size))
-  seed = [(31337 * i + 11, i = 1, seed_size)]
-  call random_seed(put=seed)
+  call seed_random(31337, 11)
   do k = 1, nr
     call random_number(u)
     row_body(2, k) = 1 + int(n * u(1))

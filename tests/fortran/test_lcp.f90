@@ -7,18 +7,14 @@ program test_lcp
   use impact1d_kinds, only: wp
   use impact1d_lcp, only: lcp_work_type, lcp_reserve, lcp_solve, lcp_basis_values, &
     lcp_solved, lcp_ray, lcp_too_large
-  use testing, only: check, finish
+  use testing, only: check, finish, seed_random
   implicit none
   integer, parameter :: cap = 16
   type(lcp_work_type) :: work
   real(wp) :: m(cap, cap), q(cap), dq(cap), z(cap), w(cap), zb(cap), worst
-  integer :: status, trial, n, seed_size, i, fails
-  integer, allocatable :: seed(:)
+  integer :: status, trial, n, i, fails
 
-  call random_seed(size=seed_size)
-  allocate(seed(seed_size))
-  seed = [(7919 * i + 17, i = 1, seed_size)]
-  call random_seed(put=seed)
+  call seed_random(7919, 17)
   call lcp_reserve(work, cap)
 
   ! P-matrices (positive definite, symmetric or not): the solution is unique.

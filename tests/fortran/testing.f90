@@ -12,13 +12,25 @@ module testing
   use impact1d_chain, only: input_records, mechanism_records
   implicit none
   private
-  public :: check, finish, two_body, on_rows, row_values, row_of
+  public :: check, finish, two_body, on_rows, row_values, row_of, seed_random
 
   integer, save :: failures = 0
   !> What two_body starts from: two unit masses a metre apart, a second's run at 1 ms steps.
   character(len=*), parameter :: base_scene = 'm1 = 1, m2 = 1, x1 = 0, x2 = 1, t_end = 1, dt = 1e-3'
 
 contains
+
+  !> Seed the random numbers with seed(i) = multiplier i + offset, so that a test's random
+  !> problems are the same on every run (and a failure can be reproduced).
+  subroutine seed_random(multiplier, offset)
+    integer, intent(in) :: multiplier, offset
+    integer :: seed_size, i
+    integer, allocatable :: seed(:)
+    call random_seed(size=seed_size)
+    allocate(seed(seed_size))
+    seed = [(multiplier * i + offset, i = 1, seed_size)]
+    call random_seed(put=seed)
+  end subroutine seed_random
 
   subroutine check(condition, what)
     logical, intent(in) :: condition
