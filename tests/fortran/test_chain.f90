@@ -6,11 +6,13 @@ program test_chain
   use impact1d_error, only: error_type
   use impact1d_scene, only: scene_input, is_nbody
   use impact1d_io, only: read_scene_file
-  use impact1d_chain, only: input_records, mechanism_records, n_bodies_of
+  use impact1d_chain, only: input_records, mechanism_records, n_bodies_of, alias_slot, slot_of
+  use impact1d_fields, only: n_arrays, alias_name
   use testing, only: check, finish
   implicit none
   character(len=*), parameter :: path = 'output/test_chain_scene.nml'
   type(mechanism_records) :: r
+  integer :: j, i
 
   ! The tutorial's case 3 with springs: left, right, slot; k1 (0,1), k2 (0,2), k12 (1,2).
   call records_of([character(len=80) :: &
@@ -54,6 +56,15 @@ program test_chain
   call check(all(r%element_body(:, 5) == [1, 2]) .and. all(r%element_body(:, 7) == [3, 4]) .and. &
     all(r%element_body(:, 8) == [0, 4]) .and. r%element_rest(8) == 3.0_wp .and. r%element_k(8) == 7.0_wp, &
     'chain: link springs, then the record turned round')
+
+  ! The table of the tutorial's names (element reads two-body arrays through it) names the
+  ! slots a search of the names finds.
+  do j = 1, n_arrays
+    do i = 1, 3
+      call check(alias_slot(j, i) == slot_of(alias_name(j, i)), 'alias_slot: ' // trim(alias_name(j, i)))
+    end do
+  end do
+
   call finish('test_chain')
 
 contains
