@@ -2,8 +2,9 @@
 !> the chain shorthand and the &contact / &spring records into the model's record layout
 !> (issue 19), and a tutorial two-body scene gives today's contacts and springs as records.
 program test_chain
+  use, intrinsic :: iso_fortran_env, only: int64
   use impact1d_kinds, only: wp
-  use impact1d_error, only: error_type
+  use impact1d_error, only: error_type, fmt
   use impact1d_scene, only: scene_input, is_nbody
   use impact1d_io, only: read_scene_file
   use impact1d_chain, only: input_records, mechanism_records, n_bodies_of, alias_slot, slot_of
@@ -13,6 +14,9 @@ program test_chain
   character(len=*), parameter :: path = 'output/test_chain_scene.nml'
   type(mechanism_records) :: r
   integer :: j, i
+  integer(int64), parameter :: samples(9) = [0_int64, 7_int64, -7_int64, 10_int64, -10_int64, 1234567890_int64, &
+    huge(0_int64), -huge(0_int64), -huge(0_int64) - 1_int64]
+  character(len=32) :: written
 
   ! The tutorial's case 3 with springs: left, right, slot; k1 (0,1), k2 (0,2), k12 (1,2).
   call records_of([character(len=80) :: &
@@ -65,6 +69,14 @@ program test_chain
     end do
   end do
 
+  ! fmt's integers (the labels of check_start's messages), digit by digit as '(i0)' writes them.
+  do j = 1, size(samples)
+    write(written, '(i0)') samples(j)
+    call check(fmt(samples(j)) == written, 'fmt(int64): ' // trim(written))
+    if (samples(j) >= -huge(0) .and. samples(j) <= huge(0)) &
+      call check(fmt(int(samples(j))) == written, 'fmt(int): ' // trim(written))
+  end do
+  call check(fmt(-huge(0) - 1) == '-2147483648', 'fmt(int): -huge - 1')
   call finish('test_chain')
 
 contains
