@@ -256,10 +256,26 @@ contains
 
   !> What needs no engine, after validate: an N-body scene's arrays element by element, the
   !> records (ends, limits, names) and the initial state inside every contact.
-  subroutine validate_chain(input, error)
+  !> checked_records, when present, takes the records it checked (input_records'): the caller
+  !> that builds the scene from them need not make them again (18 allocations).
+  subroutine validate_chain(input, error, checked_records)
     type(scene_input), intent(in) :: input
     type(error_type), allocatable, intent(out) :: error
+    type(mechanism_records), intent(out), optional :: checked_records
     type(mechanism_records) :: records
+    if (present(checked_records)) then
+      call check_chain(input, checked_records, error)
+    else
+      call check_chain(input, records, error)
+    end if
+  end subroutine validate_chain
+
+  !> validate_chain's checks, the records made on the way (not made after an error in the
+  !> arrays or the records' fields).
+  subroutine check_chain(input, records, error)
+    type(scene_input), intent(in) :: input
+    type(mechanism_records), intent(out) :: records
+    type(error_type), allocatable, intent(out) :: error
     if (input%chain%n_bodies > 2) call check_arrays(input, error)
     if (allocated(error)) return
     if (allocated(input%chain%contacts)) call check_records(input, input%chain%contacts, .true., error)
@@ -270,7 +286,7 @@ contains
     call check_names(records, error)
     if (allocated(error)) return
     call check_start(input, records, error)
-  end subroutine validate_chain
+  end subroutine check_chain
 
   !> An N-body scene's arrays: finite, x given, masses positive, coefficients not negative,
   !> static friction at least sliding, pairs that go together, slot limits in order.

@@ -7,7 +7,7 @@ program test_chain
   use impact1d_error, only: error_type, fmt
   use impact1d_scene, only: scene_input, is_nbody
   use impact1d_io, only: read_scene_file
-  use impact1d_chain, only: input_records, mechanism_records, n_bodies_of, alias_slot, slot_of
+  use impact1d_chain, only: input_records, mechanism_records, n_bodies_of, alias_slot, slot_of, validate_chain
   use impact1d_fields, only: n_arrays, alias_name
   use testing, only: check, finish
   implicit none
@@ -87,6 +87,7 @@ contains
     character(len=*), intent(in) :: lines(:)
     type(mechanism_records), intent(out) :: records
     integer, intent(in) :: n
+    type(mechanism_records) :: checked
     type(scene_input) :: input
     type(error_type), allocatable :: error
     integer :: unit, k
@@ -105,5 +106,18 @@ contains
     call check(n_bodies_of(input) == n, 'records_of: N')
     call check(is_nbody(input) .eqv. n > 2, 'records_of: needs the N-body engine')
     call input_records(input, records)
+    ! validate_chain hands back the records it checked (prepare_scene builds the scene from
+    ! them): the same as input_records'.
+    call validate_chain(input, error, checked)
+    call check(.not. allocated(error), 'records_of: validate_chain')
+    call check(checked%n_contacts == records%n_contacts .and. checked%n_elements == records%n_elements, &
+      'validate_chain: record counts')
+    call check(all(checked%contact_body == records%contact_body) .and. all(checked%contact_has .eqv. &
+      records%contact_has) .and. all(checked%contact_limit == records%contact_limit) .and. &
+      all(checked%contact_restitution == records%contact_restitution) .and. &
+      all(checked%contact_name == records%contact_name), 'validate_chain: contact records')
+    call check(all(checked%element_body == records%element_body) .and. all(checked%element_k == records%element_k) &
+      .and. all(checked%element_c == records%element_c) .and. all(checked%element_rest == records%element_rest), &
+      'validate_chain: element records')
   end subroutine records_of
 end program test_chain
