@@ -107,7 +107,7 @@ contains
     call validate(input, .true., error)
     if (.not. allocated(error)) call validate_chain(input, error, records)
     if (allocated(error)) return
-    call build_scene(input, tables, records, scene, error)
+    call build_scene(input, tables, records, scene, error, validated=.true.)
   end subroutine prepare_scene
 
   !> A namelist scene, read by its own parser: gfortran's namelist reader took an '&initial'
