@@ -8,7 +8,9 @@ module impact1d_chain
   use impact1d_error, only: error_type, raise, status_input, fmt
   use impact1d_scene, only: scene_input, real_names, text_names, n_real, n_text, set_text, name_of, value_or, &
     positive_value, nonnegative_value, unit_interval, resolvable, i_m1, i_m2, i_x_left, i_r_left, i_x_right, i_r_right, &
-    i_r_min, i_d_min, i_g, default_gravity
+    i_r_min, i_d_min, i_g, default_gravity, i_mu1, i_mu2, i_mus1, i_mus2, i_x1, i_x2, i_v1, i_v2, i_f1, i_f2, &
+    i_f1_amp, i_f2_amp, i_f1_period, i_f2_period, i_f1_phase, i_f2_phase, i_k1, i_k2, i_x1_rest, i_x2_rest, &
+    i_c1, i_c2, i_d_max, i_r_max, i_k12, i_d_rest, i_c12, i_f1_table, i_f2_table
   use impact1d_fields, only: n_arrays, array_names, array_is_link, array_is_text, alias_name, name_len, &
     record_input, a_m, a_mu, a_mus, a_x, a_f_amp, a_f_period, a_f_phase, a_k, a_x_rest, a_c, a_d_min, a_r_min, &
     a_d_max, a_r_max, a_k_link, a_d_rest, a_c_link, r_a, r_b, r_d_min, r_r_min, r_d_max, r_r_max, r_k, r_d_rest, &
@@ -16,7 +18,7 @@ module impact1d_chain
     a_f_table, mechanism_records
   implicit none
   private
-  public :: settle_chain, validate_chain, input_records, mechanism_records, n_bodies_of, slot_of
+  public :: settle_chain, validate_chain, input_records, mechanism_records, n_bodies_of, slot_of, alias_slot
   public :: id_arrays, id_r_meet, id_contact, id_spring, n_ids, field_name, field_is_text, assign_number, &
     assign_text, scene_assignments
 
@@ -26,6 +28,15 @@ module impact1d_chain
   integer, parameter :: id_arrays = n_real + n_text, id_r_meet = id_arrays + n_arrays + 1, &
     id_contact = id_r_meet, id_spring = id_contact + n_contact_fields, n_ids = id_spring + n_spring_fields
 
+
+  !> alias_slot(j, i) for i = 1, 2 (0: no such name), impact1d_fields' array order:
+  !> element reads a two-body scene's arrays through it, and a search of the names by string
+  !> cost 2 x 10^5 instructions per prepare_scene (3/4 of a short run's set-up).
+  !> test_chain checks it against the search.
+  integer, parameter :: alias_slots(2, n_arrays) = reshape([i_m1, i_m2, i_mu1, i_mu2, i_mus1, i_mus2, &
+    i_x1, i_x2, i_v1, i_v2, i_f1, i_f2, i_f1_amp, i_f2_amp, i_f1_period, i_f2_period, i_f1_phase, i_f2_phase, &
+    i_k1, i_k2, i_x1_rest, i_x2_rest, i_c1, i_c2, i_d_min, 0, i_r_min, 0, i_d_max, 0, i_r_max, 0, i_k12, 0, &
+    i_d_rest, 0, i_c12, 0, n_real + i_f1_table, n_real + i_f2_table], [2, n_arrays])
 
   !> Arrays whose elements must not be negative.
   integer, parameter :: nonnegative_arrays(6) = [a_mu, a_mus, a_k, a_c, a_k_link, a_c_link]
@@ -99,7 +110,7 @@ contains
     integer :: j, i, slot
     do j = 1, n_arrays
       do i = 1, 2
-        slot = slot_of(alias_name(j, i))
+        slot = alias_slot(j, i)
         if (slot == 0) cycle
         if (.not. given_slot(input, slot)) cycle
         call raise(error, status_input, trim(alias_name(j, i)) // ' is a name of a one- or two-body scene, ' // &
@@ -119,7 +130,7 @@ contains
     integer :: i, slot
     character(len=16) :: spelled
     do i = 1, input%chain%array(j)%n
-      slot = slot_of(alias_name(j, i))
+      slot = alias_slot(j, i)
       write(spelled, '(a, "(", i0, ")")') trim(array_names(j)), i
       if (given_slot(input, slot)) then
         call raise(error, status_input, trim(alias_name(j, i)) // ' is given and so is ' // trim(array_names(j)) // &
@@ -170,6 +181,13 @@ contains
     end do
   end function slot_of
 
+  !> The slot of the tutorial's name of element i of array j ('m2', 'k12'), 0 when it has none.
+  pure integer function alias_slot(j, i)
+    integer, intent(in) :: j, i
+    alias_slot = 0
+    if (i == 1 .or. i == 2) alias_slot = alias_slots(i, j)
+  end function alias_slot
+
   !> Whether slot k (a scalar, or n_real + a text) is given.
   pure logical function given_slot(input, k)
     type(scene_input), intent(in) :: input
@@ -199,7 +217,7 @@ contains
       given = input%chain%array(j)%n >= i
       if (given) value = input%chain%array(j)%v(i)
     else
-      slot = slot_of(alias_name(j, i))
+      slot = alias_slot(j, i)
       if (slot < 1 .or. slot > n_real) return
       given = input%given(slot)
       value = input%value(slot)
@@ -232,16 +250,32 @@ contains
     if (input%chain%n_bodies > 2) then
       write(name, '(a, "(", i0, ")")') trim(array_names(j)), i
     else
-      name = name_of(input, slot_of(alias_name(j, i)))
+      name = name_of(input, alias_slot(j, i))
     end if
   end function element_name
 
   !> What needs no engine, after validate: an N-body scene's arrays element by element, the
   !> records (ends, limits, names) and the initial state inside every contact.
-  subroutine validate_chain(input, error)
+  !> checked_records, when present, takes the records it checked (input_records'): the caller
+  !> that builds the scene from them need not make them again (18 allocations).
+  subroutine validate_chain(input, error, checked_records)
     type(scene_input), intent(in) :: input
     type(error_type), allocatable, intent(out) :: error
+    type(mechanism_records), intent(out), optional :: checked_records
     type(mechanism_records) :: records
+    if (present(checked_records)) then
+      call check_chain(input, checked_records, error)
+    else
+      call check_chain(input, records, error)
+    end if
+  end subroutine validate_chain
+
+  !> validate_chain's checks, the records made on the way (not made after an error in the
+  !> arrays or the records' fields).
+  subroutine check_chain(input, records, error)
+    type(scene_input), intent(in) :: input
+    type(mechanism_records), intent(out) :: records
+    type(error_type), allocatable, intent(out) :: error
     if (input%chain%n_bodies > 2) call check_arrays(input, error)
     if (allocated(error)) return
     if (allocated(input%chain%contacts)) call check_records(input, input%chain%contacts, .true., error)
@@ -252,7 +286,7 @@ contains
     call check_names(records, error)
     if (allocated(error)) return
     call check_start(input, records, error)
-  end subroutine validate_chain
+  end subroutine check_chain
 
   !> An N-body scene's arrays: finite, x given, masses positive, coefficients not negative,
   !> static friction at least sliding, pairs that go together, slot limits in order.

@@ -120,15 +120,34 @@ contains
     out = text
   end function fmt_real
 
+  !> As write(out, '(i0)') i, digit by digit: the checks of every prepared scene label its
+  !> contacts ('x2 - x1') before they know whether a message needs them, and an internal
+  !> write cost 4,500 instructions of a 70,000-instruction prepare_scene.
   pure function fmt_int64(i) result(out)
     integer(int64), intent(in) :: i
     character(len=fmt_width) :: out
-    write(out, '(i0)') i
+    character(len=fmt_width) :: digits
+    integer(int64) :: rest
+    integer :: at
+    digits = ''
+    at = fmt_width
+    rest = i
+    do                                   ! (abs of each digit: no overflow at -huge - 1)
+      digits(at:at) = achar(iachar('0') + int(abs(mod(rest, 10_int64))))
+      rest = rest / 10_int64
+      if (rest == 0) exit
+      at = at - 1
+    end do
+    if (i < 0) then
+      at = at - 1
+      digits(at:at) = '-'
+    end if
+    out = digits(at:)
   end function fmt_int64
 
   pure function fmt_int(i) result(out)
     integer, intent(in) :: i
     character(len=fmt_width) :: out
-    write(out, '(i0)') i
+    out = fmt_int64(int(i, int64))
   end function fmt_int
 end module impact1d_error

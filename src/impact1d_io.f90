@@ -11,7 +11,7 @@ module impact1d_io
   use impact1d_forcing, only: table_type
   use impact1d_fields, only: n_arrays, array_names, array_groups, array_is_text, n_contact_fields, contact_fields, &
     n_spring_fields, spring_fields, r_name, record_input, text_item
-  use impact1d_chain, only: settle_chain, validate_chain, slot_of, input_records, mechanism_records, id_arrays, id_r_meet, &
+  use impact1d_chain, only: settle_chain, validate_chain, slot_of, mechanism_records, id_arrays, id_r_meet, &
     id_contact, id_spring, n_ids
   use impact1d_files, only: check_input_file
   implicit none
@@ -105,10 +105,9 @@ contains
     ! The records' ends index the bodies: checked (validate_chain) before they are made,
     ! after the scene's values (validate, as build_scene does: its messages come first).
     call validate(input, .true., error)
-    if (.not. allocated(error)) call validate_chain(input, error)
+    if (.not. allocated(error)) call validate_chain(input, error, records)
     if (allocated(error)) return
-    call input_records(input, records)
-    call build_scene(input, tables, records, scene, error)
+    call build_scene(input, tables, records, scene, error, validated=.true.)
   end subroutine prepare_scene
 
   !> A namelist scene, read by its own parser: gfortran's namelist reader took an '&initial'

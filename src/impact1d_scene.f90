@@ -621,14 +621,20 @@ contains
 
   !> Validate and build the model. tables(i) holds f_i's table when the input names one;
   !> records are the scene's contacts and elements (impact1d_chain's input_records).
-  subroutine build_scene(input, tables, records, scene, error)
+  !> validated: the caller has run validate(input, .true.) (prepare_scene, which must before
+  !> it makes the records): not run again (8,000 instructions and 16 allocations a call).
+  subroutine build_scene(input, tables, records, scene, error, validated)
     type(scene_input), intent(in) :: input
     type(table_type), intent(in) :: tables(2)
     type(mechanism_records), intent(in) :: records
     type(scene_type), intent(out) :: scene
     type(error_type), allocatable, intent(out) :: error
+    logical, intent(in), optional :: validated
+    logical :: again
 
-    call validate(input, .true., error)
+    again = .true.
+    if (present(validated)) again = .not. validated
+    if (again) call validate(input, .true., error)
     if (allocated(error)) return
     ! Up to two bodies the two-body kernels run any records (set_rows counts their rows).
     if (is_nbody(input)) then

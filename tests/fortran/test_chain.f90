@@ -2,15 +2,21 @@
 !> the chain shorthand and the &contact / &spring records into the model's record layout
 !> (issue 19), and a tutorial two-body scene gives today's contacts and springs as records.
 program test_chain
+  use, intrinsic :: iso_fortran_env, only: int64
   use impact1d_kinds, only: wp
-  use impact1d_error, only: error_type
+  use impact1d_error, only: error_type, fmt
   use impact1d_scene, only: scene_input, is_nbody
   use impact1d_io, only: read_scene_file
-  use impact1d_chain, only: input_records, mechanism_records, n_bodies_of
+  use impact1d_chain, only: input_records, mechanism_records, n_bodies_of, alias_slot, slot_of, validate_chain
+  use impact1d_fields, only: n_arrays, alias_name
   use testing, only: check, finish
   implicit none
   character(len=*), parameter :: path = 'output/test_chain_scene.nml'
   type(mechanism_records) :: r
+  integer :: j, i
+  integer(int64), parameter :: samples(9) = [0_int64, 7_int64, -7_int64, 10_int64, -10_int64, 1234567890_int64, &
+    huge(0_int64), -huge(0_int64), -huge(0_int64) - 1_int64]
+  character(len=32) :: written
 
   ! The tutorial's case 3 with springs: left, right, slot; k1 (0,1), k2 (0,2), k12 (1,2).
   call records_of([character(len=80) :: &
@@ -54,6 +60,23 @@ program test_chain
   call check(all(r%element_body(:, 5) == [1, 2]) .and. all(r%element_body(:, 7) == [3, 4]) .and. &
     all(r%element_body(:, 8) == [0, 4]) .and. r%element_rest(8) == 3.0_wp .and. r%element_k(8) == 7.0_wp, &
     'chain: link springs, then the record turned round')
+
+  ! The table of the tutorial's names (element reads two-body arrays through it) names the
+  ! slots a search of the names finds.
+  do j = 1, n_arrays
+    do i = 1, 3
+      call check(alias_slot(j, i) == slot_of(alias_name(j, i)), 'alias_slot: ' // trim(alias_name(j, i)))
+    end do
+  end do
+
+  ! fmt's integers (the labels of check_start's messages), digit by digit as '(i0)' writes them.
+  do j = 1, size(samples)
+    write(written, '(i0)') samples(j)
+    call check(fmt(samples(j)) == written, 'fmt(int64): ' // trim(written))
+    if (samples(j) >= -huge(0) .and. samples(j) <= huge(0)) &
+      call check(fmt(int(samples(j))) == written, 'fmt(int): ' // trim(written))
+  end do
+  call check(fmt(-huge(0) - 1) == '-2147483648', 'fmt(int): -huge - 1')
   call finish('test_chain')
 
 contains
@@ -64,6 +87,7 @@ contains
     character(len=*), intent(in) :: lines(:)
     type(mechanism_records), intent(out) :: records
     integer, intent(in) :: n
+    type(mechanism_records) :: checked
     type(scene_input) :: input
     type(error_type), allocatable :: error
     integer :: unit, k
@@ -82,5 +106,18 @@ contains
     call check(n_bodies_of(input) == n, 'records_of: N')
     call check(is_nbody(input) .eqv. n > 2, 'records_of: needs the N-body engine')
     call input_records(input, records)
+    ! validate_chain hands back the records it checked (prepare_scene builds the scene from
+    ! them): the same as input_records'.
+    call validate_chain(input, error, checked)
+    call check(.not. allocated(error), 'records_of: validate_chain')
+    call check(checked%n_contacts == records%n_contacts .and. checked%n_elements == records%n_elements, &
+      'validate_chain: record counts')
+    call check(all(checked%contact_body == records%contact_body) .and. all(checked%contact_has .eqv. &
+      records%contact_has) .and. all(checked%contact_limit == records%contact_limit) .and. &
+      all(checked%contact_restitution == records%contact_restitution) .and. &
+      all(checked%contact_name == records%contact_name), 'validate_chain: contact records')
+    call check(all(checked%element_body == records%element_body) .and. all(checked%element_k == records%element_k) &
+      .and. all(checked%element_c == records%element_c) .and. all(checked%element_rest == records%element_rest), &
+      'validate_chain: element records')
   end subroutine records_of
 end program test_chain
