@@ -3,7 +3,7 @@
 module impact1d_contacts
   use impact1d_kinds, only: wp
   use impact1d_scene, only: scene_type
-  use impact1d_impacts, only: normal_velocity, both_limits_closed
+  use impact1d_impacts, only: normal_velocity
   use impact1d_state, only: lane_state_type, add_compensated
   use impact1d_yardsticks, only: gap_rounding, time_rounding, velocity_rounding
   use impact1d_modes, only: mode_type, pair_rows
@@ -105,14 +105,18 @@ contains
   end subroutine snap
 
   !> Both limits of a link closed (a rigid link, d_min = d_max, whose row_partner the event
-  !> point closed with its row): its bodies are one.
+  !> point closed with its row): its bodies are one. A record's two rows are adjacent, so
+  !> one look at each neighbouring pair is what both_limits_closed over every row found
+  !> (called several times an event: one pass, no inner loop).
   pure logical function rigid_pair(scene, closed)
     type(scene_type), intent(in) :: scene
     logical, intent(in) :: closed(pair_rows)
     integer :: k
     rigid_pair = .false.
-    do k = 1, scene%n_rows
-      rigid_pair = rigid_pair .or. both_limits_closed(scene, k, closed)
+    do k = 1, scene%n_rows - 1
+      if (closed(k) .and. closed(k + 1)) then
+        if (scene%row_contact(k) == scene%row_contact(k + 1)) rigid_pair = .true.
+      end if
     end do
   end function rigid_pair
 

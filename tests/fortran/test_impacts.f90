@@ -4,7 +4,8 @@ program test_impacts
   use impact1d_kinds, only: wp
   use impact1d_scene, only: scene_type, i_left, i_right, i_slot_min, i_slot_max
   use impact1d_impacts, only: impulse, normal_velocity, most_approaching, restitution_of, &
-    joint_inelastic, inelastic_projection
+    joint_inelastic, inelastic_projection, both_limits_closed
+  use impact1d_contacts, only: rigid_pair
   use testing, only: check, finish, two_body, on_rows, row_values
   use impact1d_modes, only: pair_rows
   implicit none
@@ -12,6 +13,8 @@ program test_impacts
   real(wp), parameter :: tol = 1.0e-13_wp
   type(scene_type) :: scene
   real(wp) :: v(2), v_after(2), r, expected(2)
+  integer :: pattern, k
+  logical :: any_both
   logical :: closed(pair_rows), pushed(pair_rows)
   real(wp), parameter :: no_tol(pair_rows) = 0.0_wp
   ! The solver's rounding level of a normal velocity of about 8 m/s (64 ulps of it).
@@ -82,6 +85,20 @@ program test_impacts
   call two_body(contacts // ', r_left = 0, r_right = 0, r_min = 0, r_max = 0', scene)
   call check(.not. joint_inelastic(scene, on_rows([.false., .false., .true., .false.])), 'one closed contact: one impulse')
   call check(.not. joint_inelastic(scene, on_rows([.false., .false., .true., .true.])), 'a rigid link alone: one impulse')
+
+  ! rigid_pair looks at neighbouring rows once: for every closed pattern it is whether any
+  ! row has both limits of its record closed (a rigid link: slot_min and slot_max only).
+  call two_body(contacts, scene)
+  do pattern = 0, 15
+    closed = on_rows([btest(pattern, 0), btest(pattern, 1), btest(pattern, 2), btest(pattern, 3)])
+    any_both = .false.
+    do k = 1, scene%n_rows
+      any_both = any_both .or. both_limits_closed(scene, k, closed)
+    end do
+    call check(rigid_pair(scene, closed) .eqv. any_both, 'rigid_pair: any record with both limits closed')
+    call check(rigid_pair(scene, closed) .eqv. (closed(i_slot_min) .and. closed(i_slot_max)), &
+      'rigid_pair: only the slot''s two limits make a rigid pair')
+  end do
 
   call finish('test_impacts')
 
