@@ -25,6 +25,7 @@ module impact1d_forcing
     procedure :: allocate_bodies
     procedure :: set_varies
     procedure :: force
+    procedure :: force_all
     procedure :: rate
     procedure :: next_breakpoint
     procedure :: is_polynomial
@@ -72,17 +73,39 @@ contains
     integer :: i
     do i = 1, max_lanes      ! (a loop of max_lanes trips the compiler unrolls: N <= max_lanes)
       if (i > size(self%constant)) exit
-      if (self%has_table(i)) f(i) = f(i) + table_value(self%table(i), t)
-      if (self%has_sine(i)) f(i) = f(i) + self%amp(i) * sin(self%omega(i) * t + self%phase(i))
+      call add_body_varying(self, i, t, f(i))
     end do
   end subroutine add_varying
 
-  !> Right derivative df/dt at t, in lanes: tells which way a force that is exactly at a
-  !> bound will go.
+  !> fi += body i's table and sine terms at t (the table's first: the order of the sums).
+  pure subroutine add_body_varying(self, i, t, fi)
+    class(forcing_type), intent(in) :: self
+    integer, intent(in) :: i
+    real(wp), intent(in) :: t
+    real(wp), intent(inout) :: fi
+    if (self%has_table(i)) fi = fi + table_value(self%table(i), t)
+    if (self%has_sine(i)) fi = fi + self%amp(i) * sin(self%omega(i) * t + self%phase(i))
+  end subroutine add_body_varying
+
+  !> Forces on all N bodies at time t (N-long: the N-body engine's; force's sums).
+  pure subroutine force_all(self, t, f)
+    class(forcing_type), intent(in) :: self
+    real(wp), intent(in) :: t
+    real(wp), contiguous, intent(out) :: f(:)
+    integer :: i
+    f = self%constant
+    if (.not. self%varies) return
+    do i = 1, size(f)
+      call add_body_varying(self, i, t, f(i))
+    end do
+  end subroutine force_all
+
+  !> Right derivative df/dt at t, in lanes or N-long (a lane past N 0): tells which way a
+  !> force that is exactly at a bound will go.
   pure subroutine rate(self, t, df)
     class(forcing_type), intent(in) :: self
     real(wp), intent(in) :: t
-    real(wp), intent(out) :: df(max_lanes)
+    real(wp), intent(out) :: df(:)
     integer :: i, k
     df = 0.0_wp      ! (and an idle lane)
     do i = 1, size(self%constant)
