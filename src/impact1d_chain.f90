@@ -11,7 +11,7 @@ module impact1d_chain
     i_r_min, i_d_min, i_g, default_gravity, i_mu1, i_mu2, i_mus1, i_mus2, i_x1, i_x2, i_v1, i_v2, i_f1, i_f2, &
     i_f1_amp, i_f2_amp, i_f1_period, i_f2_period, i_f1_phase, i_f2_phase, i_k1, i_k2, i_x1_rest, i_x2_rest, &
     i_c1, i_c2, i_d_max, i_r_max, i_k12, i_d_rest, i_c12, i_f1_table, i_f2_table
-  use impact1d_fields, only: n_arrays, array_names, array_is_link, array_is_text, alias_name, name_len, &
+  use impact1d_fields, only: array_value, n_arrays, array_names, array_is_link, array_is_text, alias_name, name_len, &
     record_input, a_m, a_mu, a_mus, a_x, a_f_amp, a_f_period, a_f_phase, a_k, a_x_rest, a_c, a_d_min, a_r_min, &
     a_d_max, a_r_max, a_k_link, a_d_rest, a_c_link, r_a, r_b, r_d_min, r_r_min, r_d_max, r_r_max, r_k, r_d_rest, &
     r_c, contact_fields, spring_fields, r_name, n_contact_fields, n_spring_fields, written_array, text_item, &
@@ -215,7 +215,7 @@ contains
     given = .false.
     if (input%chain%n_bodies > 2) then
       given = input%chain%array(j)%n >= i
-      if (given) value = input%chain%array(j)%v(i)
+      value = array_value(input%chain, j, i, 0.0_wp)
     else
       slot = alias_slot(j, i)
       if (slot < 1 .or. slot > n_real) return

@@ -6,7 +6,7 @@ module impact1d_event_log
   use impact1d_kinds, only: wp
   use impact1d_lanes, only: max_lanes
   use impact1d_scene, only: scene_type
-  use impact1d_output, only: sink_type, run_stats, class_rest, class_release, count_event
+  use impact1d_output, only: sink_type, run_stats, class_rest, class_release, class_stick, class_slip, count_event
   use impact1d_yardsticks, only: same_instant
   implicit none
   private
@@ -65,8 +65,18 @@ contains
     integer, intent(in) :: class, index
     real(wp), intent(in) :: v_before(:), v_after(:)
     real(wp) :: v(4)
+    integer :: ends(2)
     call count_event(stats, class, index)
     v = 0.0_wp
+    if (scene%n_bodies > 2) then
+      ! N bodies: the event's own pair, the row's ends or (body, 0).
+      ends = [index, 0]
+      if (class /= class_stick .and. class /= class_slip) ends = scene%row_body(:, index)
+      call pair_velocities(ends, v_before, v(1:2))
+      call pair_velocities(ends, v_after, v(3:4))
+      call sink%put_event(t, class, index, ends(1), ends(2), v)
+      return
+    end if
     v(1) = v_before(1)
     v(3) = v_after(1)
     if (scene%n_bodies == 2) then
@@ -75,6 +85,23 @@ contains
     end if
     call sink%put_event(t, class, index, 1, merge(2, 0, scene%n_bodies == 2), v)
   end subroutine log_event
+
+  !> The velocities of a pair's ends (0 for the ground) from the N bodies' velocities v, or
+  !> from v itself when it holds the pair's two (a release's, kept by the log).
+  pure subroutine pair_velocities(ends, v, pair)
+    integer, intent(in) :: ends(2)
+    real(wp), intent(in) :: v(:)
+    real(wp), intent(out) :: pair(2)
+    integer :: e
+    if (size(v) == 2) then
+      pair = v
+      return
+    end if
+    pair = 0.0_wp
+    do e = 1, 2
+      if (ends(e) > 0) pair(e) = v(ends(e))
+    end do
+  end subroutine pair_velocities
 
   !> Rest after an accumulation of impacts is logged at the accumulation time (t, velocities v).
   subroutine flush_pending_rest(self, scene, t, v, sink, stats)

@@ -12,7 +12,7 @@ module impact1d_fields
   public :: a_d_min, a_r_min, a_d_max, a_r_max, a_k_link, a_d_rest, a_c_link, a_f_table
   public :: n_contact_fields, contact_fields, n_spring_fields, spring_fields
   public :: r_a, r_b, r_d_min, r_r_min, r_d_max, r_r_max, r_name, r_k, r_d_rest, r_c
-  public :: name_len, text_item, written_array, record_input, chain_input, alias_name, mechanism_records
+  public :: name_len, text_item, written_array, record_input, chain_input, alias_name, mechanism_records, array_value
 
   !> Longest contact name a record may carry (names of events: '<name>', 'rest_<name>', ...).
   integer, parameter :: name_len = 32
@@ -97,6 +97,15 @@ module impact1d_fields
   end type mechanism_records
 
 contains
+
+  !> Element i of array j of a chain (N > 2: as written), or default when it is not written.
+  pure real(wp) function array_value(chain, j, i, default)
+    type(chain_input), intent(in) :: chain
+    integer, intent(in) :: j, i
+    real(wp), intent(in) :: default
+    array_value = default
+    if (chain%array(j)%n >= i) array_value = chain%array(j)%v(i)
+  end function array_value
 
   !> The tutorial's name of element i of array j ('m2', 'k12'), or '' when it has none.
   pure function alias_name(j, i) result(name)

@@ -10,9 +10,9 @@ module impact1d_io
     i_substeps, i_events
   use impact1d_forcing, only: table_type
   use impact1d_fields, only: n_arrays, array_names, array_groups, array_is_text, n_contact_fields, contact_fields, &
-    n_spring_fields, spring_fields, r_name, record_input, text_item
+    n_spring_fields, spring_fields, r_name, record_input, text_item, a_f_table
   use impact1d_chain, only: settle_chain, validate_chain, slot_of, mechanism_records, id_arrays, id_r_meet, &
-    id_contact, id_spring, n_ids
+    id_contact, id_spring, n_ids, n_bodies_of
   use impact1d_files, only: check_input_file
   implicit none
   private
@@ -91,14 +91,28 @@ contains
     type(scene_input), intent(in) :: input
     type(scene_type), intent(out) :: scene
     type(error_type), allocatable, intent(out) :: error
-    type(table_type) :: tables(2)
+    type(table_type), allocatable :: tables(:)
     type(mechanism_records) :: records
+    character(len=:), allocatable :: path
     integer :: i
-    do i = 1, 2
-      if (len_trim(input%text(i_f1_table + i - 1)%s) == 0) cycle
-      call read_table(trim(input%text(i_f1_table + i - 1)%s), tables(i), error)
+    allocate(tables(max(2, n_bodies_of(input))))
+    do i = 1, size(tables)
+      ! Body i's table: the tutorial's f1_table, f2_table, or f_table(i) of N > 2 bodies.
+      if (input%chain%n_bodies > 2) then
+        if (input%chain%array(a_f_table)%n < i) cycle
+        path = trim(input%chain%array(a_f_table)%t(i)%s)
+      else
+        if (i > 2) cycle
+        path = trim(input%text(i_f1_table + i - 1)%s)
+      end if
+      if (len(path) == 0) cycle
+      call read_table(path, tables(i), error)
       if (allocated(error)) then
-        error%message = 'f' // trim(fmt(i)) // '_table: ' // error%message
+        if (input%chain%n_bodies > 2) then
+          error%message = 'f_table(' // trim(fmt(i)) // '): ' // error%message
+        else
+          error%message = 'f' // trim(fmt(i)) // '_table: ' // error%message
+        end if
         return
       end if
     end do

@@ -19,7 +19,7 @@ module impact1d_output
   public :: event_impact, event_rest, event_release, event_stick, event_slip, run_stats, checkpoint
   public :: class_impact, class_rest, class_release, class_stick, class_slip, event_name, start_counts, &
     count_event, event_count, impacts_on
-  public :: emit_sample, events_path, present_columns, i_pe, i_work, i_friction_loss, i_impact_loss, &
+  public :: emit_sample, emit_bodies, events_path, present_columns, i_pe, i_work, i_friction_loss, i_impact_loss, &
     i_damping_loss
 
   !> Every column a run can have; a scene's output carries those it has (present_columns):
@@ -244,6 +244,21 @@ contains
       call sink%put_sample(row)
     end associate
   end subroutine emit_sample
+
+  !> TEMPORARY (integrator's branch, replaced by the outputs branch's N-column row): an
+  !> N-body sample as the first two bodies' columns.
+  subroutine emit_bodies(sink, stats, t, x, v, mass, ke0, work, friction_loss, impact_loss, &
+      with_springs, springs, error)
+    class(sink_type), intent(inout) :: sink
+    type(run_stats), intent(inout) :: stats
+    real(wp), contiguous, intent(in) :: x(:), v(:), mass(:)
+    real(wp), intent(in) :: t, ke0, work, friction_loss, impact_loss
+    logical, intent(in) :: with_springs
+    real(wp), intent(in) :: springs(3)
+    type(error_type), allocatable, intent(out) :: error
+    call emit_sample(sink, stats, t, x(1:2), v(1:2), mass(1:2), ke0, work, friction_loss, impact_loss, &
+      with_springs, springs, error)
+  end subroutine emit_bodies
 
   !> The columns a scene's output has, as indices into the full row: all but pe when it names
   !> no spring and damping_loss when it names no damper (a component a scene does not name

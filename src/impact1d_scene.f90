@@ -6,9 +6,10 @@ module impact1d_scene
   use impact1d_kinds, only: wp, eps_wp
   use impact1d_error, only: error_type, raise, status_input, fmt, fmt_width
   use impact1d_forcing, only: forcing_type, table_type
-  use impact1d_springs, only: springs_type, pair_elements
+  use impact1d_springs, only: springs_type, pair_elements, assemble, rate_bound
   use impact1d_modes, only: pair_type, pair_rows
-  use impact1d_fields, only: chain_input, mechanism_records, r_k, r_c
+  use impact1d_fields, only: chain_input, mechanism_records, r_k, r_c, array_value, a_m, a_mu, a_mus, a_x, a_v, &
+    a_f, a_f_amp, a_f_period, a_f_phase, a_f_table
   use impact1d_stability, only: linear_modes, stable_step, mode_error, coarse_rate
   implicit none
   private
@@ -18,7 +19,7 @@ module impact1d_scene
     i_r_min, i_d_max, i_r_max, i_x1, i_v1, i_x2, i_v2, i_f1, i_f2, i_f1_amp, i_f1_period, &
     i_f1_phase, i_f2_amp, i_f2_period, i_f2_phase, i_t_end, i_dt, i_dt_out, i_mus1, i_mus2, &
     i_k1, i_x1_rest, i_c1, i_k2, i_x2_rest, i_c2, i_k12, i_d_rest, i_c12, i_max_events
-  public :: sample_time, set_text, events_kept, name_of, is_nbody, value_or, nbody_refusal
+  public :: sample_time, step_length, set_text, events_kept, name_of, is_nbody, value_or, nbody_refusal
   public :: positive_value, nonnegative_value, unit_interval, resolvable
   public :: i_title, i_f1_table, i_f2_table, i_method, i_substeps, i_events, default_gravity
   public :: events_all, events_impacts, events_none
@@ -72,9 +73,11 @@ module impact1d_scene
   integer, parameter :: name_len = 32
 
   real(wp), parameter :: default_gravity = 9.80665_wp
-  !> What a scene of more than two bodies gets until the cluster solver runs it (is_nbody).
-  character(len=*), parameter :: nbody_refusal = 'more than two bodies need the cluster solver (issue 19, ' // &
-    'stage 4): this build reads and checks such scenes but cannot run them yet'
+  !> What a scene of more than two bodies gets with the vissim method (is_nbody).
+  character(len=*), parameter :: nbody_refusal = "method = 'vissim' is the tutorial's two-body scheme: " // &
+    "a scene of more than two bodies runs with method = 'event'"
+  !> Bodies up to which build_scene checks dt against the springs' modes (a dense eigenproblem).
+  integer, parameter :: max_modal_bodies = 400
   !> The tutorial's zero-velocity threshold, used by the vissim method only.
   real(wp), parameter :: default_zero_velocity = 0.005_wp
   !> Output rows a run may produce: beyond this the user almost surely meant a larger dt_out.
@@ -625,7 +628,7 @@ contains
   !> it makes the records): not run again (8,000 instructions and 16 allocations a call).
   subroutine build_scene(input, tables, records, scene, error, validated)
     type(scene_input), intent(in) :: input
-    type(table_type), intent(in) :: tables(2)
+    type(table_type), intent(in) :: tables(:)   !< (N) body i's force table (when it has one)
     type(mechanism_records), intent(in) :: records
     type(scene_type), intent(out) :: scene
     type(error_type), allocatable, intent(out) :: error
@@ -636,16 +639,20 @@ contains
     if (present(validated)) again = .not. validated
     if (again) call validate(input, .true., error)
     if (allocated(error)) return
-    ! Up to two bodies the two-body kernels run any records (set_rows counts their rows).
-    if (is_nbody(input)) then
-      call raise(error, status_input, nbody_refusal)
-      return
-    end if
-
     scene%title = trim(input%text(i_title)%s)
     scene%method = 'event'
     if (len_trim(input%text(i_method)%s) > 0) scene%method = trim(input%text(i_method)%s)
-    call set_bodies(input, tables, scene)
+    ! Up to two bodies the two-body kernels run any records (set_rows counts their rows);
+    ! more run on the N-body engine (impact1d_nbody_solver), which has no vissim method.
+    if (is_nbody(input)) then
+      if (scene%method == 'vissim') then
+        call raise(error, status_input, nbody_refusal)
+        return
+      end if
+      call set_chain_bodies(input, tables, scene)
+    else
+      call set_bodies(input, tables, scene)
+    end if
     call set_records(input, records, scene)
     call set_rows(scene, error)
     if (allocated(error)) return
@@ -658,7 +665,13 @@ contains
     if (input%given(i_dt_out)) scene%dt_out = input%value(i_dt_out)
     if (input%given(i_zero_vel)) scene%zero_velocity = input%value(i_zero_vel)
     scene%warnings = ''
-    if (scene%springs%present) call check_step(scene, input%text(i_substeps)%s == 'auto', error)
+    ! The modes are a dense eigenproblem (N^3): past max_modal_bodies the step is not checked.
+    if (scene%springs%present .and. scene%n_bodies <= max_modal_bodies) then
+      call check_step(scene, input%text(i_substeps)%s == 'auto', error)
+    else if (scene%springs%present) then
+      scene%warnings = 'the step was not checked against the springs'' modes (more than ' // &
+        trim(fmt(max_modal_bodies)) // ' bodies): choose dt well below 2 / w of the stiffest spring'
+    end if
     if (allocated(error)) return
     scene%events = events_kept(input)
     if (input%given(i_max_impulses)) scene%max_impulses = int(input%value(i_max_impulses))
@@ -671,7 +684,7 @@ contains
   !> The bodies (N: 2 with m2, else 1), their forces, and the kernels' view of them (pair).
   subroutine set_bodies(input, tables, scene)
     type(scene_input), intent(in) :: input
-    type(table_type), intent(in) :: tables(2)
+    type(table_type), intent(in) :: tables(:)
     type(scene_type), intent(inout) :: scene
     integer :: i, k, n
     real(wp) :: g
@@ -724,6 +737,45 @@ contains
     call scene%forcing%set_varies()
   end subroutine set_bodies
 
+  !> The bodies of a scene written as arrays of N > 2 (impact1d_fields' chain_input): body i's
+  !> values at position i, mu and f 0 and mus = mu when absent, v 0; tables(i) its force table.
+  subroutine set_chain_bodies(input, tables, scene)
+    type(scene_input), intent(in) :: input
+    type(table_type), intent(in) :: tables(:)
+    type(scene_type), intent(inout) :: scene
+    integer :: i, n
+    real(wp) :: g, mu
+    n = input%chain%n_bodies
+    scene%n_bodies = n
+    allocate(scene%body_mass(n), scene%body_friction(n), scene%body_static(n), scene%body_x0(n), &
+      scene%body_v0(n))
+    g = value_or(input, i_g, default_gravity)
+    call scene%forcing%allocate_bodies(n)
+    do i = 1, n
+      associate (chain => input%chain)
+        scene%body_mass(i) = array_value(chain, a_m, i, 1.0_wp)
+        mu = array_value(chain, a_mu, i, 0.0_wp)
+        scene%body_friction(i) = max(mu * scene%body_mass(i) * g, 0.0_wp)
+        scene%body_static(i) = max(array_value(chain, a_mus, i, mu) * scene%body_mass(i) * g, &
+          scene%body_friction(i))
+        ! (-0 enters as +0: docs/architecture.md, "Signed zeros")
+        scene%body_x0(i) = array_value(chain, a_x, i, 0.0_wp) + 0.0_wp
+        scene%body_v0(i) = array_value(chain, a_v, i, 0.0_wp) + 0.0_wp
+        scene%forcing%constant(i) = array_value(chain, a_f, i, 0.0_wp)
+        scene%forcing%has_table(i) = .false.
+        if (chain%array(a_f_table)%n >= i) scene%forcing%has_table(i) = len_trim(chain%array(a_f_table)%t(i)%s) > 0
+        if (scene%forcing%has_table(i)) scene%forcing%table(i) = tables(i)
+        scene%forcing%has_sine(i) = chain%array(a_f_amp)%n >= i
+        if (scene%forcing%has_sine(i)) then
+          scene%forcing%amp(i) = array_value(chain, a_f_amp, i, 0.0_wp)
+          scene%forcing%omega(i) = 2.0_wp * acos(-1.0_wp) / array_value(chain, a_f_period, i, 1.0_wp)
+          scene%forcing%phase(i) = array_value(chain, a_f_phase, i, 0.0_wp)
+        end if
+      end associate
+    end do
+    call scene%forcing%set_varies()
+  end subroutine set_chain_bodies
+
   !> The model's contact and element records: impact1d_chain's input_records (the walls,
   !> the slot, then the &contact records; the springs k1, k2, k12, then the &spring records:
   !> the orders of docs/nbody-plan.md B4, B5). A limit of -0 enters as +0 (docs/architecture.md,
@@ -770,6 +822,13 @@ contains
     type(error_type), allocatable, intent(inout) :: error
     integer :: ne
     ne = scene%n_elements
+    if (scene%n_bodies > 2) then
+      ! The N-body engine reads the element records themselves (impact1d_elements).
+      scene%springs%present = ne > 0
+      scene%springs%omega = rate_bound(scene%element_body, scene%element_k, scene%element_c, &
+        minval(scene%body_mass))
+      return
+    end if
     if (ne > pair_elements) then
       call raise(error, status_input, 'the scene has ' // trim(fmt(ne)) // ' springs and dampers: a scene ' // &
         'of one or two bodies has at most ' // trim(fmt(pair_elements)) // ' (the two-body kernels'' elements)')
@@ -811,7 +870,7 @@ contains
     real(wp) :: sgn
     logical :: suffix
     nr = count(scene%contact_has)
-    if (nr > pair_rows) then
+    if (nr > pair_rows .and. scene%n_bodies <= 2) then
       call raise(error, status_input, 'the contacts have ' // trim(fmt(nr)) // ' limits: a scene of one or ' // &
         'two bodies has at most ' // trim(fmt(pair_rows)) // ' (the two-body kernels'' rows)')
       return
@@ -842,7 +901,9 @@ contains
         end if
       end if
     end do
-    ! The kernels' view: each row's coefficients on the pair's lanes (body i in lane i).
+    ! The two-body kernels' view: each row's coefficients on the pair's lanes (body i in
+    ! lane i). The N-body engine reads the rows themselves.
+    if (scene%n_bodies > 2) return
     scene%pair%n_rows = nr
     scene%pair%normal = 0.0_wp
     do r = 1, nr
@@ -870,7 +931,8 @@ contains
     logical :: ok
     integer :: j
 
-    call scene%springs%linear_part(scene%n_bodies, k, c)
+    call assemble(scene%element_body, scene%element_k, k)
+    call assemble(scene%element_body, scene%element_c, c)
     call linear_modes(scene%body_mass, c, k, lambda, ok)
     if (.not. ok) then
       call raise(error, status_input, 'the modes of the springs and dampers could not be found ' // &
@@ -939,7 +1001,7 @@ contains
     integer :: j, ne
     ne = scene%n_elements
     do j = 1, ne
-      associate (m => scene%pair%mass, a => scene%element_body(1, j), b => scene%element_body(2, j))
+      associate (m => scene%body_mass, a => scene%element_body(1, j), b => scene%element_body(2, j))
         mass(j) = m(b)
         if (a > 0) mass(j) = 1.0_wp / (1.0_wp / m(a) + 1.0_wp / m(b))
       end associate
@@ -955,6 +1017,14 @@ contains
       text = 'c' // trim(ends) // ' = ' // trim(fmt(scene%element_c(j)))
     end if
   end function fastest_element
+
+  !> The step toward a stop with `remaining` time to it: dt, or what is left when that is
+  !> less. No sliver steps: a step that would end just short of the stop goes to it.
+  pure real(wp) function step_length(dt, remaining) result(h)
+    real(wp), intent(in) :: dt, remaining
+    h = min(dt, remaining)
+    if (remaining - h <= 1.0e-9_wp * dt) h = remaining
+  end function step_length
 
   !> Output rows of a run: samples at j dt_out from t = 0, and at t_end when it is off that
   !> grid (within 1e-9 of a step it is on it). Real: a refused scene's count may exceed any

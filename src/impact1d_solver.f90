@@ -9,7 +9,7 @@ module impact1d_solver
   use, intrinsic :: iso_fortran_env, only: int64
   use impact1d_kinds, only: wp
   use impact1d_error, only: error_type, raise, status_simulation, fmt
-  use impact1d_scene, only: scene_type, sample_time
+  use impact1d_scene, only: scene_type, sample_time, step_length
   use impact1d_modes, only: mode_type
   use impact1d_impacts, only: normal_velocity, kinetic_energy
   use impact1d_output, only: sink_type, run_stats, emit_sample, checkpoint, start_counts
@@ -23,6 +23,7 @@ module impact1d_solver
   use impact1d_location, only: watch_type, refine, constraints_hold, located_type, located_row
   use impact1d_event_log, only: event_log_type
   use impact1d_event_point, only: event_point
+  use impact1d_nbody_solver, only: run_nbody
   implicit none
   private
   public :: run, run_stats
@@ -73,11 +74,10 @@ contains
     ! What the sink calls the events on each row; nothing counted yet.
     sink%row_names = scene%row_name
     call start_counts(stats, scene%n_rows, scene%n_bodies)
-    ! The stepping kernels take the bodies in lanes (impact1d_lanes); scenes have no more
-    ! bodies than that until the cluster solver (issue 19, stage 4).
+    ! The stepping kernels here take the bodies in lanes (impact1d_lanes); more bodies run
+    ! on the N-body engine.
     if (scene%n_bodies > max_lanes) then
-      call raise(error, status_simulation, 'internal: ' // trim(fmt(scene%n_bodies)) // ' bodies: the ' // &
-        'solver takes at most ' // trim(fmt(max_lanes)) // ' (N-body scenes need the cluster solver, issue 19)')
+      call run_nbody(scene, sink, stats, error)
       return
     end if
     if (scene%method == 'vissim') then
@@ -263,13 +263,6 @@ contains
     real(wp), intent(in) :: t_stop
     h = step_length(scene%dt, (t_stop - s%t) - s%t_lo)
   end function step_toward
-
-  !> step_toward's rule on the time remaining to the stop.
-  pure real(wp) function step_length(dt, remaining) result(h)
-    real(wp), intent(in) :: dt, remaining
-    h = min(dt, remaining)
-    if (remaining - h <= 1.0e-9_wp * dt) h = remaining
-  end function step_length
 
   !> A stop that is a sample and nothing else (no table corner, no accumulation time, not
   !> the run's last sample, which run takes): glide takes its sample and goes on.

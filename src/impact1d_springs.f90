@@ -12,7 +12,7 @@ module impact1d_springs
   use impact1d_lanes, only: max_lanes
   implicit none
   private
-  public :: springs_type, pair_elements
+  public :: springs_type, pair_elements, assemble, rate_bound
 
   !> Elements a unit of two bodies can have: the tutorial's three (each body to the ground,
   !> and between them) and room for more records on the pair (issue 19, stage 3).
@@ -125,17 +125,25 @@ contains
   pure subroutine set_frequency(self, min_mass)
     class(springs_type), intent(inout) :: self
     real(wp), intent(in) :: min_mass
+    self%omega = rate_bound(self%body(:, :self%n), self%k(:self%n), self%c(:self%n), min_mass)
+  end subroutine set_frequency
+
+  !> The stiffest natural frequency and fastest damping rate of elements with ends body and
+  !> coefficients k, c over the lightest mass (set_frequency's bound, for any elements).
+  pure real(wp) function rate_bound(body, k, c, min_mass) result(omega)
+    integer, intent(in) :: body(:, :)
+    real(wp), intent(in) :: k(:), c(:), min_mass
     real(wp) :: stiffness, damping, weight
     integer :: j
     stiffness = 0.0_wp
     damping = 0.0_wp
-    do j = 1, self%n
-      weight = merge(1.0_wp, 2.0_wp, self%body(1, j) == 0)
-      stiffness = stiffness + weight * self%k(j)
-      damping = damping + weight * self%c(j)
+    do j = 1, size(k)
+      weight = merge(1.0_wp, 2.0_wp, body(1, j) == 0)
+      stiffness = stiffness + weight * k(j)
+      damping = damping + weight * c(j)
     end do
-    self%omega = sqrt(stiffness / min_mass) + damping / min_mass
-  end subroutine set_frequency
+    omega = sqrt(stiffness / min_mass) + damping / min_mass
+  end function rate_bound
 
   !> The elements' lane coefficients from their ends (body).
   pure subroutine set_normals(self)
@@ -153,24 +161,26 @@ contains
     class(springs_type), intent(in) :: self
     integer, intent(in) :: n
     real(wp), intent(out) :: k(n, n), c(n, n)
-    call assemble(self, self%k, k)
-    call assemble(self, self%c, c)
+    call assemble(self%body(:, :self%n), self%k(:self%n), k)
+    call assemble(self%body(:, :self%n), self%c(:self%n), c)
   end subroutine linear_part
 
   !> The matrix of the elements' coefficients: each adds its coefficient to its bodies'
   !> diagonal entries and takes it from their shared off-diagonal ones, in record order.
   !> (An off-diagonal entry is set, not summed from +0: a link of coefficient 0 gives -0 there,
   !> as the matrix written out for the tutorial's elements did.)
-  pure subroutine assemble(self, coefficient, matrix)
-    class(springs_type), intent(in) :: self
-    real(wp), intent(in) :: coefficient(pair_elements)
+  !> Elements given by their ends body(:, j) (0 the ground) and coefficients (the N-body
+  !> scenes' element records, or the pair's).
+  pure subroutine assemble(body, coefficient, matrix)
+    integer, intent(in) :: body(:, :)
+    real(wp), intent(in) :: coefficient(:)
     real(wp), intent(out) :: matrix(:, :)
     integer :: j
     logical :: coupled(size(matrix, 1), size(matrix, 1))
     matrix = 0.0_wp
     coupled = .false.
-    do j = 1, self%n
-      associate (a => self%body(1, j), b => self%body(2, j))
+    do j = 1, size(coefficient)
+      associate (a => body(1, j), b => body(2, j))
         matrix(b, b) = matrix(b, b) + coefficient(j)
         if (a == 0) cycle
         matrix(a, a) = matrix(a, a) + coefficient(j)

@@ -1,0 +1,640 @@
+!> The event point of the N-body engine (METHOD.md 5-6; docs/method.md section 9): closed
+!> rows snapped, impacts resolved (one joint inelastic impact of the closed rows when all
+!> are plastic, otherwise sequential impulses on the most approaching row), bounce series
+!> whose rest is below the clock's resolution put to rest (Zeno), stopped bodies zeroed, the
+!> new mode (impact1d_body_mode) and the log of what changed. The rules are the two-body
+!> engine's (impact1d_event_point), on N-long arrays and the rows' ends.
+module impact1d_nbody_event
+  use impact1d_kinds, only: wp, eps_wp
+  use impact1d_error, only: error_type, raise, status_simulation, fmt
+  use impact1d_scene, only: scene_type
+  use impact1d_state, only: state_type, add_compensated
+  use impact1d_output, only: sink_type, run_stats, class_impact, class_rest, class_stick, class_slip
+  use impact1d_yardsticks, only: gap_rounding, velocity_rounding, time_rounding, energy_rounding, same_instant
+  use impact1d_event_log, only: event_log_type, log_event
+  use impact1d_event_point, only: bounce_series_time
+  use impact1d_clusters, only: uf_join, uf_find
+  use impact1d_cluster_impact, only: impact_work_type, impact_reserve, cluster_projection
+  use impact1d_lcp, only: lcp_solved
+  use impact1d_body_mode, only: body_mode_type, mode_work_type, solve_body_mode, mode_solved
+  use impact1d_nbody_step, only: nbody_force, nbody_rate, row_gap, row_velocity, row_gap_tolerance, force_size, &
+    found_row, found_body
+  implicit none
+  private
+  public :: point_work_type, new_point_work, nbody_event_point
+
+  !> The event point's memory (sized by the run) and what one event point leaves for the
+  !> next at the same instant.
+  type :: point_work_type
+    type(mode_work_type) :: mode
+    type(impact_work_type) :: impact
+    !> The last event point's instant and the velocity scale its impulses came from (N).
+    real(wp) :: scale_time = -huge(1.0_wp)
+    real(wp), allocatable :: scale(:)
+    integer, allocatable :: rigid(:)          !< (0:N) bodies locked by rigid links (union-find)
+    real(wp), allocatable :: rigid_mass(:)    !< (0:N) mass of each rigid group, by root
+    integer, allocatable :: local(:)          !< (N) a body's index in a gathered impact
+  end type point_work_type
+
+contains
+
+  !> The event point's memory for n bodies.
+  subroutine new_point_work(n, work)
+    integer, intent(in) :: n
+    type(point_work_type), intent(inout) :: work
+    allocate(work%scale(n), work%rigid(0:n), work%rigid_mass(0:n), work%local(n))
+    work%scale = 0.0_wp
+  end subroutine new_point_work
+
+  !> The event point at s%t: found, index say what the location found (a row, a body); initial:
+  !> the run's start (no mode yet). Leaves the new mode.
+  subroutine nbody_event_point(scene, initial, found, index, s, mode, event_log, work, sink, stats, error)
+    type(scene_type), intent(in) :: scene
+    logical, intent(in) :: initial
+    integer, intent(in) :: found, index
+    type(state_type), intent(inout) :: s
+    type(body_mode_type), intent(inout) :: mode
+    type(event_log_type), intent(inout) :: event_log
+    type(point_work_type), intent(inout) :: work
+    class(sink_type), intent(inout) :: sink
+    type(run_stats), intent(inout) :: stats
+    type(error_type), allocatable, intent(inout) :: error
+    real(wp), dimension(scene%n_bodies) :: f, df, acc, entry_scale
+    logical :: closed(scene%n_rows), candidate(scene%n_rows)
+    type(body_mode_type) :: new
+    integer :: k, i, status
+
+    call nbody_force(scene, s%t, s%x, s%x_lo, s%v, f)
+    call nbody_rate(scene, s%t, s%v, df)
+    call close_rows(scene, initial, merge(index, 0, found == found_row), s, closed)
+    ! Velocity scale of each body entering this event point: impulses redistribute velocity
+    ! but cannot create precision, so what is below its rounding is zero.
+    if (initial) then
+      acc = f / scene%body_mass
+    else
+      call mode%acceleration(f, acc)
+    end if
+    entry_scale = abs(s%v) + abs(acc) * scene%dt
+    if (same_instant(scene, s%t, work%scale_time)) entry_scale = max(entry_scale, work%scale)
+    do i = 1, scene%n_bodies
+      if (scene%body_static(i) == 0.0_wp) cycle
+      if ((found == found_body .and. index == i) .or. abs(s%v(i)) <= velocity_rounding * abs(acc(i)) * scene%dt) &
+        call zero_velocity(scene, s, i)
+    end do
+    call lock_rigid(scene, closed, s, work)
+    call impacts(scene, closed, entry_scale, acc, s, work, sink, stats, error)
+    if (allocated(error)) return
+    work%scale_time = s%t
+    work%scale = entry_scale
+    call settle(scene, mode, closed, f, df, acc, entry_scale, s, event_log, work, sink, stats)
+
+    ! Dampers pull with the velocities the impacts left.
+    if (scene%springs%present) then
+      call nbody_force(scene, s%t, s%x, s%x_lo, s%v, f)
+      call nbody_rate(scene, s%t, s%v, df)
+    end if
+    do k = 1, scene%n_rows
+      candidate(k) = closed(k)
+      if (candidate(k)) candidate(k) = abs(row_velocity(scene, k, s%v)) <= u_tolerance(scene, k, s%v, acc, entry_scale)
+    end do
+    new = mode
+    call solve_body_mode(scene, work%mode, f, df, s%v, candidate, new, status)
+    if (status /= mode_solved) then
+      call raise(error, status_simulation, 'at t = ' // trim(fmt(s%t)) // &
+        ': no consistent contact and friction state (complementarity problem has no solution)')
+      return
+    end if
+    call log_mode_change(scene, initial, f, df, candidate, new, s, event_log, sink, stats)
+    mode = new
+  end subroutine nbody_event_point
+
+  !> The closed rows (the located one, gaps within rounding; at the start, within the
+  !> rounding of the user's decimals), a rigid link's two rows together, each snapped onto
+  !> its constraint.
+  pure subroutine close_rows(scene, initial, located, s, closed)
+    type(scene_type), intent(in) :: scene
+    logical, intent(in) :: initial
+    integer, intent(in) :: located
+    type(state_type), intent(inout) :: s
+    logical, intent(out) :: closed(:)
+    integer :: k
+    real(wp) :: size_scale
+    do k = 1, scene%n_rows
+      closed(k) = k == located .or. row_gap(scene, k, s) <= row_gap_tolerance(scene, k, s, 0.0_wp)
+      if (initial .and. .not. closed(k)) then
+        size_scale = max(abs(s%x(scene%row_body(2, k))), abs(scene%row_offset(k)))
+        if (scene%row_body(1, k) > 0) size_scale = max(size_scale, abs(s%x(scene%row_body(1, k))))
+        closed(k) = row_gap(scene, k, s) <= gap_rounding * size_scale
+      end if
+    end do
+    do k = 1, scene%n_rows
+      if (scene%row_partner(k) > 0) closed(k) = closed(k) .or. closed(scene%row_partner(k))
+    end do
+    do k = 1, scene%n_rows
+      if (closed(k)) call snap(scene, k, closed, s)
+    end do
+  end subroutine close_rows
+
+  !> Put closed row k exactly on its constraint: a ground row puts its body at -offset / n_b;
+  !> a row between bodies puts x_b - x_a on its limit by moving the end that no closed ground
+  !> row holds (b if neither is).
+  pure subroutine snap(scene, k, closed, s)
+    type(scene_type), intent(in) :: scene
+    integer, intent(in) :: k
+    logical, intent(in) :: closed(:)
+    type(state_type), intent(inout) :: s
+    real(wp) :: limit
+    integer :: j
+    associate (a => scene%row_body(1, k), b => scene%row_body(2, k))
+      limit = -scene%row_offset(k) / scene%row_normal(2, k)
+      if (a == 0) then
+        s%x(b) = limit
+        s%x_lo(b) = 0.0_wp
+        return
+      end if
+      do j = 1, scene%n_rows
+        if (closed(j) .and. scene%row_body(1, j) == 0 .and. scene%row_body(2, j) == b) then
+          s%x(a) = s%x(b)
+          s%x_lo(a) = s%x_lo(b)
+          call add_compensated(s%x(a), s%x_lo(a), -limit)
+          return
+        end if
+      end do
+      s%x(b) = s%x(a)
+      s%x_lo(b) = s%x_lo(a)
+      call add_compensated(s%x(b), s%x_lo(b), limit)
+    end associate
+  end subroutine snap
+
+  !> Bodies joined by rigid links whose two rows are closed (d_min = d_max) are one body: the
+  !> groups (work%rigid, 0 the ground for a link to it) and their masses; each group moves
+  !> with its centre of mass (a relative velocity the link cannot have is absorbed, as by a
+  !> plastic impact, and booked as impact loss).
+  subroutine lock_rigid(scene, closed, s, work)
+    type(scene_type), intent(in) :: scene
+    logical, intent(in) :: closed(:)
+    type(state_type), intent(inout) :: s
+    type(point_work_type), intent(inout) :: work
+    real(wp) :: momentum(0:scene%n_bodies), v_new(scene%n_bodies)
+    integer :: i, k, r
+    logical :: joined
+    work%rigid = [(i, i = 0, scene%n_bodies)]
+    do k = 1, scene%n_rows
+      if (scene%row_partner(k) == 0) cycle
+      if (closed(k) .and. closed(scene%row_partner(k))) joined = uf_join(work%rigid, scene%row_body(1, k), &
+        scene%row_body(2, k))
+    end do
+    work%rigid_mass = 0.0_wp
+    momentum = 0.0_wp
+    do i = 1, scene%n_bodies
+      r = uf_find(work%rigid, i)
+      work%rigid_mass(r) = work%rigid_mass(r) + scene%body_mass(i)
+      momentum(r) = momentum(r) + scene%body_mass(i) * s%v(i)
+    end do
+    v_new = s%v
+    do i = 1, scene%n_bodies
+      r = work%rigid(i)
+      if (r == 0) then
+        v_new(i) = 0.0_wp
+      else if (work%rigid_mass(r) /= scene%body_mass(i)) then
+        v_new(i) = momentum(r) / work%rigid_mass(r)
+      end if
+    end do
+    if (any(v_new /= s%v)) call apply(scene, s, v_new)
+  end subroutine lock_rigid
+
+  !> Rounding level of row k's normal velocity: from the speeds of its ends and what a step
+  !> changes them by, not below the speeds they entered the event point with.
+  pure real(wp) function u_tolerance(scene, k, v, acc, entry_scale) result(tol)
+    type(scene_type), intent(in) :: scene
+    integer, intent(in) :: k
+    real(wp), intent(in) :: v(:), acc(:), entry_scale(:)
+    integer :: e, i
+    tol = 0.0_wp
+    do e = 1, 2
+      i = scene%row_body(e, k)
+      if (i > 0) tol = tol + max(abs(v(i)) + abs(acc(i)) * scene%dt, entry_scale(i))
+    end do
+    tol = velocity_rounding * tol
+  end function u_tolerance
+
+  !> The impacts at this instant: all closed rows plastic (and no rigid link among them):
+  !> one joint inelastic impact; then sequential impulses on the most approaching closed
+  !> row (Newton's restitution on its normal velocity, the rigid groups' masses) until none
+  !> approaches.
+  subroutine impacts(scene, closed, entry_scale, acc, s, work, sink, stats, error)
+    type(scene_type), intent(in) :: scene
+    logical, intent(in) :: closed(:)
+    real(wp), intent(inout) :: entry_scale(:)
+    real(wp), intent(in) :: acc(:)
+    type(state_type), intent(inout) :: s
+    type(point_work_type), intent(inout) :: work
+    class(sink_type), intent(inout) :: sink
+    type(run_stats), intent(inout) :: stats
+    type(error_type), allocatable, intent(inout) :: error
+    real(wp), dimension(scene%n_bodies) :: v_before, v_after
+    logical :: pushed(scene%n_rows), plastic
+    integer :: k, n_impulses
+
+    plastic = count(closed) > 1
+    do k = 1, scene%n_rows
+      if (closed(k)) plastic = plastic .and. scene%row_restitution(k) == 0.0_wp .and. .not. internal(k)
+    end do
+    if (plastic) then
+      v_before = s%v
+      call joint_projection(scene, work%impact, closed, s%v, tolerances(), v_after, pushed, error)
+      if (allocated(error)) return
+      if (any(pushed)) then
+        call check_dissipative(scene, s%t, v_before, v_after, error)
+        if (allocated(error)) return
+        call apply(scene, s, v_after)
+        call share_scale(scene, pushed, entry_scale)
+        do k = 1, scene%n_rows
+          if (pushed(k)) call log_event(scene, sink, stats, s%t, class_impact, k, v_before, s%v)
+        end do
+      end if
+    end if
+    n_impulses = 0
+    do
+      k = most_approaching(scene, closed, s%v, tolerances())
+      if (k == 0) exit
+      n_impulses = n_impulses + 1
+      if (n_impulses > scene%max_impulses) then
+        call raise(error, status_simulation, 'at t = ' // trim(fmt(s%t)) // ': the impacts did not settle after ' &
+          // trim(fmt(scene%max_impulses)) // ' impulses (typically a light body squeezed between much ' // &
+          'heavier ones or a wall: the impulses pass back and forth, more of them the larger the mass ' // &
+          'ratio; raise &run max_impulses)')
+        return
+      end if
+      v_before = s%v
+      call impulse(scene, work, k, scene%row_restitution(k), s%v, v_after)
+      call check_dissipative(scene, s%t, v_before, v_after, error)
+      if (allocated(error)) return
+      call apply(scene, s, v_after)
+      pushed = .false.
+      pushed(k) = .true.
+      call share_scale(scene, pushed, entry_scale)
+      call log_event(scene, sink, stats, s%t, class_impact, k, v_before, s%v)
+    end do
+
+  contains
+
+    !> Every row's u_tolerance now.
+    function tolerances() result(tol)
+      real(wp) :: tol(scene%n_rows)
+      integer :: j
+      do j = 1, scene%n_rows
+        tol(j) = u_tolerance(scene, j, s%v, acc, entry_scale)
+      end do
+    end function tolerances
+
+    !> Row j joins bodies of one rigid group (both limits of a rigid link closed).
+    logical function internal(j)
+      integer, intent(in) :: j
+      internal = uf_find(work%rigid, scene%row_body(1, j)) == uf_find(work%rigid, scene%row_body(2, j))
+    end function internal
+  end subroutine impacts
+
+  !> The closed row approaching fastest beyond its tolerance (0 if none; the first in row
+  !> order among equals); rows inside a rigid group never approach.
+  integer function most_approaching(scene, closed, v, tol) result(k_best)
+    type(scene_type), intent(in) :: scene
+    logical, intent(in) :: closed(:)
+    real(wp), intent(in) :: v(:), tol(:)
+    integer :: k
+    real(wp) :: u, u_best
+    k_best = 0
+    u_best = 0.0_wp
+    do k = 1, scene%n_rows
+      if (.not. closed(k)) cycle
+      u = row_velocity(scene, k, v)
+      if (u < min(u_best, -tol(k))) then
+        k_best = k
+        u_best = u
+      end if
+    end do
+  end function most_approaching
+
+  !> Velocities after an impulse on row k that leaves its normal velocity at -r times its
+  !> value before, through the rigid groups of its ends (a group joined to the ground does
+  !> not move); a row inside one group takes none.
+  subroutine impulse(scene, work, k, r, v, v_after)
+    type(scene_type), intent(in) :: scene
+    type(point_work_type), intent(inout) :: work
+    integer, intent(in) :: k
+    real(wp), intent(in) :: r, v(:)
+    real(wp), intent(out) :: v_after(:)
+    real(wp) :: inverse(2), p
+    integer :: e, i, root(2)
+    v_after = v
+    do e = 1, 2
+      root(e) = uf_find(work%rigid, scene%row_body(e, k))
+      inverse(e) = 0.0_wp
+      if (root(e) > 0) inverse(e) = 1.0_wp / work%rigid_mass(root(e))
+    end do
+    if (root(1) == root(2) .or. sum(inverse) == 0.0_wp) return
+    p = -(1.0_wp + r) * row_velocity(scene, k, v) / sum(inverse)
+    do i = 1, scene%n_bodies
+      do e = 1, 2
+        if (root(e) > 0 .and. work%rigid(i) == root(e)) v_after(i) = v(i) + scene%row_normal(e, k) * p * inverse(e)
+      end do
+    end do
+  end subroutine impulse
+
+  !> The joint perfectly inelastic impact of the closed rows (impact1d_cluster_impact), on the
+  !> bodies they touch gathered into one problem: v_after, and pushed, the rows it pushed.
+  subroutine joint_projection(scene, work, closed, v, tol, v_after, pushed, error)
+    type(scene_type), intent(in) :: scene
+    type(impact_work_type), intent(inout) :: work
+    logical, intent(in) :: closed(:)
+    real(wp), intent(in) :: v(:), tol(:)
+    real(wp), intent(out) :: v_after(:)
+    logical, intent(out) :: pushed(:)
+    type(error_type), allocatable, intent(inout) :: error
+    integer :: local(0:scene%n_bodies), body(scene%n_bodies), rows(scene%n_rows), nb, nr, k, e, status
+    real(wp) :: v_local(scene%n_bodies), impulse_local(scene%n_rows)
+    logical :: pushed_local(scene%n_rows)
+    local = 0
+    nb = 0
+    nr = 0
+    do k = 1, scene%n_rows
+      if (.not. closed(k)) cycle
+      nr = nr + 1
+      rows(nr) = k
+      do e = 1, 2
+        associate (i => scene%row_body(e, k))
+          if (i == 0) cycle
+          if (local(i) > 0) cycle
+          nb = nb + 1
+          body(nb) = i
+          local(i) = nb
+        end associate
+      end do
+    end do
+    v_after = v
+    pushed = .false.
+    if (nr == 0) return
+    call impact_reserve(work, nb, nr)
+    call cluster_projection(work, scene%body_mass(body(:nb)), v(body(:nb)), &
+      reshape([(local(scene%row_body(:, rows(k))), k = 1, nr)], [2, nr]), scene%row_normal(:, rows(:nr)), &
+      spread(.true., 1, nr), tol(rows(:nr)), v_local(:nb), impulse_local(:nr), pushed_local(:nr), status)
+    if (status /= lcp_solved) then
+      call raise(error, status_simulation, 'internal: the joint inelastic impact has no solution (LCP status ' // &
+        trim(fmt(status)) // '): please report the scene')
+      return
+    end if
+    v_after(body(:nb)) = v_local(:nb)
+    pushed(rows(:nr)) = pushed_local(:nr)
+  end subroutine joint_projection
+
+  !> A row between bodies that took an impulse gives both its ends the larger scale.
+  pure subroutine share_scale(scene, pushed, entry_scale)
+    type(scene_type), intent(in) :: scene
+    logical, intent(in) :: pushed(:)
+    real(wp), intent(inout) :: entry_scale(:)
+    integer :: k
+    do k = 1, scene%n_rows
+      if (.not. pushed(k) .or. scene%row_body(1, k) == 0) cycle
+      entry_scale(scene%row_body(:, k)) = maxval(entry_scale(scene%row_body(:, k)))
+    end do
+  end subroutine share_scale
+
+  !> After the impacts: bodies stopped within rounding are at rest, approach left at two or
+  !> more closed rows goes jointly, rounding-level normal velocities on closed rows are
+  !> zero, bounce series whose remaining time is below the clock's resolution end in rest,
+  !> and a body against a stopped one (a closed row, still) stops too.
+  subroutine settle(scene, mode, closed, f, df, acc, entry_scale, s, event_log, work, sink, stats)
+    type(scene_type), intent(in) :: scene
+    type(body_mode_type), intent(in) :: mode
+    logical, intent(in) :: closed(:)
+    real(wp), intent(in) :: f(:), df(:), acc(:), entry_scale(:)
+    type(state_type), intent(inout) :: s
+    type(event_log_type), intent(inout) :: event_log
+    type(point_work_type), intent(inout) :: work
+    class(sink_type), intent(inout) :: sink
+    type(run_stats), intent(inout) :: stats
+    real(wp) :: v_after(scene%n_bodies)
+    logical :: pushed(scene%n_rows)
+    type(error_type), allocatable :: ignored
+    integer :: k, e
+    call zero_stopped(scene, s, acc, entry_scale)
+    call joint_projection(scene, work%impact, closed, s%v, spread(0.0_wp, 1, scene%n_rows), v_after, pushed, &
+      ignored)
+    if (.not. allocated(ignored) .and. count(pushed) >= 2) call apply(scene, s, v_after)
+    do k = 1, scene%n_rows
+      if (.not. closed(k)) cycle
+      if (abs(row_velocity(scene, k, s%v)) <= u_tolerance(scene, k, s%v, acc, entry_scale) .and. &
+          row_velocity(scene, k, s%v) /= 0.0_wp) then
+        call impulse(scene, work, k, 0.0_wp, s%v, v_after)
+        call apply(scene, s, v_after)
+      end if
+    end do
+    do k = 1, scene%n_rows
+      if (closed(k)) call settle_bounce_series(scene, mode, k, f, df, closed, acc, entry_scale, s, event_log, &
+        work, sink, stats)
+    end do
+    call zero_stopped(scene, s, acc, entry_scale)
+    do k = 1, scene%n_rows
+      if (.not. closed(k) .or. scene%row_body(1, k) == 0) cycle
+      if (abs(row_velocity(scene, k, s%v)) > u_tolerance(scene, k, s%v, acc, entry_scale)) cycle
+      do e = 1, 2
+        if (s%v(scene%row_body(e, k)) == 0.0_wp) call zero_velocity(scene, s, scene%row_body(3 - e, k))
+      end do
+    end do
+  end subroutine settle
+
+  !> The bounce series on closed row k, if its ends separate slowly: the gap's acceleration
+  !> rising (a_up) and falling back (a_down) from the mode with k left free. If what remains
+  !> of the series is below the clock's resolution, the row rests now, logged at the
+  !> series' accumulation time (the two-body engine's settle_bounce_series).
+  subroutine settle_bounce_series(scene, mode, k, f, df, closed, acc, entry_scale, s, event_log, work, sink, stats)
+    type(scene_type), intent(in) :: scene
+    type(body_mode_type), intent(in) :: mode
+    integer, intent(in) :: k
+    real(wp), intent(in) :: f(:), df(:), acc(:), entry_scale(:)
+    logical, intent(in) :: closed(:)
+    type(state_type), intent(inout) :: s
+    type(event_log_type), intent(inout) :: event_log
+    type(point_work_type), intent(inout) :: work
+    class(sink_type), intent(inout) :: sink
+    type(run_stats), intent(inout) :: stats
+    real(wp) :: u, a_up, a_down, remaining, v_bounce(scene%n_bodies)
+    u = row_velocity(scene, k, s%v)
+    if (u <= u_tolerance(scene, k, s%v, acc, entry_scale)) return
+    a_up = free_gap_acceleration(s%v)
+    if (a_up >= 0.0_wp) return
+    call impulse(scene, work, k, 1.0_wp, s%v, v_bounce)
+    a_down = free_gap_acceleration(v_bounce)
+    remaining = bounce_series_time(u, a_up, a_down, scene%row_restitution(k))
+    if (remaining > time_rounding * max(abs(s%t), scene%dt)) return
+    call impulse(scene, work, k, 0.0_wp, s%v, v_bounce)
+    call apply(scene, s, v_bounce)
+    if (remaining < huge(1.0_wp)) then
+      call event_log%begin_rest(scene, k, s%t, s%t + remaining, s%v, sink, stats)
+    else
+      call event_log%begin_rest(scene, k, s%t, s%t, s%v, sink, stats)
+    end if
+
+  contains
+
+    !> Row k's gap acceleration with k left free and the other rows as they are, at
+    !> velocities v.
+    real(wp) function free_gap_acceleration(v) result(a_gap)
+      real(wp), intent(in) :: v(:)
+      type(body_mode_type) :: free
+      logical :: candidate(scene%n_rows)
+      real(wp) :: a(scene%n_bodies)
+      integer :: j, status
+      do j = 1, scene%n_rows
+        candidate(j) = closed(j) .and. j /= k
+        if (candidate(j)) candidate(j) = abs(row_velocity(scene, j, v)) <= u_tolerance(scene, j, v, acc, entry_scale)
+      end do
+      free = mode
+      call solve_body_mode(scene, work%mode, f, df, v, candidate, free, status)
+      a_gap = 0.0_wp
+      if (status /= mode_solved) return
+      call free%acceleration(f, a)
+      a_gap = row_velocity(scene, k, a)
+    end function free_gap_acceleration
+  end subroutine settle_bounce_series
+
+  !> Bodies whose velocity is below the rounding of what a step changes it by, or of the
+  !> velocities this event point started from, are at rest.
+  pure subroutine zero_stopped(scene, s, acc, entry_scale)
+    type(scene_type), intent(in) :: scene
+    type(state_type), intent(inout) :: s
+    real(wp), intent(in) :: acc(:), entry_scale(:)
+    integer :: i
+    do i = 1, scene%n_bodies
+      if (s%v(i) /= 0.0_wp .and. abs(s%v(i)) <= velocity_rounding * max(abs(acc(i)) * scene%dt, &
+          entry_scale(i))) call zero_velocity(scene, s, i)
+    end do
+  end subroutine zero_stopped
+
+  !> Body i is at rest; the rounding-level energy it had goes to friction where friction
+  !> stopped it, else to impacts.
+  pure subroutine zero_velocity(scene, s, i)
+    type(scene_type), intent(in) :: scene
+    type(state_type), intent(inout) :: s
+    integer, intent(in) :: i
+    if (scene%body_static(i) > 0.0_wp) then
+      call add_compensated(s%friction_loss, s%friction_lo, 0.5_wp * scene%body_mass(i) * s%v(i)**2)
+    else
+      s%impact_loss = s%impact_loss + 0.5_wp * scene%body_mass(i) * s%v(i)**2
+    end if
+    s%v(i) = 0.0_wp
+    s%v_lo(i) = 0.0_wp
+  end subroutine zero_velocity
+
+  !> Kinetic energy of the bodies at velocities v.
+  pure real(wp) function kinetic(scene, v)
+    type(scene_type), intent(in) :: scene
+    real(wp), intent(in) :: v(:)
+    kinetic = 0.5_wp * dot_product(scene%body_mass, v**2)
+  end function kinetic
+
+  !> An impact cannot raise the kinetic energy beyond its rounding: if one does, the engine
+  !> is wrong, and the run says so.
+  subroutine check_dissipative(scene, t, v_before, v_after, error)
+    type(scene_type), intent(in) :: scene
+    real(wp), intent(in) :: t, v_before(:), v_after(:)
+    type(error_type), allocatable, intent(inout) :: error
+    real(wp) :: ke_before, ke_after
+    ke_before = kinetic(scene, v_before)
+    ke_after = kinetic(scene, v_after)
+    if (ke_after <= ke_before * (1.0_wp + energy_rounding)) return
+    call raise(error, status_simulation, 'at t = ' // trim(fmt(t)) // ': internal error: an impact ' // &
+      'raised the kinetic energy from ' // trim(fmt(ke_before)) // ' to ' // trim(fmt(ke_after)) // &
+      ' J; please report the scene')
+  end subroutine check_dissipative
+
+  !> New velocities at an instant, the kinetic energy they remove booked as impact loss.
+  pure subroutine apply(scene, s, v_new)
+    type(scene_type), intent(in) :: scene
+    type(state_type), intent(inout) :: s
+    real(wp), intent(in) :: v_new(:)
+    s%impact_loss = s%impact_loss + kinetic(scene, s%v) - kinetic(scene, v_new)
+    s%v = v_new
+    s%v_lo = 0.0_wp
+  end subroutine apply
+
+  !> Log what a user can see change between the old mode and new: rows that start or stop
+  !> holding, bodies that come to rest or break away (the two-body engine's rules).
+  subroutine log_mode_change(scene, initial, f, df, candidate, new, s, event_log, sink, stats)
+    type(scene_type), intent(in) :: scene
+    logical, intent(in) :: initial, candidate(:)
+    real(wp), intent(in) :: f(:), df(:)
+    type(body_mode_type), intent(in) :: new
+    type(state_type), intent(in) :: s
+    type(event_log_type), intent(inout) :: event_log
+    class(sink_type), intent(inout) :: sink
+    type(run_stats), intent(inout) :: stats
+    real(wp), dimension(scene%n_bodies) :: acc, tol_a, acc_rate
+    real(wp) :: rate_tol, direction
+    logical :: leaving, resting_now
+    integer :: k, i
+
+    call new%acceleration(f, acc)
+    call new%rate_response(df, acc_rate)
+    tol_a = 1.0e3_wp * eps_wp * force_size(scene, f, df) / scene%body_mass
+    rate_tol = 1.0e3_wp * eps_wp * sum(abs(df))
+    do k = 1, scene%n_rows
+      if (new%active(k) .and. .not. event_log%in_contact(k)) then
+        call event_log%begin_rest(scene, k, s%t, s%t, s%v, sink, stats)
+      else if (event_log%in_contact(k) .and. .not. new%active(k)) then
+        if (.not. candidate(k) .or. row_velocity(scene, k, acc) > row_abs_tol(k, tol_a) .or. &
+            (row_velocity(scene, k, acc) >= -row_abs_tol(k, tol_a) .and. &
+            row_velocity(scene, k, acc_rate) > rate_tol / minval(scene%body_mass))) then
+          if (event_log%pending_rest(k) < huge(1.0_wp)) then
+            call log_event(scene, sink, stats, s%t, class_rest, k, s%v, s%v)
+            event_log%pending_rest(k) = huge(1.0_wp)
+          end if
+          event_log%in_contact(k) = .false.
+          event_log%release_time(k) = s%t
+          event_log%release_v(:, k) = pair_of(k, s%v)
+        end if
+      end if
+    end do
+    do i = 1, scene%n_bodies
+      if (scene%body_static(i) == 0.0_wp) cycle
+      ! Its sliding direction; a body that breaks away with no sliding friction has none
+      ! (sgn 0): the way it accelerates.
+      direction = new%sgn(i)
+      if (direction == 0.0_wp) direction = sign(1.0_wp, merge(acc(i), acc_rate(i), acc(i) /= 0.0_wp))
+      leaving = direction * acc(i) > tol_a(i) .or. (direction * acc(i) >= -tol_a(i) .and. &
+        direction * acc_rate(i) > rate_tol / scene%body_mass(i))
+      resting_now = s%v(i) == 0.0_wp .and. .not. leaving
+      if (resting_now .and. .not. event_log%at_rest(i) .and. .not. initial .and. &
+          .not. same_instant(scene, s%t, event_log%rest_lost_time(i))) &
+        call log_event(scene, sink, stats, s%t, class_stick, i, s%v, s%v)
+      if (.not. resting_now .and. event_log%at_rest(i)) then
+        if (s%v(i) == 0.0_wp) then
+          call log_event(scene, sink, stats, s%t, class_slip, i, s%v, s%v)
+        else
+          event_log%rest_lost_time(i) = s%t
+        end if
+      end if
+      event_log%at_rest(i) = resting_now
+    end do
+
+  contains
+
+    !> Row j's |n| . tol (its ends' tolerances).
+    pure real(wp) function row_abs_tol(j, tol)
+      integer, intent(in) :: j
+      real(wp), intent(in) :: tol(:)
+      row_abs_tol = tol(scene%row_body(2, j))
+      if (scene%row_body(1, j) > 0) row_abs_tol = row_abs_tol + tol(scene%row_body(1, j))
+    end function row_abs_tol
+
+    !> The velocities of row j's ends (0 for the ground), as a release logs them.
+    pure function pair_of(j, v) result(pair)
+      integer, intent(in) :: j
+      real(wp), intent(in) :: v(:)
+      real(wp) :: pair(2)
+      pair = 0.0_wp
+      if (scene%row_body(1, j) > 0) pair(1) = v(scene%row_body(1, j))
+      pair(2) = v(scene%row_body(2, j))
+    end function pair_of
+  end subroutine log_mode_change
+end module impact1d_nbody_event

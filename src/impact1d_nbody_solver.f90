@@ -1,0 +1,210 @@
+!> The N-body engine's driver (docs/method.md section 9): the two-body engine's method on
+!> N-long arrays. From the current state it picks the next stop (sample time, table corner
+!> or pending rest), takes one RK4 step toward it, locates the earliest event inside the step
+!> on the dense output (impact1d_nbody_step), re-takes the step to it, and calls the event
+!> point (impact1d_nbody_event); samples go to the sink at sample times. impact1d_solver's
+!> run hands scenes of more than two bodies here.
+module impact1d_nbody_solver
+  use, intrinsic :: iso_fortran_env, only: int64
+  use impact1d_kinds, only: wp
+  use impact1d_error, only: error_type, raise, status_simulation, fmt
+  use impact1d_scene, only: scene_type, sample_time, step_length
+  use impact1d_state, only: state_type, new_state, finite_state
+  use impact1d_output, only: sink_type, run_stats, emit_bodies, checkpoint
+  use impact1d_event_log, only: event_log_type
+  use impact1d_yardsticks, only: velocity_rounding
+  use impact1d_elements, only: element_potential
+  use impact1d_body_mode, only: body_mode_type, new_mode
+  use impact1d_nbody_step, only: nbody_step, nbody_force, locate_nbody, refine_nbody, gaps_hold, row_gap, &
+    row_velocity, row_gap_tolerance, found_none, found_row
+  use impact1d_nbody_event, only: point_work_type, new_point_work, nbody_event_point
+  implicit none
+  private
+  public :: run_nbody
+
+  integer, parameter :: max_halvings = 60        !< retries of a step whose end violated a constraint
+
+  !> What the run owns besides its state: the mode, the event point's memory, the log.
+  type :: nbody_run_type
+    type(body_mode_type) :: mode
+    type(point_work_type) :: work
+    type(event_log_type) :: event_log
+    !> Tables and constants only: the dense output is exact, so no root can be missed.
+    logical :: polynomial = .false.
+    real(wp) :: ke0 = 0.0_wp, pe0 = 0.0_wp
+  end type nbody_run_type
+
+contains
+
+  !> Run an N-body scene from t = 0 to t_end, every dt_out sample and every event to sink.
+  subroutine run_nbody(scene, sink, stats, error)
+    type(scene_type), intent(in) :: scene
+    class(sink_type), intent(inout) :: sink
+    type(run_stats), intent(inout) :: stats
+    type(error_type), allocatable, intent(inout) :: error
+    type(state_type) :: s, trial
+    type(nbody_run_type) :: r
+    real(wp) :: sample_t, t_break, t_rest, t_stop, window_start
+    integer :: j_sample, found, index, window_events
+    logical :: at_stop, event_due
+
+    call start(scene, s, trial, r)
+    call nbody_event_point(scene, .true., found_none, 0, s, r%mode, r%event_log, r%work, sink, stats, error)
+    if (allocated(error)) return
+    j_sample = 0
+    call emit(scene, s, r, j_sample, sink, stats, error)
+    if (allocated(error)) return
+    window_events = 0
+    window_start = 0.0_wp
+    t_break = scene%forcing%next_breakpoint(s%t)
+    do while (j_sample < scene%n_samples)
+      sample_t = sample_time(scene, j_sample)
+      if (t_break <= s%t) t_break = scene%forcing%next_breakpoint(s%t)
+      t_rest = huge(1.0_wp)
+      if (scene%n_rows > 0) t_rest = minval(r%event_log%pending_rest)
+      t_stop = min(sample_t, t_break, t_rest)
+      call advance(scene, r, t_stop, s, trial, found, index, at_stop, sink, stats, error)
+      if (allocated(error)) return
+      event_due = found /= found_none
+      if (.not. event_due .and. at_stop) event_due = t_stop == t_break .or. t_stop == t_rest .or. &
+        impact_due(scene, s)
+      if (event_due) then
+        ! Work is bounded per step of simulated time (the two-body engine's rule).
+        if (s%t - window_start >= scene%dt) then
+          window_start = s%t
+          window_events = 0
+        end if
+        window_events = window_events + 1
+        if (window_events > scene%max_step_events) then
+          call raise(error, status_simulation, 'at t = ' // trim(fmt(s%t)) // ': more than ' // &
+            trim(fmt(scene%max_step_events)) // ' events within one step (dt = ' // trim(fmt(scene%dt)) // &
+            '): the contacts chatter faster than the run can follow (lower a restitution near 1 on a ' // &
+            'contact pressed shut, or raise &run max_step_events)')
+          return
+        end if
+        call r%event_log%flush_releases(scene, s%t, .false., sink, stats)
+        call r%event_log%flush_pending_rest(scene, s%t, s%v, sink, stats)
+        call nbody_event_point(scene, .false., found, index, s, r%mode, r%event_log, r%work, sink, stats, error)
+        if (allocated(error)) return
+      end if
+      if (at_stop .and. s%t == sample_t) then
+        call emit(scene, s, r, j_sample, sink, stats, error)
+        if (allocated(error)) return
+      end if
+    end do
+    call r%event_log%flush_releases(scene, s%t, .true., sink, stats)
+    call sink%end_progress()
+  end subroutine run_nbody
+
+  !> The run's memory, once (nothing allocates per step), and its start.
+  subroutine start(scene, s, trial, r)
+    type(scene_type), intent(in) :: scene
+    type(state_type), intent(inout) :: s, trial
+    type(nbody_run_type), intent(inout) :: r
+    call new_state(scene%n_bodies, s)
+    call new_state(scene%n_bodies, trial)
+    s%x = scene%body_x0
+    s%v = scene%body_v0
+    call new_mode(scene%n_bodies, scene%n_rows, r%mode, r%work%mode)
+    call new_point_work(scene%n_bodies, r%work)
+    call r%event_log%allocate_log(scene%n_rows, scene%n_bodies)
+    r%polynomial = scene%forcing%is_polynomial() .and. .not. scene%springs%present
+    r%ke0 = 0.5_wp * dot_product(scene%body_mass, s%v**2)
+    if (scene%springs%present) r%pe0 = element_potential(scene, s%x, s%x_lo)
+  end subroutine start
+
+  !> Sample j_sample (then the next one is due).
+  subroutine emit(scene, s, r, j_sample, sink, stats, error)
+    type(scene_type), intent(in) :: scene
+    type(state_type), intent(in) :: s
+    type(nbody_run_type), intent(in) :: r
+    integer, intent(inout) :: j_sample
+    class(sink_type), intent(inout) :: sink
+    type(run_stats), intent(inout) :: stats
+    type(error_type), allocatable, intent(inout) :: error
+    real(wp) :: pe
+    pe = 0.0_wp
+    if (scene%springs%present) pe = element_potential(scene, s%x, s%x_lo)
+    call emit_bodies(sink, stats, s%t, s%x, s%v, scene%body_mass, r%ke0, s%work, s%friction_loss, &
+      s%impact_loss, scene%springs%present, [pe, r%pe0, s%damping_loss], error)
+    j_sample = j_sample + 1
+  end subroutine emit
+
+  !> One step from s toward t_stop, ended at the earliest event located in it (found, index)
+  !> or at the stop (at_stop). A step whose end breaks a constraint (a root the location
+  !> missed: forcing that is not polynomial only) is retried shorter.
+  subroutine advance(scene, r, t_stop, s, trial, found, index, at_stop, sink, stats, error)
+    type(scene_type), intent(in) :: scene
+    type(nbody_run_type), intent(inout) :: r
+    real(wp), intent(in) :: t_stop
+    type(state_type), intent(inout) :: s, trial
+    integer, intent(out) :: found, index
+    logical, intent(out) :: at_stop
+    class(sink_type), intent(inout) :: sink
+    type(run_stats), intent(inout) :: stats
+    type(error_type), allocatable, intent(inout) :: error
+    real(wp) :: h, theta
+    integer :: halvings
+    h = step_length(scene%dt, (t_stop - s%t) - s%t_lo)
+    halvings = 0
+    do
+      found = found_none
+      index = 0
+      if (h <= 0.0_wp) then
+        trial = s
+        exit
+      end if
+      call nbody_step(scene, r%mode, s, h, trial)
+      call locate_nbody(scene, r%mode, r%work%mode, r%polynomial, s, trial, h, theta, found, index)
+      if (found /= found_none .and. theta <= h) then
+        h = theta
+        if (h > 0.0_wp) then
+          call refine_nbody(scene, r%mode, s, h, found, index, trial)
+        else
+          trial = s
+          exit
+        end if
+      else
+        found = found_none
+      end if
+      if (r%polynomial) exit
+      if (gaps_hold(scene, r%mode, s, trial, merge(index, 0, found == found_row))) exit
+      halvings = halvings + 1
+      if (halvings > max_halvings) then
+        call raise(error, status_simulation, 'at t = ' // trim(fmt(s%t)) // &
+          ': no step keeps the constraints (event location failed)')
+        return
+      end if
+      h = 0.5_wp * h
+    end do
+    at_stop = found == found_none .and. h == (t_stop - s%t) - s%t_lo
+    s = trial
+    if (at_stop) then
+      s%t = t_stop
+      s%t_lo = 0.0_wp
+    end if
+    stats%steps = stats%steps + 1
+    if (iand(stats%steps, 4095_int64) == 0) then
+      call checkpoint(sink, stats, s%t, scene%t_end, error)
+      if (allocated(error)) return
+    end if
+    if (.not. finite_state(s%x, s%v, s%work)) call raise(error, status_simulation, 'at t = ' // &
+      trim(fmt(s%t)) // ': the state is no longer finite')
+  end subroutine advance
+
+  !> A gap that closed exactly at a stop (its root at the step's very end) with its ends
+  !> still approaching: the impact belongs to this instant.
+  logical function impact_due(scene, s)
+    type(scene_type), intent(in) :: scene
+    type(state_type), intent(in) :: s
+    integer :: k
+    real(wp) :: speed
+    impact_due = .false.
+    do k = 1, scene%n_rows
+      if (row_gap(scene, k, s) > row_gap_tolerance(scene, k, s, 0.0_wp)) cycle
+      speed = abs(s%v(scene%row_body(2, k)))
+      if (scene%row_body(1, k) > 0) speed = speed + abs(s%v(scene%row_body(1, k)))
+      if (row_velocity(scene, k, s%v) < -velocity_rounding * speed) impact_due = .true.
+    end do
+  end function impact_due
+end module impact1d_nbody_solver

@@ -1,0 +1,337 @@
+!> Stepping and event location of the N-body engine (METHOD.md 3-4; docs/method.md section
+!> 9): the classical RK4 step of N bodies within a mode, its energy ledger, the rows' exact
+!> gaps, and the earliest event inside a step (a gap closing, a sliding body stopping, the
+!> mode's conditions failing) on the step's Hermite dense output. The state is N-long
+!> (impact1d_state's state_type); the two-body engine's counterparts work in lanes.
+module impact1d_nbody_step
+  use impact1d_kinds, only: wp, eps_wp
+  use impact1d_scene, only: scene_type
+  use impact1d_state, only: state_type, add_compensated
+  use impact1d_events, only: hermite, earliest_crossing
+  use impact1d_yardsticks, only: gap_rounding, velocity_rounding, time_rounding
+  use impact1d_elements, only: add_element_forces, add_element_rates, element_damping_power
+  use impact1d_body_mode, only: body_mode_type, mode_work_type, solve_body_mode, same_mode, mode_solved
+  implicit none
+  private
+  public :: nbody_force, nbody_rate, nbody_step, row_gap, row_velocity, row_gap_tolerance, locate_nbody, &
+    refine_nbody, gaps_hold, force_size
+  public :: found_none, found_row, found_body, found_hold
+
+  !> What a location found: a row's gap closing, a sliding body stopping, the mode failing.
+  integer, parameter :: found_none = 0, found_row = 1, found_body = 2, found_hold = 3
+
+contains
+
+  !> Applied forces f (external and elements') at time t, positions x + dx, velocities v.
+  pure subroutine nbody_force(scene, t, x, dx, v, f)
+    type(scene_type), intent(in) :: scene
+    real(wp), intent(in) :: t, x(:), dx(:), v(:)
+    real(wp), intent(out) :: f(:)
+    call scene%forcing%force_all(t, f)
+    if (scene%springs%present) call add_element_forces(scene, x, dx, v, f)
+  end subroutine nbody_force
+
+  !> Right derivative df of the applied forces at time t, velocities v.
+  pure subroutine nbody_rate(scene, t, v, df)
+    type(scene_type), intent(in) :: scene
+    real(wp), intent(in) :: t, v(:)
+    real(wp), intent(out) :: df(:)
+    call scene%forcing%rate(t, df)
+    if (scene%springs%present) call add_element_rates(scene, v, df)
+  end subroutine nbody_rate
+
+  !> Size of the forces around an instant (the yardstick of a force's rounding): as
+  !> impact1d_yardsticks' force_scale.
+  pure real(wp) function force_size(scene, f, df)
+    type(scene_type), intent(in) :: scene
+    real(wp), intent(in) :: f(:), df(:)
+    force_size = sum(abs(f)) + 2.0_wp * sum(scene%body_static) + sum(abs(df)) * scene%dt
+  end function force_size
+
+  !> One classical RK4 step of the mode's equations from a to b (the four stages in full: the
+  !> forces may depend on the state); the ledger by Simpson's rule on the step's Hermite
+  !> velocity (external work, sliding friction's loss, dampers' dissipation), exact where
+  !> RK4 is.
+  subroutine nbody_step(scene, mode, a, step, b)
+    type(scene_type), intent(in) :: scene
+    type(body_mode_type), intent(in) :: mode
+    type(state_type), intent(in) :: a
+    real(wp), intent(in) :: step
+    type(state_type), intent(inout) :: b
+    real(wp), dimension(scene%n_bodies) :: v0, v1, vm, f, dx, kx1, kx2, kx3, kx4, kv1, kv2, kv3, kv4, &
+      f0, fm, f1, acc_end
+    real(wp) :: half
+    half = 0.5_wp * step
+    v0 = a%v + a%v_lo
+    call scene%forcing%force_all(a%t, f0)
+    call scene%forcing%force_all(a%t + half, fm)
+    call scene%forcing%force_all(a%t + step, f1)
+    kx1 = v0
+    call stage(f0, a%x_lo, kx1, kv1)
+    kx2 = v0 + half * kv1
+    call stage(fm, a%x_lo + half * kx1, kx2, kv2)
+    kx3 = v0 + half * kv2
+    call stage(fm, a%x_lo + half * kx2, kx3, kv3)
+    kx4 = v0 + step * kv3
+    call stage(f1, a%x_lo + step * kx3, kx4, kv4)
+    b = a
+    call add_compensated(b%t, b%t_lo, step)
+    call add_compensated(b%x, b%x_lo, (step / 6.0_wp) * (kx1 + 2.0_wp * (kx2 + kx3) + kx4))
+    call add_compensated(b%v, b%v_lo, (step / 6.0_wp) * (kv1 + 2.0_wp * (kv2 + kv3) + kv4))
+    v1 = b%v + b%v_lo
+    f = f1
+    if (scene%springs%present) call add_element_forces(scene, b%x, b%x_lo, v1, f)
+    call mode%acceleration(f, acc_end)
+    vm = 0.5_wp * (v0 + v1) + 0.125_wp * step * (kv1 - acc_end)
+    call add_compensated(b%work, b%work_lo, step / 6.0_wp * (dot_product(f0, v0) + &
+      4.0_wp * dot_product(fm, vm) + dot_product(f1, v1)))
+    if (any(mode%f_slide /= 0.0_wp)) call add_compensated(b%friction_loss, b%friction_lo, step / 6.0_wp * &
+      dot_product(-mode%f_slide, v0 + 4.0_wp * vm + v1))
+    if (scene%springs%present) call add_compensated(b%damping_loss, b%damping_lo, step / 6.0_wp * &
+      (element_damping_power(scene, v0) + 4.0_wp * element_damping_power(scene, vm) + &
+      element_damping_power(scene, v1)))
+
+  contains
+
+    !> A stage's accelerations acc at external forces fx, positions a%x + dx', velocities v.
+    subroutine stage(fx, dx_stage, v, acc)
+      real(wp), intent(in) :: fx(:), dx_stage(:), v(:)
+      real(wp), intent(out) :: acc(:)
+      f = fx
+      if (scene%springs%present) then
+        dx = dx_stage
+        call add_element_forces(scene, a%x, dx, v, f)
+      end if
+      call mode%acceleration(f, acc)
+    end subroutine stage
+  end subroutine nbody_step
+
+  !> Gap of row k in state s, exact to its own size: x_b - x_a is formed without rounding
+  !> (two-sum), so a limit it is close to is subtracted exactly.
+  pure real(wp) function row_gap(scene, k, s) result(g)
+    type(scene_type), intent(in) :: scene
+    integer, intent(in) :: k
+    type(state_type), intent(in) :: s
+    real(wp) :: p, q, total, rounded, low
+    p = 0.0_wp
+    q = 0.0_wp
+    low = 0.0_wp
+    associate (a => scene%row_body(1, k), b => scene%row_body(2, k), n => scene%row_normal(:, k))
+      if (a > 0) then
+        p = n(1) * s%x(a)
+        low = n(1) * s%x_lo(a)
+      end if
+      q = n(2) * s%x(b)
+      low = low + n(2) * s%x_lo(b)
+    end associate
+    total = p + q
+    rounded = total - p
+    g = (total + scene%row_offset(k)) + (((p - (total - rounded)) + (q - rounded)) + low)
+  end function row_gap
+
+  !> Rate of change of row k's gap at velocities v.
+  pure real(wp) function row_velocity(scene, k, v) result(u)
+    type(scene_type), intent(in) :: scene
+    integer, intent(in) :: k
+    real(wp), intent(in) :: v(:)
+    u = scene%row_normal(2, k) * v(scene%row_body(2, k))
+    if (scene%row_body(1, k) > 0) u = u + scene%row_normal(1, k) * v(scene%row_body(1, k))
+  end function row_velocity
+
+  !> n_k . y with |n| (row k's ends' sum of |y|).
+  pure real(wp) function row_abs(scene, k, y)
+    type(scene_type), intent(in) :: scene
+    integer, intent(in) :: k
+    real(wp), intent(in) :: y(:)
+    row_abs = abs(y(scene%row_body(2, k)))
+    if (scene%row_body(1, k) > 0) row_abs = row_abs + abs(y(scene%row_body(1, k)))
+  end function row_abs
+
+  !> Rounding level of row k's gap in state s after the gap moved by `moved` (as the
+  !> two-body engine's gap_tolerance: the low parts, what a step moved it, and a gap
+  !> closing within the clock's resolution).
+  pure real(wp) function row_gap_tolerance(scene, k, s, moved) result(tol)
+    type(scene_type), intent(in) :: scene
+    integer, intent(in) :: k
+    type(state_type), intent(in) :: s
+    real(wp), intent(in) :: moved
+    tol = gap_rounding * (moved + row_abs(scene, k, s%x_lo)) + &
+      time_rounding * max(abs(s%t), scene%dt) * max(0.0_wp, -row_velocity(scene, k, s%v))
+  end function row_gap_tolerance
+
+  !> Hermite coefficients of each body's displacement over the step from a to b.
+  pure subroutine dense_output(a, b, step, c)
+    type(state_type), intent(in) :: a, b
+    real(wp), intent(in) :: step
+    real(wp), intent(out) :: c(:, :)
+    integer :: i
+    do i = 1, size(a%x)
+      c(:, i) = hermite((b%x(i) - a%x(i)) + (b%x_lo(i) - a%x_lo(i)), a%v(i), b%v(i), step)
+    end do
+  end subroutine dense_output
+
+  !> Earliest event in (0, step] of the step from a to b: a gap of a row not held closing, a
+  !> body sliding with friction stopping, or (forces that vary) the mode failing; found and
+  !> index say what and where (found_none: theta past the step).
+  subroutine locate_nbody(scene, mode, work, polynomial, a, b, step, theta, found, index)
+    type(scene_type), intent(in) :: scene
+    type(body_mode_type), intent(in) :: mode
+    type(mode_work_type), intent(inout) :: work
+    logical, intent(in) :: polynomial     !< the motion is a cubic: the dense output is exact
+    type(state_type), intent(in) :: a, b
+    real(wp), intent(in) :: step
+    real(wp), intent(out) :: theta
+    integer, intent(out) :: found, index
+    real(wp) :: c(3, scene%n_bodies), p(0:3), q(0:3), candidate, acc0(scene%n_bodies), f(scene%n_bodies), &
+      acc_rounding
+    integer :: k, i
+    theta = huge(1.0_wp)
+    found = found_none
+    index = 0
+    call dense_output(a, b, step, c)
+    call nbody_force(scene, a%t, a%x, a%x_lo, a%v, f)
+    call mode%acceleration(f, acc0)
+    acc_rounding = 1.0e3_wp * eps_wp * sum(abs(f)) / minval(scene%body_mass)
+    do k = 1, scene%n_rows
+      if (mode%active(k)) cycle
+      associate (ea => scene%row_body(1, k), eb => scene%row_body(2, k), n => scene%row_normal(:, k))
+        p(0) = row_gap(scene, k, a)
+        p(1:3) = n(2) * c(:, eb)
+        q(1:3) = gap_rounding * abs(c(:, eb))
+        if (ea > 0) then
+          p(1:3) = p(1:3) + n(1) * c(:, ea)
+          q(1:3) = q(1:3) + gap_rounding * abs(c(:, ea))
+        end if
+      end associate
+      if (p(0) - step * (abs(p(1)) + step * (abs(p(2)) + step * abs(p(3)))) > 0.0_wp) cycle
+      q(0) = row_gap_tolerance(scene, k, a, 0.0_wp)
+      q(2) = q(2) + acc_rounding
+      ! A motion that is not a cubic is only approximated by it: the dips the cubic's wrong
+      ! curvature makes at a gap just released do not count (the step's end is checked on
+      ! the integrator's own state: gaps_hold).
+      if (.not. polynomial) q(2) = q(2) + abs(p(2) - 0.5_wp * row_velocity(scene, k, acc0))
+      candidate = earliest_crossing(p, step, q)
+      if (candidate < theta) then
+        theta = candidate
+        found = found_row
+        index = k
+      end if
+    end do
+    do i = 1, scene%n_bodies
+      if (scene%body_static(i) == 0.0_wp .or. mode%sgn(i) == 0.0_wp .or. mode%group(i) == 0) cycle
+      p = mode%sgn(i) * [c(1, i), 2.0_wp * c(2, i), 3.0_wp * c(3, i), 0.0_wp]
+      q = [velocity_rounding * max(abs(a%v(i)), abs(b%v(i)), abs(b%v(i) - a%v(i))), 0.0_wp, 0.0_wp, 0.0_wp]
+      if (.not. polynomial) q(1) = q(1) + abs(p(1) - mode%sgn(i) * acc0(i))
+      candidate = earliest_crossing(p, step, q)
+      if (candidate < theta) then
+        theta = candidate
+        found = found_body
+        index = i
+      end if
+    end do
+    if (mode%held .and. (scene%forcing%varies .or. scene%springs%present)) &
+      call mode_crossing(scene, mode, work, a, c, min(theta, step), theta, found)
+  end subroutine locate_nbody
+
+  !> The first instant in (0, until] at which the mode no longer holds (the mode solved anew
+  !> with its held rows as the candidates differs), by bisection on the dense output c of
+  !> the step from a: theta and found updated when there is one.
+  subroutine mode_crossing(scene, mode, work, a, c, until, theta, found)
+    type(scene_type), intent(in) :: scene
+    type(body_mode_type), intent(in) :: mode
+    type(mode_work_type), intent(inout) :: work
+    type(state_type), intent(in) :: a
+    real(wp), intent(in) :: c(:, :), until
+    real(wp), intent(inout) :: theta
+    integer, intent(inout) :: found
+    real(wp) :: lo, hi, mid
+    if (holds_at(until)) return
+    lo = 0.0_wp
+    hi = until
+    do while (hi - lo > 2.0_wp * eps_wp * max(abs(a%t + hi), until))
+      mid = 0.5_wp * (lo + hi)
+      if (holds_at(mid)) then
+        lo = mid
+      else
+        hi = mid
+      end if
+    end do
+    theta = hi
+    found = found_hold
+
+  contains
+
+    !> Whether the mode is the one solved theta into the step.
+    logical function holds_at(tau)
+      real(wp), intent(in) :: tau
+      type(body_mode_type) :: probe
+      real(wp), dimension(scene%n_bodies) :: f, df, dx, v
+      integer :: status
+      dx = a%x_lo + tau * (c(1, :) + tau * (c(2, :) + tau * c(3, :)))
+      v = c(1, :) + tau * (2.0_wp * c(2, :) + 3.0_wp * tau * c(3, :))
+      ! A body held still stays exactly still; one that slides keeps its direction.
+      where (mode%stuck) v = 0.0_wp
+      call nbody_force(scene, a%t + tau, a%x, dx, v, f)
+      call nbody_rate(scene, a%t + tau, v, df)
+      probe = mode
+      call solve_body_mode(scene, work, f, df, v, mode%active, probe, status)
+      holds_at = status == mode_solved
+      if (holds_at) holds_at = same_mode(probe, mode)
+    end function holds_at
+  end subroutine mode_crossing
+
+  !> Re-take the step to the located time and polish it by Newton's method on the watched
+  !> function on the integrator's own state (exact under polynomial forcing at once).
+  subroutine refine_nbody(scene, mode, a, step, found, index, b)
+    type(scene_type), intent(in) :: scene
+    type(body_mode_type), intent(in) :: mode
+    type(state_type), intent(in) :: a
+    real(wp), intent(inout) :: step
+    integer, intent(in) :: found, index
+    type(state_type), intent(inout) :: b
+    real(wp) :: value, slope, tol, located_step, f(scene%n_bodies), acc(scene%n_bodies)
+    integer :: iteration
+    located_step = step
+    call nbody_step(scene, mode, a, step, b)
+    if (found /= found_row .and. found /= found_body) return
+    do iteration = 1, 8
+      if (found == found_body) then
+        value = b%v(index)
+        call nbody_force(scene, b%t, b%x, b%x_lo, b%v, f)
+        call mode%acceleration(f, acc)
+        slope = acc(index)
+        tol = velocity_rounding * max(abs(a%v(index)), abs(value))
+      else
+        value = row_gap(scene, index, b)
+        slope = row_velocity(scene, index, b%v)
+        tol = row_gap_tolerance(scene, index, b, row_abs(scene, index, (b%x - a%x) + (b%x_lo - a%x_lo)))
+      end if
+      if (abs(value) <= tol .or. slope == 0.0_wp) exit
+      if (step - value / slope <= 0.0_wp .or. step - value / slope > located_step) exit
+      step = step - value / slope
+      call nbody_step(scene, mode, a, step, b)
+    end do
+  end subroutine refine_nbody
+
+  !> No step from s may end at b with a gap below zero beyond rounding (a root the location
+  !> missed: only under forcing that is not polynomial), nor a sliding body past zero; the
+  !> located row (else 0) is put on its constraint at the event point.
+  pure logical function gaps_hold(scene, mode, s, b, located)
+    type(scene_type), intent(in) :: scene
+    type(body_mode_type), intent(in) :: mode
+    type(state_type), intent(in) :: s, b
+    integer, intent(in) :: located
+    integer :: k, i
+    gaps_hold = .true.
+    do k = 1, scene%n_rows
+      if (mode%active(k) .or. k == located) cycle
+      if (row_gap(scene, k, b) < -row_gap_tolerance(scene, k, b, &
+        row_abs(scene, k, (b%x - s%x) + (b%x_lo - s%x_lo)))) gaps_hold = .false.
+    end do
+    do i = 1, scene%n_bodies
+      if (scene%body_static(i) == 0.0_wp .or. mode%sgn(i) == 0.0_wp) cycle
+      if (mode%sgn(i) * b%v(i) < -velocity_rounding * max(abs(s%v(i)), abs(b%v(i)), &
+          abs(b%v(i) - s%v(i)))) gaps_hold = .false.
+    end do
+  end function gaps_hold
+end module impact1d_nbody_step
