@@ -9,7 +9,7 @@ module impact1d_api
   use impact1d_kinds, only: wp
   use impact1d_error, only: error_type, status_ok, status_input, status_interrupted, raise
   use impact1d_interrupt, only: catch_interrupts, interrupt_count
-  use impact1d_scene, only: scene_input, scene_type, validate, is_nbody, nbody_refusal, n_real, n_text, real_names, text_names, &
+  use impact1d_scene, only: scene_input, scene_type, validate, n_real, n_text, real_names, text_names, &
     i_title, i_f1_table, i_f2_table, i_method, i_substeps, i_events, set_text
   use impact1d_io, only: read_scene_file, prepare_scene
   use impact1d_chain, only: settle_chain, validate_chain, n_ids, id_arrays, id_r_meet, field_name, assign_number, &
@@ -153,7 +153,6 @@ contains
     call settle_chain(input, error)
     if (.not. allocated(error)) call validate(input, .false., error)
     if (.not. allocated(error)) call validate_chain(input, error)
-    if (.not. allocated(error) .and. is_nbody(input)) call raise(error, status_input, nbody_refusal)
     if (failed(error, status, message)) return
     values = real(input%value, c_double)
     given = merge(1_c_int, 0_c_int, input%given)

@@ -8,6 +8,7 @@ module impact1d_event_log
   use impact1d_scene, only: scene_type
   use impact1d_output, only: sink_type, run_stats, class_rest, class_release, class_stick, class_slip, count_event
   use impact1d_yardsticks, only: same_instant
+  use impact1d_accumulation, only: cycle_history_type
   implicit none
   private
   public :: event_log_type, log_event
@@ -30,6 +31,8 @@ module impact1d_event_log
     !> velocity but cannot create precision, however many event points they take).
     real(wp) :: scale_time = -huge(1.0_wp)
     real(wp) :: scale(max_lanes) = 0.0_wp
+    !> The event points with impacts lately (an accumulation over several contacts).
+    type(cycle_history_type) :: cycles
   contains
     procedure :: allocate_log
     procedure :: flush_pending_rest
@@ -51,6 +54,7 @@ contains
     self%release_v = 0.0_wp
     self%at_rest = .false.
     self%rest_lost_time = -huge(1.0_wp)
+    call self%cycles%reserve(n_rows)
   end subroutine allocate_log
 
   !> Event (class, index) at t, counted and sent to the sink with the velocities of the

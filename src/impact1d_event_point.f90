@@ -21,6 +21,7 @@ module impact1d_event_point
   use impact1d_location, only: watch_type, located_type, located_row, located_body
   use impact1d_loads, only: state_force, applied_rate
   use impact1d_event_log, only: event_log_type, log_event
+  use impact1d_accumulation, only: join_cycle
   implicit none
   private
   public :: event_point, bounce_series_time
@@ -45,7 +46,7 @@ contains
     type(run_stats), intent(inout) :: stats
     type(error_type), allocatable, intent(inout) :: error
     logical :: closed(pair_rows), candidate(pair_rows), resting(max_lanes), found
-    logical :: pushed(pair_rows)
+    logical :: pushed(pair_rows), hit(pair_rows)
     real(wp), dimension(max_lanes) :: f, df, v_before, v_after, moving_sign, acc
     ! Velocity scale of each body entering this event point: impulses redistribute
     ! velocity but cannot create precision, so what is below its rounding is zero.
@@ -85,6 +86,7 @@ contains
 
     ! Perfectly inelastic contacts closed together take one joint impact: sequential
     ! impulses would only approach it geometrically (a body pinned by a heavier one).
+    hit = .false.
     if (joint_inelastic(scene, closed)) then
       v_before = s%v
       call inelastic_projection(scene, closed, s%v, u_tolerances(scene, mode, s, entry_scale), v_after, pushed)
@@ -99,6 +101,7 @@ contains
         do k = 1, scene%n_rows
           if (pushed(k)) call log_event(scene, sink, stats, s%t, class_impact, k, v_before, v_after)
         end do
+        hit = pushed
       end if
     end if
     n_impulses = 0
@@ -120,7 +123,9 @@ contains
       call apply(scene, s, v_after)
       if (all(scene%pair%normal(:, k) /= 0.0_wp)) entry_scale = maxval(entry_scale)
       call log_event(scene, sink, stats, s%t, class_impact, k, v_before, v_after)
+      hit(k) = .true.
     end do
+    if (any(hit)) call cut_cycle(scene, hit, closed, s, event_log, sink, stats)
 
     event_log%scale_time = s%t
     event_log%scale = entry_scale
@@ -185,6 +190,40 @@ contains
     watch%watching = mode%n_hold > 0 .or. any(.not. mode%active(:scene%n_rows)) .or. &
       any(scene%pair%static_friction > 0.0_wp .and. mode%sgn /= 0.0_wp)
   end subroutine event_point
+
+  !> An event point whose impulses hit the rows marked, recorded; when the last points make
+  !> an accumulation over several contacts (impact1d_accumulation) whose rest is near, its
+  !> rows close now: snapped, the bodies they join moving as one (at rest if joined to the
+  !> ground), their rests logged at the series' limit time.
+  subroutine cut_cycle(scene, hit, closed, s, event_log, sink, stats)
+    type(scene_type), intent(in) :: scene
+    logical, intent(in) :: hit(pair_rows)
+    logical, intent(inout) :: closed(pair_rows)
+    type(lane_state_type), intent(inout) :: s
+    type(event_log_type), intent(inout) :: event_log
+    class(sink_type), intent(inout) :: sink
+    type(run_stats), intent(inout) :: stats
+    real(wp) :: u(scene%n_rows), remaining, v(max_lanes)
+    logical :: rows(scene%n_rows), found
+    integer :: k
+    do k = 1, scene%n_rows
+      u(k) = normal_velocity(scene, k, s%v)
+    end do
+    call event_log%cycles%record(s%t, hit(:scene%n_rows), u)
+    call event_log%cycles%find_cycle(scene%row_body, scene%dt, time_rounding * max(abs(s%t), scene%dt), rows, remaining, found)
+    if (.not. found) return
+    call event_log%cycles%forget()
+    closed(:scene%n_rows) = closed(:scene%n_rows) .or. rows
+    do k = 1, scene%n_rows
+      if (rows(k)) call snap(scene, k, closed, s)
+    end do
+    v = s%v
+    call join_cycle(scene%row_body, rows, scene%body_mass, v(:scene%n_bodies))
+    call apply(scene, s, v)
+    do k = 1, scene%n_rows
+      if (rows(k)) call event_log%begin_rest(scene, k, s%t, s%t + remaining, s%v, sink, stats)
+    end do
+  end subroutine cut_cycle
 
   !> Log what a user can see change between the old mode and new_mode: contacts that start
   !> or stop holding, bodies that come to rest or break away.

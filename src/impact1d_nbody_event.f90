@@ -14,6 +14,7 @@ module impact1d_nbody_event
   use impact1d_event_log, only: event_log_type, log_event
   use impact1d_event_point, only: bounce_series_time
   use impact1d_clusters, only: uf_join, uf_find
+  use impact1d_accumulation, only: join_cycle
   use impact1d_cluster_impact, only: impact_work_type, impact_reserve, cluster_projection
   use impact1d_lcp, only: lcp_solved
   use impact1d_body_mode, only: body_mode_type, mode_work_type, solve_body_mode, mode_solved
@@ -60,7 +61,7 @@ contains
     type(run_stats), intent(inout) :: stats
     type(error_type), allocatable, intent(inout) :: error
     real(wp), dimension(scene%n_bodies) :: f, df, acc, entry_scale
-    logical :: closed(scene%n_rows), candidate(scene%n_rows)
+    logical :: closed(scene%n_rows), candidate(scene%n_rows), hit(scene%n_rows)
     type(body_mode_type) :: new
     integer :: k, i, status
 
@@ -82,8 +83,9 @@ contains
         call zero_velocity(scene, s, i)
     end do
     call lock_rigid(scene, closed, s, work)
-    call impacts(scene, closed, entry_scale, acc, s, work, sink, stats, error)
+    call impacts(scene, closed, entry_scale, acc, s, work, hit, sink, stats, error)
     if (allocated(error)) return
+    if (any(hit)) call cut_cycle(scene, hit, closed, s, event_log, sink, stats)
     work%scale_time = s%t
     work%scale = entry_scale
     call settle(scene, mode, closed, f, df, acc, entry_scale, s, event_log, work, sink, stats)
@@ -218,42 +220,36 @@ contains
     tol = velocity_rounding * tol
   end function u_tolerance
 
-  !> The impacts at this instant: all closed rows plastic (and no rigid link among them):
-  !> one joint inelastic impact; then sequential impulses on the most approaching closed
-  !> row (Newton's restitution on its normal velocity, the rigid groups' masses) until none
-  !> approaches.
-  subroutine impacts(scene, closed, entry_scale, acc, s, work, sink, stats, error)
+  !> The impacts at this instant (the reference's rule, tests/exact_nbody.py): while a closed
+  !> row approaches beyond its tolerance, the fastest one and the closed rows joined to it
+  !> through shared bodies (its group) take one joint inelastic impact when the group has
+  !> several rows, all plastic (a rigid link's own rows count as plastic) and not just one
+  !> rigid link; otherwise that row alone takes Newton's impulse through the rigid groups'
+  !> masses. A plastic impact leaves its rows' normal velocities exactly 0 (the bodies they
+  !> join move as one). hit: the rows that took an impulse.
+  subroutine impacts(scene, closed, entry_scale, acc, s, work, hit, sink, stats, error)
     type(scene_type), intent(in) :: scene
     logical, intent(in) :: closed(:)
     real(wp), intent(inout) :: entry_scale(:)
     real(wp), intent(in) :: acc(:)
     type(state_type), intent(inout) :: s
     type(point_work_type), intent(inout) :: work
+    logical, intent(out) :: hit(:)
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
     type(error_type), allocatable, intent(inout) :: error
     real(wp), dimension(scene%n_bodies) :: v_before, v_after
-    logical :: pushed(scene%n_rows), plastic
-    integer :: k, n_impulses
+    real(wp) :: restitution(scene%n_rows)
+    logical :: pushed(scene%n_rows), group(scene%n_rows), internal(scene%n_rows), joint
+    integer :: k, n_impulses, root_a, root_b
 
-    plastic = count(closed) > 1
+    hit = .false.
     do k = 1, scene%n_rows
-      if (closed(k)) plastic = plastic .and. scene%row_restitution(k) == 0.0_wp .and. .not. internal(k)
+      root_a = uf_find(work%rigid, scene%row_body(1, k))
+      root_b = uf_find(work%rigid, scene%row_body(2, k))
+      internal(k) = closed(k) .and. root_a == root_b
+      restitution(k) = merge(0.0_wp, scene%row_restitution(k), internal(k))
     end do
-    if (plastic) then
-      v_before = s%v
-      call joint_projection(scene, work%impact, closed, s%v, tolerances(), v_after, pushed, error)
-      if (allocated(error)) return
-      if (any(pushed)) then
-        call check_dissipative(scene, s%t, v_before, v_after, error)
-        if (allocated(error)) return
-        call apply(scene, s, v_after)
-        call share_scale(scene, pushed, entry_scale)
-        do k = 1, scene%n_rows
-          if (pushed(k)) call log_event(scene, sink, stats, s%t, class_impact, k, v_before, s%v)
-        end do
-      end if
-    end if
     n_impulses = 0
     do
       k = most_approaching(scene, closed, s%v, tolerances())
@@ -266,15 +262,28 @@ contains
           'ratio; raise &run max_impulses)')
         return
       end if
+      call closed_group(scene, closed, k, group)
+      joint = count(group) > 1 .and. all(restitution == 0.0_wp .or. .not. group) .and. &
+        .not. all(internal .or. .not. group)
       v_before = s%v
-      call impulse(scene, work, k, scene%row_restitution(k), s%v, v_after)
+      if (joint) then
+        call joint_projection(scene, work%impact, group, s%v, tolerances(), v_after, pushed, error)
+        if (allocated(error)) return
+      else
+        call impulse(scene, work, k, restitution(k), s%v, v_after)
+        pushed = .false.
+        pushed(k) = .true.
+      end if
+      if (joint .or. restitution(k) == 0.0_wp) call join_cycle(scene%row_body, pushed .or. internal, &
+        scene%body_mass, v_after)
       call check_dissipative(scene, s%t, v_before, v_after, error)
       if (allocated(error)) return
       call apply(scene, s, v_after)
-      pushed = .false.
-      pushed(k) = .true.
       call share_scale(scene, pushed, entry_scale)
-      call log_event(scene, sink, stats, s%t, class_impact, k, v_before, s%v)
+      hit = hit .or. pushed
+      do k = 1, scene%n_rows
+        if (pushed(k)) call log_event(scene, sink, stats, s%t, class_impact, k, v_before, s%v)
+      end do
     end do
 
   contains
@@ -287,13 +296,67 @@ contains
         tol(j) = u_tolerance(scene, j, s%v, acc, entry_scale)
       end do
     end function tolerances
-
-    !> Row j joins bodies of one rigid group (both limits of a rigid link closed).
-    logical function internal(j)
-      integer, intent(in) :: j
-      internal = uf_find(work%rigid, scene%row_body(1, j)) == uf_find(work%rigid, scene%row_body(2, j))
-    end function internal
   end subroutine impacts
+
+  !> The closed rows joined to row `start` through shared bodies (the ground joins nothing).
+  pure subroutine closed_group(scene, closed, start, group)
+    type(scene_type), intent(in) :: scene
+    logical, intent(in) :: closed(:)
+    integer, intent(in) :: start
+    logical, intent(out) :: group(:)
+    logical :: reached(0:scene%n_bodies), grew
+    integer :: k
+    group = .false.
+    group(start) = .true.
+    reached = .false.
+    reached(scene%row_body(:, start)) = .true.
+    grew = .true.
+    do while (grew)
+      grew = .false.
+      do k = 1, scene%n_rows
+        if (group(k) .or. .not. closed(k)) cycle
+        if (.not. (reached(scene%row_body(2, k)) .or. (scene%row_body(1, k) > 0 .and. &
+            reached(scene%row_body(1, k))))) cycle
+        group(k) = .true.
+        reached(scene%row_body(:, k)) = .true.
+        grew = .true.
+      end do
+    end do
+  end subroutine closed_group
+
+  !> An event point whose impulses hit the rows marked, recorded; when the last points make
+  !> an accumulation over several contacts (impact1d_accumulation) whose rest is near, its
+  !> rows close now: snapped, the bodies they join moving as one (at rest if joined to the
+  !> ground), their rests logged at the series' limit time.
+  subroutine cut_cycle(scene, hit, closed, s, event_log, sink, stats)
+    type(scene_type), intent(in) :: scene
+    logical, intent(in) :: hit(:)
+    logical, intent(inout) :: closed(:)
+    type(state_type), intent(inout) :: s
+    type(event_log_type), intent(inout) :: event_log
+    class(sink_type), intent(inout) :: sink
+    type(run_stats), intent(inout) :: stats
+    real(wp) :: u(scene%n_rows), remaining, v(scene%n_bodies)
+    logical :: rows(scene%n_rows), found
+    integer :: k
+    do k = 1, scene%n_rows
+      u(k) = row_velocity(scene, k, s%v)
+    end do
+    call event_log%cycles%record(s%t, hit, u)
+    call event_log%cycles%find_cycle(scene%row_body, scene%dt, time_rounding * max(abs(s%t), scene%dt), rows, remaining, found)
+    if (.not. found) return
+    call event_log%cycles%forget()
+    closed = closed .or. rows
+    do k = 1, scene%n_rows
+      if (rows(k)) call snap(scene, k, closed, s)
+    end do
+    v = s%v
+    call join_cycle(scene%row_body, rows, scene%body_mass, v)
+    call apply(scene, s, v)
+    do k = 1, scene%n_rows
+      if (rows(k)) call event_log%begin_rest(scene, k, s%t, s%t + remaining, s%v, sink, stats)
+    end do
+  end subroutine cut_cycle
 
   !> The closed row approaching fastest beyond its tolerance (0 if none; the first in row
   !> order among equals); rows inside a rigid group never approach.
