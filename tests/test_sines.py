@@ -295,3 +295,18 @@ def test_the_core_takes_no_vector_math():
     said novector."""
     from impact1d import _core
     assert b"_ZGV" not in Path(_core.__file__).read_bytes()
+
+
+def test_the_documented_example_reads(tmp_path):
+    """docs/formats.md's &sine example (under "Rules") reads as two records on body 1,
+    the first with no phase, and runs."""
+    doc = (Path(__file__).resolve().parent.parent / "docs" / "formats.md").read_text()
+    lines = [line.strip() for line in doc.splitlines() if line.startswith("      &")]
+    assert [line.split()[0] for line in lines] == ["&forces", "&sine", "&sine"]
+    path = tmp_path / "doc.nml"
+    path.write_text("&bodies m1 = 1.0 /\n&initial x1 = 0.0 /\n&run t_end = 1.0, dt = 1e-2 /\n"
+                    + "\n".join(lines) + "\n")
+    scene = impact1d.load_scene(path)
+    assert scene.sines == [{"body": 1, "amp": 2.0, "period": 0.7},
+                           {"body": 1, "amp": 0.8, "period": 1.1326, "phase": 0.4}]
+    assert impact1d.simulate(scene).x1[-1] != 0.0
