@@ -219,6 +219,12 @@ def test_the_output_header_records_the_sines(tmp_path):
                       "# sine.3.period = 0.3", "# sine.3.phase = -1.0"]
     back = impact1d.read_output(out)
     assert back.scene.sines == NAMELIST_SINES
+    # read back with its scene, whose forces must be the header's: the sines count too
+    assert impact1d.read_output(out, scene=path).scene.sines == NAMELIST_SINES
+    other = tmp_path / "other.nml"
+    other.write_text(NAMELIST.replace("amp = 4.0", "amp = 4.5"))
+    with pytest.raises(impact1d.InputError, match="was not run from the scene .*: its header has sines = "):
+        impact1d.read_output(out, scene=other)
     assert np.allclose(back.samples, impact1d.simulate(impact1d.load_scene(path)).samples,
                        rtol=1e-15, atol=1e-15)
 

@@ -17,7 +17,7 @@ __all__ = ["read_output", "events_path"]
 
 # The scene fields that make the applied forces, besides the tables (which the output's
 # header does not name).
-FORCE_FIELDS = ("f1", "f2", "f1_amp", "f1_period", "f1_phase", "f2_amp", "f2_period", "f2_phase")
+FORCE_FIELDS = ("f1", "f2", "f1_amp", "f1_period", "f1_phase", "f2_amp", "f2_period", "f2_phase", "sines")
 
 
 def events_path(path) -> str:
@@ -131,7 +131,7 @@ def with_forces_of(result: Result, scene, path) -> Result:
         scene = load_scene(scene)
     if is_nbody_form(scene):
         # (written with arrays of one or two bodies: compared in the tutorial's names)
-        scene = from_core(*to_core(scene), source=scene.source)
+        scene = dataclasses.replace(from_core(*to_core(scene), source=scene.source), sines=scene.sines)
     for name in FORCE_FIELDS:
         mine, theirs = getattr(result.scene, name), getattr(scene, name)
         if mine != theirs:
