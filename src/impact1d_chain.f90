@@ -15,18 +15,19 @@ module impact1d_chain
     record_input, a_m, a_mu, a_mus, a_x, a_f_amp, a_f_period, a_f_phase, a_k, a_x_rest, a_c, a_d_min, a_r_min, &
     a_d_max, a_r_max, a_k_link, a_d_rest, a_c_link, r_a, r_b, r_d_min, r_r_min, r_d_max, r_r_max, r_k, r_d_rest, &
     r_c, contact_fields, spring_fields, r_name, n_contact_fields, n_spring_fields, written_array, text_item, &
-    a_f_table, mechanism_records
+    a_f_table, mechanism_records, n_sine_fields, sine_fields, r_body, r_amp, r_period, r_phase
   implicit none
   private
   public :: settle_chain, validate_chain, input_records, mechanism_records, n_bodies_of, slot_of, alias_slot
-  public :: id_arrays, id_r_meet, id_contact, id_spring, n_ids, field_name, field_is_text, assign_number, &
+  public :: id_arrays, id_r_meet, id_contact, id_spring, id_sine, n_ids, field_name, field_is_text, assign_number, &
     assign_text, scene_assignments
 
   !> The input fields' numbering (the namelist reader's and the flat API's): 1..n_real the
   !> tutorial's scalars, then its texts, the arrays (impact1d_fields' order), r_meet, the
-  !> &contact record fields, the &spring record fields.
+  !> &contact record fields, the &spring record fields, the &sine record fields.
   integer, parameter :: id_arrays = n_real + n_text, id_r_meet = id_arrays + n_arrays + 1, &
-    id_contact = id_r_meet, id_spring = id_contact + n_contact_fields, n_ids = id_spring + n_spring_fields
+    id_contact = id_r_meet, id_spring = id_contact + n_contact_fields, id_sine = id_spring + n_spring_fields, &
+    n_ids = id_sine + n_sine_fields
 
 
   !> alias_slot(j, i) for i = 1, 2 (0: no such name), impact1d_fields' array order:
@@ -282,6 +283,8 @@ contains
     if (allocated(error)) return
     if (allocated(input%chain%springs)) call check_records(input, input%chain%springs, .false., error)
     if (allocated(error)) return
+    if (allocated(input%chain%sines)) call check_sines(input, error)
+    if (allocated(error)) return
     call input_records(input, records)
     call check_names(records, error)
     if (allocated(error)) return
@@ -407,9 +410,7 @@ contains
     character(len=:), allocatable :: where
     do r = 1, size(records)
       associate (rec => records(r))
-        ! (a record from Python has no line: its place among the records)
-        where = trim(merge('&contact', '&spring ', contact)) // ' (line ' // trim(fmt(rec%line)) // '): '
-        if (rec%line == 0) where = trim(merge('&contact', '&spring ', contact)) // ' record ' // trim(fmt(r)) // ': '
+        call record_place(trim(merge('&contact', '&spring ', contact)), rec, r, where)
         do f = 1, merge(size(contact_fields) - 1, size(spring_fields), contact)
           if (rec%given(f) .and. .not. ieee_is_finite(rec%value(f))) call raise(error, status_input, where // &
             trim(field_of(contact, f)) // ' = ' // trim(fmt(rec%value(f))) // ' is not a finite number')
@@ -428,6 +429,50 @@ contains
       end associate
     end do
   end subroutine check_records
+
+  !> Where record r of a group is, for messages: its line, or (a record from Python has no
+  !> line) its place among the records.
+  pure subroutine record_place(group, rec, r, where)
+    character(len=*), intent(in) :: group
+    type(record_input), intent(in) :: rec
+    integer, intent(in) :: r
+    character(len=:), allocatable, intent(out) :: where
+    if (rec%line == 0) then
+      where = group // ' record ' // trim(fmt(r)) // ': '
+    else
+      where = group // ' (line ' // trim(fmt(rec%line)) // '): '
+    end if
+  end subroutine record_place
+
+  !> Each &sine record: body, amp and period given (phase optional), each finite, body one
+  !> of the bodies 1..N (a force acts on a body, not on the ground), period positive.
+  subroutine check_sines(input, error)
+    type(scene_input), intent(in) :: input
+    type(error_type), allocatable, intent(inout) :: error
+    integer :: r, f
+    character(len=:), allocatable :: where
+    do r = 1, size(input%chain%sines)
+      associate (rec => input%chain%sines(r))
+        call record_place('&sine', rec, r, where)
+        do f = 1, n_sine_fields
+          if (.not. rec%given(f) .and. f /= r_phase) then
+            call raise(error, status_input, where // trim(sine_fields(f)) // ' is required but not given ' // &
+              '(&sine body = 1, amp = 1.0, period = 0.5, phase = 0.0 /: phase may be left out)')
+          else if (rec%given(f) .and. .not. ieee_is_finite(rec%value(f))) then
+            call raise(error, status_input, where // trim(sine_fields(f)) // ' = ' // trim(fmt(rec%value(f))) // &
+              ' is not a finite number')
+          end if
+          if (allocated(error)) return
+        end do
+        associate (body => rec%value(r_body), n => n_bodies_of(input))
+          if (body /= aint(body) .or. body < 1.0_wp .or. body > n) call raise(error, status_input, where // &
+            'body = ' // trim(fmt(body)) // ' is not a body: the bodies are 1 to N = ' // trim(fmt(n)))
+        end associate
+        call positive_value(where // 'period', rec%value(r_period), error)
+        if (allocated(error)) return
+      end associate
+    end do
+  end subroutine check_sines
 
   !> Name of field f of a &contact (contact true) or &spring record.
   pure function field_of(contact, f) result(name)
@@ -600,7 +645,27 @@ contains
     call contact_records(input, records)
     call element_records(input, n, records)
     call shrink(records)
+    call sine_records(input, records)
   end subroutine input_records
+
+  !> The &sine records in file order (phase 0 when not given).
+  pure subroutine sine_records(input, records)
+    type(scene_input), intent(in) :: input
+    type(mechanism_records), intent(inout) :: records
+    integer :: r
+    records%n_sines = 0
+    if (allocated(input%chain%sines)) records%n_sines = size(input%chain%sines)
+    allocate(records%sine_body(records%n_sines), records%sine_amp(records%n_sines), &
+      records%sine_period(records%n_sines), records%sine_phase(records%n_sines))
+    do r = 1, records%n_sines
+      associate (rec => input%chain%sines(r))
+        records%sine_body(r) = nint(rec%value(r_body))
+        records%sine_amp(r) = rec%value(r_amp)
+        records%sine_period(r) = rec%value(r_period)
+        records%sine_phase(r) = merge(rec%value(r_phase), 0.0_wp, rec%given(r_phase))
+      end associate
+    end do
+  end subroutine sine_records
 
   !> 'left' (0, 1) with lower limit x_left; 'right' (0, N) with upper limit x_right.
   subroutine wall_records(input, n, records)
@@ -775,8 +840,10 @@ contains
       name = 'r_meet'
     else if (id > id_contact .and. id <= id_spring) then
       name = 'contact.' // contact_fields(id - id_contact)
-    else if (id > id_spring .and. id <= n_ids) then
+    else if (id > id_spring .and. id <= id_sine) then
       name = 'spring.' // spring_fields(id - id_spring)
+    else if (id > id_sine .and. id <= n_ids) then
+      name = 'sine.' // sine_fields(id - id_sine)
     end if
   end function field_name
 
@@ -804,15 +871,23 @@ contains
       input%chain%r_meet = value
       input%chain%has_r_meet = .true.
     else if (id > id_contact .and. id <= id_spring) then
-      call grow_records(input%chain%contacts, index)
-      input%chain%contacts(index)%value(id - id_contact) = value
-      input%chain%contacts(index)%given(id - id_contact) = .true.
-    else if (id > id_spring .and. id <= n_ids) then
-      call grow_records(input%chain%springs, index)
-      input%chain%springs(index)%value(id - id_spring) = value
-      input%chain%springs(index)%given(id - id_spring) = .true.
+      call set_record_field(input%chain%contacts, index, id - id_contact, value)
+    else if (id > id_spring .and. id <= id_sine) then
+      call set_record_field(input%chain%springs, index, id - id_spring, value)
+    else if (id > id_sine .and. id <= n_ids) then
+      call set_record_field(input%chain%sines, index, id - id_sine, value)
     end if
   end subroutine assign_number
+
+  !> Field f of record index := value (the records grown to index).
+  pure subroutine set_record_field(records, index, f, value)
+    type(record_input), allocatable, intent(inout) :: records(:)
+    integer, intent(in) :: index, f
+    real(wp), intent(in) :: value
+    call grow_records(records, index)
+    records(index)%value(f) = value
+    records(index)%given(f) = .true.
+  end subroutine set_record_field
 
   !> Text field id := text (a text scalar, element index of f_table, record index's name).
   pure subroutine assign_text(input, id, index, text)
@@ -879,7 +954,8 @@ contains
       last = 0
       if (id > id_arrays .and. id < id_r_meet) last = input%chain%array(id - id_arrays)%n
       if (id > id_contact .and. id <= id_spring .and. allocated(input%chain%contacts)) last = size(input%chain%contacts)
-      if (id > id_spring .and. allocated(input%chain%springs)) last = size(input%chain%springs)
+      if (id > id_spring .and. id <= id_sine .and. allocated(input%chain%springs)) last = size(input%chain%springs)
+      if (id > id_sine .and. allocated(input%chain%sines)) last = size(input%chain%sines)
       if (id <= id_arrays .or. id == id_r_meet) then
         call put_field(input, id, 0, field, index, value, n_numbers, text_field, text_index, texts, n_texts)
       end if
@@ -942,8 +1018,10 @@ contains
       number = input%chain%r_meet
     else if (id <= id_spring) then
       call record_value(input%chain%contacts(i), id - id_contact, given, number, text)
-    else
+    else if (id <= id_sine) then
       call record_value(input%chain%springs(i), id - id_spring, given, number, text)
+    else
+      call record_value(input%chain%sines(i), id - id_sine, given, number, text)
     end if
     if (field_is_text(id) .and. id /= id_arrays + a_f_table) given = len(text) > 0
   end subroutine field_value

@@ -1,6 +1,6 @@
 !> The scene as written for any number of bodies (issue 19, "Mechanisms as data"): the
 !> arrays of the chain shorthand (`m = 5*1.0`, `&link d_min = 4*0.25`), the repeatable
-!> `&contact` and `&spring` records, and the field table that says which group each name
+!> `&contact`, `&spring` and `&sine` records, and the field table that says which group each name
 !> belongs to and which tutorial name is an alias of which element (m1 -> m(1), k12 ->
 !> k_link(1)). The tutorial's n_real scalars stay in scene_input's slots; this is the rest.
 module impact1d_fields
@@ -10,8 +10,9 @@ module impact1d_fields
   public :: n_arrays, array_names, array_groups, array_aliases, array_is_link, array_is_text
   public :: a_m, a_mu, a_mus, a_x, a_v, a_f, a_f_amp, a_f_period, a_f_phase, a_k, a_x_rest, a_c
   public :: a_d_min, a_r_min, a_d_max, a_r_max, a_k_link, a_d_rest, a_c_link, a_f_table
-  public :: n_contact_fields, contact_fields, n_spring_fields, spring_fields
+  public :: n_contact_fields, contact_fields, n_spring_fields, spring_fields, n_sine_fields, sine_fields
   public :: r_a, r_b, r_d_min, r_r_min, r_d_max, r_r_max, r_name, r_k, r_d_rest, r_c
+  public :: r_body, r_amp, r_period, r_phase
   public :: name_len, text_item, written_array, record_input, chain_input, alias_name, mechanism_records, array_value
 
   !> Longest contact name a record may carry (names of events: '<name>', 'rest_<name>', ...).
@@ -46,6 +47,12 @@ module impact1d_fields
     'a', 'b', 'd_min', 'r_min', 'd_max', 'r_max', 'name']
   character(len=*), parameter :: spring_fields(n_spring_fields) = [character(len=6) :: &
     'a', 'b', 'k', 'd_rest', 'c']
+  !> The fields of a &sine record: amp sin(2 pi t / period + phase) on body `body`'s force
+  !> (phase optional, 0 by default).
+  integer, parameter :: n_sine_fields = 4
+  integer, parameter :: r_body = 1, r_amp = 2, r_period = 3, r_phase = 4
+  character(len=*), parameter :: sine_fields(n_sine_fields) = [character(len=6) :: &
+    'body', 'amp', 'period', 'phase']
 
   !> One text, kept whole (an array of these, not of deferred-length strings: see
   !> impact1d_scene's scene_text).
@@ -60,7 +67,7 @@ module impact1d_fields
     type(text_item), allocatable :: t(:)
   end type written_array
 
-  !> One &contact or &spring record as written, with the line it starts on (for messages).
+  !> One &contact, &spring or &sine record as written, with the line it starts on (for messages).
   type :: record_input
     real(wp) :: value(n_contact_fields) = 0.0_wp
     logical :: given(n_contact_fields) = .false.
@@ -76,14 +83,15 @@ module impact1d_fields
     type(written_array) :: array(n_arrays)
     real(wp) :: r_meet = 1.0_wp          !< &link r_meet: restitution where neighbours meet
     logical :: has_r_meet = .false.
-    type(record_input), allocatable :: contacts(:), springs(:)
+    type(record_input), allocatable :: contacts(:), springs(:), sines(:)
   end type chain_input
 
   !> Contacts and elements as records, in the layout of the model's (scene_type, stage 2;
   !> here, below impact1d_scene, so that build_scene can take them: impact1d_chain's
   !> input_records makes them):
   !> walls, links, then &contact records in file order; ground springs, link springs, then
-  !> &spring records in file order. An end 0 is the ground (always the first end, a).
+  !> &spring records in file order; the &sine records in file order. An end 0 is the ground
+  !> (always the first end, a).
   type :: mechanism_records
     integer :: n_contacts = 0
     integer, allocatable :: contact_body(:, :)           !< (2, nc) ends a, b; 0 = ground; acts on x_b - x_a
@@ -94,6 +102,9 @@ module impact1d_fields
     integer :: n_elements = 0
     integer, allocatable :: element_body(:, :)           !< (2, ne) ends; elongation (x_b - x_a) - rest
     real(wp), allocatable :: element_k(:), element_c(:), element_rest(:)   !< (ne)
+    integer :: n_sines = 0                               !< the &sine records, in file order
+    integer, allocatable :: sine_body(:)                 !< (ns) the body whose force it adds to
+    real(wp), allocatable :: sine_amp(:), sine_period(:), sine_phase(:)   !< (ns) N, s, rad
   end type mechanism_records
 
 contains

@@ -10,25 +10,25 @@ module impact1d_io
     i_substeps, i_events
   use impact1d_forcing, only: table_type
   use impact1d_fields, only: n_arrays, array_names, array_groups, array_is_text, n_contact_fields, contact_fields, &
-    n_spring_fields, spring_fields, r_name, record_input, text_item, a_f_table
+    n_spring_fields, spring_fields, n_sine_fields, sine_fields, r_name, record_input, text_item, a_f_table
   use impact1d_chain, only: settle_chain, validate_chain, slot_of, mechanism_records, id_arrays, id_r_meet, &
-    id_contact, id_spring, n_ids, n_bodies_of
+    id_contact, id_spring, id_sine, n_ids, n_bodies_of
   use impact1d_files, only: check_input_file
   implicit none
   private
   public :: read_scene_file, prepare_scene, read_table, lower
 
-  character(len=*), parameter :: known_groups(10) = [character(len=7) :: &
-    'scene', 'bodies', 'walls', 'link', 'initial', 'forces', 'springs', 'run', 'contact', 'spring']
+  character(len=*), parameter :: known_groups(11) = [character(len=7) :: &
+    'scene', 'bodies', 'walls', 'link', 'initial', 'forces', 'springs', 'run', 'contact', 'spring', 'sine']
   !> The groups that may be given any number of times, each occurrence a record.
-  integer, parameter :: g_contact = 9, g_spring = 10
+  integer, parameter :: g_contact = 9, g_spring = 10, g_sine = 11
   !> Each group's variables: which group a name belongs to, and the message about a misspelt one.
   character(len=*), parameter :: group_variables(size(known_groups)) = [character(len=112) :: &
     'title', 'm1, m2, mu1, mu2, mus1, mus2, g', 'x_left, r_left, x_right, r_right', 'd_min, r_min, d_max, r_max', &
     'x1, v1, x2, v2', 'f1, f2, f1_table, f2_table, f1_amp, f1_period, f1_phase, f2_amp, f2_period, f2_phase', &
     'k1, x1_rest, c1, k2, x2_rest, c2, k12, d_rest, c12', &
     't_end, dt, dt_out, method, zero_vel, max_rows, max_impulses, max_step_events, substeps, events, max_events', &
-    'a, b, d_min, r_min, d_max, r_max, name', 'a, b, k, d_rest, c']
+    'a, b, d_min, r_min, d_max, r_max, name', 'a, b, k, d_rest, c', 'body, amp, period, phase']
 
   !> The tutorial's parameter files list these, in its Table 1 order; g is 10 there.
   integer, parameter :: dat_order(17) = [i_m1, i_m2, i_mu1, i_r_left, i_r_right, i_r_min, &
@@ -267,10 +267,10 @@ contains
     if (group == 0) then
       call raise(error, status_input, nml%path // ':' // trim(fmt(line)) // ': unknown group &' // name // &
         ' (groups: &scene &bodies &walls &link &initial &forces &springs &run, and as often as wanted ' // &
-        '&contact &spring)')
-    else if (group == g_contact .or. group == g_spring) then
+        '&contact &spring &sine)')
+    else if (group >= g_contact) then
       ! Each occurrence is a record of its own; "given twice" applies within it.
-      call new_record(input, group == g_contact, line)
+      call new_record(input, group, line)
       nml%given_line(id_contact + 1:) = 0
       nml%group_line(group) = line
       nml%open_group = group
@@ -410,11 +410,12 @@ contains
       call read_scalar(name, value, input%chain%r_meet, error)
       input%chain%has_r_meet = .true.
     else
-      j = field - id_contact
-      if (j > n_contact_fields) then
-        call take_record_field(name, value, j - n_contact_fields, input%chain%springs, error)
+      if (field > id_sine) then
+        call take_record_field(name, value, field - id_sine, input%chain%sines, error)
+      else if (field > id_spring) then
+        call take_record_field(name, value, field - id_spring, input%chain%springs, error)
       else
-        call take_record_field(name, value, j, input%chain%contacts, error)
+        call take_record_field(name, value, field - id_contact, input%chain%contacts, error)
       end if
     end if
   end subroutine take_value
@@ -526,21 +527,28 @@ contains
     end associate
   end subroutine take_record_field
 
-  !> A &contact (contact true) or &spring record opens at line.
-  pure subroutine new_record(input, contact, line)
+  !> A record of group (&contact, &spring or &sine) opens at line.
+  pure subroutine new_record(input, group, line)
     type(scene_input), intent(inout) :: input
-    logical, intent(in) :: contact
+    integer, intent(in) :: group, line
+    if (group == g_contact) then
+      call append_record(input%chain%contacts, line)
+    else if (group == g_spring) then
+      call append_record(input%chain%springs, line)
+    else
+      call append_record(input%chain%sines, line)
+    end if
+  end subroutine new_record
+
+  !> One more record, opened at line.
+  pure subroutine append_record(records, line)
+    type(record_input), allocatable, intent(inout) :: records(:)
     integer, intent(in) :: line
     type(record_input) :: rec
     rec%line = line
-    if (contact) then
-      if (.not. allocated(input%chain%contacts)) allocate(input%chain%contacts(0))
-      input%chain%contacts = [input%chain%contacts, rec]
-    else
-      if (.not. allocated(input%chain%springs)) allocate(input%chain%springs(0))
-      input%chain%springs = [input%chain%springs, rec]
-    end if
-  end subroutine new_record
+    if (.not. allocated(records)) allocate(records(0))
+    records = [records, rec]
+  end subroutine append_record
 
   !> The items of a list: apart by commas, semicolons or blanks, outside quotes; 'r*c' is
   !> c r times. null: an empty item (two commas, a comma first or last) or 'r*' alone.
@@ -694,11 +702,14 @@ contains
     integer :: k
     field_index = 0
     if (len(name) == 0) return
-    if (group == g_contact .or. group == g_spring) then
-      do k = 1, merge(n_contact_fields, n_spring_fields, group == g_contact)
-        if (group == g_contact .and. contact_fields(k) == name) field_index = id_contact + k
-        if (group == g_spring .and. spring_fields(k) == name) field_index = id_spring + k
-      end do
+    if (group == g_contact) then
+      field_index = record_field(name, contact_fields, id_contact)
+      return
+    else if (group == g_spring) then
+      field_index = record_field(name, spring_fields, id_spring)
+      return
+    else if (group == g_sine) then
+      field_index = record_field(name, sine_fields, id_sine)
       return
     end if
     if (index(', ' // trim(group_variables(group)) // ',', ', ' // name // ',') > 0) then
@@ -711,6 +722,17 @@ contains
       end do
     end if
   end function field_index
+
+  !> first + k when name is fields(k), else 0.
+  pure integer function record_field(name, fields, first)
+    character(len=*), intent(in) :: name, fields(:)
+    integer, intent(in) :: first
+    integer :: k
+    record_field = 0
+    do k = 1, size(fields)
+      if (fields(k) == name) record_field = first + k
+    end do
+  end function record_field
 
   !> The text inside one quoted string ('...' or "..."), a doubled quote read as one; ok is
   !> false for anything else (no quotes, two strings, a lone quote inside).

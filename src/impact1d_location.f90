@@ -169,10 +169,8 @@ contains
     t0 = a%t
     tol = hold_tolerance(scene, a)
     n_sub = 1
-    do j = 1, scene%n_bodies
-      if (scene%forcing%has_sine(j)) n_sub = max(n_sub, &
-        ceiling(16.0_wp * step * scene%forcing%omega(j) / two_pi))
-    end do
+    ! (the fastest sine's count is the largest of the sines' counts: rounding is monotone)
+    if (scene%forcing%fastest > 0.0_wp) n_sub = max(n_sub, ceiling(16.0_wp * step * scene%forcing%fastest / two_pi))
     if (scene%springs%present) n_sub = max(n_sub, &
       ceiling(16.0_wp * step * scene%springs%omega / two_pi))
     lo = 0.0_wp

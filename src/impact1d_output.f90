@@ -10,7 +10,7 @@ module impact1d_output
   use impact1d_scene, only: scene_input, real_names, n_real, i_title, i_method, i_g, i_dt_out, &
     events_all, events_impacts, events_none, events_kept, name_len, &
     i_dt, default_gravity, i_m2, springs_named
-  use impact1d_fields, only: n_contact_fields, contact_fields, n_spring_fields, spring_fields, r_name
+  use impact1d_fields, only: n_contact_fields, contact_fields, spring_fields, sine_fields, r_name, record_input
   use impact1d_files, only: output_target, make_temporary, resolve_output, lock_folders, unlock_folders, write_text, &
     lock_timed_out, lock_wait
   implicit none
@@ -664,9 +664,10 @@ contains
     self%bytes(2) = self%bytes(2) + self%event_bytes
   end subroutine file_put_event
 
-  !> The scene's &contact and &spring records in the header, a line per given field in the
-  !> form of the others ('# contact.2.d_min = 0.5', '# spring.1.k = 40.0'), so that a reader
-  !> rebuilds the scene (impact1d.read_output: Scene.contacts, springs).
+  !> The scene's &contact, &spring and &sine records in the header, a line per given field in
+  !> the form of the others ('# contact.2.d_min = 0.5', '# spring.1.k = 40.0', '# sine.1.amp
+  !> = 2.0'), so that a reader rebuilds the scene (impact1d.read_output: Scene.contacts,
+  !> springs, sines).
   subroutine put_records(self, input)
     class(file_sink), intent(inout) :: self
     type(scene_input), intent(in) :: input
@@ -687,15 +688,25 @@ contains
         end associate
       end do
     end if
-    if (.not. allocated(input%chain%springs)) return
-    do r = 1, size(input%chain%springs)
-      do f = 1, n_spring_fields
-        write(key, '("spring.", i0, ".", a)') r, trim(spring_fields(f))
-        if (input%chain%springs(r)%given(f)) call self%put_line(self%unit, '# ' // trim(key) // ' = ' // &
-          trim(fmt(input%chain%springs(r)%value(f))))
+    if (allocated(input%chain%springs)) call put_numeric_records(self, 'spring', spring_fields, input%chain%springs)
+    if (allocated(input%chain%sines)) call put_numeric_records(self, 'sine', sine_fields, input%chain%sines)
+  end subroutine put_records
+
+  !> Records of numbers only, a line per given field ('# group.r.field = value').
+  subroutine put_numeric_records(self, group, fields, records)
+    class(file_sink), intent(inout) :: self
+    character(len=*), intent(in) :: group, fields(:)
+    type(record_input), intent(in) :: records(:)
+    integer :: r, f
+    character(len=32) :: key
+    do r = 1, size(records)
+      do f = 1, size(fields)
+        write(key, '(a, ".", i0, ".", a)') group, r, trim(fields(f))
+        if (records(r)%given(f)) call self%put_line(self%unit, '# ' // trim(key) // ' = ' // &
+          trim(fmt(records(r)%value(f))))
       end do
     end do
-  end subroutine put_records
+  end subroutine put_numeric_records
 
   !> A header line, checked like every row.
   subroutine put_line(self, unit, text)

@@ -5,7 +5,7 @@ module impact1d_scene
   use, intrinsic :: iso_fortran_env, only: int64
   use impact1d_kinds, only: wp, eps_wp
   use impact1d_error, only: error_type, raise, status_input, fmt, fmt_width
-  use impact1d_forcing, only: forcing_type, table_type
+  use impact1d_forcing, only: forcing_type, table_type, angular_frequency
   use impact1d_springs, only: springs_type, pair_elements, assemble, rate_bound
   use impact1d_modes, only: pair_type, pair_rows
   use impact1d_fields, only: chain_input, mechanism_records, r_k, r_c, array_value, a_m, a_mu, a_mus, a_x, a_v, &
@@ -653,6 +653,9 @@ contains
     else
       call set_bodies(input, tables, scene)
     end if
+    if (records%n_sines > 0) call scene%forcing%set_sines(records%sine_body, records%sine_amp, &
+      records%sine_period, records%sine_phase)
+    call scene%forcing%set_varies()
     call set_records(input, records, scene)
     call set_rows(scene, error)
     if (allocated(error)) return
@@ -681,7 +684,8 @@ contains
     scene%n_samples = int(row_count(scene%t_end, scene%dt_out))
   end subroutine build_scene
 
-  !> The bodies (N: 2 with m2, else 1), their forces, and the kernels' view of them (pair).
+  !> The bodies (N: 2 with m2, else 1), their forces but the &sine records' (build_scene's),
+  !> and the kernels' view of them (pair).
   subroutine set_bodies(input, tables, scene)
     type(scene_input), intent(in) :: input
     type(table_type), intent(in) :: tables(:)
@@ -730,11 +734,10 @@ contains
       scene%forcing%has_sine(i) = input%given(k)
       if (scene%forcing%has_sine(i)) then
         scene%forcing%amp(i) = input%value(k)
-        scene%forcing%omega(i) = 2.0_wp * acos(-1.0_wp) / input%value(k + 1)
+        scene%forcing%omega(i) = angular_frequency(input%value(k + 1))
         if (input%given(k + 2)) scene%forcing%phase(i) = input%value(k + 2)
       end if
     end do
-    call scene%forcing%set_varies()
   end subroutine set_bodies
 
   !> The bodies of a scene written as arrays of N > 2 (impact1d_fields' chain_input): body i's
@@ -773,7 +776,6 @@ contains
         end if
       end associate
     end do
-    call scene%forcing%set_varies()
   end subroutine set_chain_bodies
 
   !> The model's contact and element records: impact1d_chain's input_records (the walls,

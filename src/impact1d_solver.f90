@@ -87,8 +87,7 @@ contains
     ! Springs and dampers make the forces depend on the state: no closed forms then.
     rk%polynomial_forcing = scene%forcing%is_polynomial() .and. .not. scene%springs%present
     rk%bulk_steps => constant_steps
-    rk%constant_forcing = .not. (any(scene%forcing%has_table) .or. any(scene%forcing%has_sine) .or. &
-      scene%springs%present)
+    rk%constant_forcing = .not. (scene%forcing%varies .or. scene%springs%present)
     ! Every array of the run, once: nothing allocates per step.
     call new_state(scene%n_bodies, s0)
     allocate(watch%quiet_body(scene%n_bodies))

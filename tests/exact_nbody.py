@@ -883,7 +883,9 @@ class _Run:
             g0 = mpf(0) if k in self.touching else self.gaps[k]
             self.gaps[k] = g0 + s * (lim.rate(v) + s * (lim.rate(a0) / 2 + s * lim.rate(a1) / 6))
         touching = {key[1] for key in hits if key[0] == "contact"}
-        touching |= {k for k in self.touching if ("contact", k) not in roots}
+        # A closed contact stays closed unless the phase opened it: a phase of zero length
+        # (another contact hit at once) leaves its gap 0, whatever its own root.
+        touching |= {k for k in self.touching if ("contact", k) not in roots or s == 0}
         stopped = tuple(sorted(key[1] for key in hits if key[0] == "stop"))
         return t_new, stopped, touching
 

@@ -474,3 +474,28 @@ def test_lemke_solves_positive_semidefinite_problems(seed):
     for i in range(n):
         assert abs(w[i] - q[i] - sum(Q[i][j] * z[j] for j in range(n))) < EXACT
         assert w[i] > -EXACT and z[i] > -EXACT and abs(w[i] * z[i]) < EXACT
+
+
+def test_zero_length_phase_keeps_closed_contacts():
+    """Body 3 pinned between body 4 and the right wall, body 2 resting on body 3 and pulled
+    away from it (n23 closed, separating), when n34 closes again 1e-98 s later: a phase
+    shorter than the clock's resolution (t + s == t at 50 digits).  n23 was dropped from the
+    closed contacts because it had a root of its own (its gap is still 0); then the impulse
+    on n34 drove body 3 into body 2 across a contact no longer watched, n34 was dropped in
+    turn, and the two contacts took turns at the same instant until 'events do not
+    advance at t = 0.5704' (nbody_scenes.random_scene(33) with r = 1 made 0.875)."""
+    scene = dict(m=[1.921875, 2.078125, 2.546875, 1.1875], x=[0.0, 0.4375, 0.9375, 1.5],
+                 v=[1.421875, -0.4375, 2.078125, 2.5625], mu=[0.0, 0.0, 0.0, 0.28125],
+                 mus=[0.0, 0.0, 0.0, 0.28125], f=[10.640625, -4.765625, -0.09375, 2.578125], g=9.8125,
+                 contacts=[dict(a=1, b=2, d_min=0.328125, r_min=0.7, name="n12"),
+                           dict(a=2, b=3, d_min=0.5, r_min=0.7, name="n23"),
+                           dict(a=3, b=4, d_min=0.3125, r_min=0.875, name="n34"),
+                           dict(a=0, b=1, d_min=-0.890625, r_min=0.0, name="left"),
+                           dict(a=0, b=4, d_max=1.65625, r_max=0.046875, name="right"),
+                           dict(a=0, b=3, d_min=0.703125, r_min=0.875, name="stop3")], t_end=0.625)
+    sol = nb.solve(scene)
+    at = [e for e in sol.events if abs(e.t - mpf("0.5704289111933493")) < 1e-15]
+    assert {"n23", "n34", "right"} <= {e.kind for e in at}
+    model = sol.model
+    assert min(_gaps(model, sol.final[0])) > -EXACT
+    assert abs(sol.ledger["residual"]) < EXACT * 100

@@ -17,7 +17,7 @@ __all__ = ["read_output", "events_path"]
 
 # The scene fields that make the applied forces, besides the tables (which the output's
 # header does not name).
-FORCE_FIELDS = ("f1", "f2", "f1_amp", "f1_period", "f1_phase", "f2_amp", "f2_period", "f2_phase")
+FORCE_FIELDS = ("f1", "f2", "f1_amp", "f1_period", "f1_phase", "f2_amp", "f2_period", "f2_phase", "sines")
 
 
 def events_path(path) -> str:
@@ -101,11 +101,12 @@ def read_output(path, scene=None) -> Result:
     for name in TEXT_FIELDS:
         if name in header:
             kwargs[name] = header[name]
-    # The records: '# contact.2.d_min = 0.5', '# spring.1.k = 40.0' (in record order).
+    # The records: '# contact.2.d_min = 0.5', '# spring.1.k = 40.0', '# sine.1.amp = 2.0'
+    # (in record order).
     for key, value in header.items():
         group, _, rest = key.partition(".")
         number, _, field = rest.partition(".")
-        if group in ("contact", "spring") and number.isdigit() and field:
+        if group in ("contact", "spring", "sine") and number.isdigit() and field:
             _put(kwargs, f"{group}.{field}", int(number), value if field == "name" else float(value))
     header_scene = Scene(**kwargs, source=header.get("scene"))
 
@@ -130,7 +131,7 @@ def with_forces_of(result: Result, scene, path) -> Result:
         scene = load_scene(scene)
     if is_nbody_form(scene):
         # (written with arrays of one or two bodies: compared in the tutorial's names)
-        scene = from_core(*to_core(scene), source=scene.source)
+        scene = dataclasses.replace(from_core(*to_core(scene), source=scene.source), sines=scene.sines)
     for name in FORCE_FIELDS:
         mine, theirs = getattr(result.scene, name), getattr(scene, name)
         if mine != theirs:

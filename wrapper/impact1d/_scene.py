@@ -52,11 +52,18 @@ REAL_FIELDS = (
 TEXT_FIELDS = ("title", "f1_table", "f2_table", "method", "substeps", "events")
 # The N-body scene (DESIGN "Mechanisms as data"): arrays (body i's value at i; the &link
 # ones and k_link, d_rest, c_link one per neighbour pair), &link r_meet, and the fields of
-# the &contact and &spring records. Checked against _api.input_field_names() at import.
+# the &contact, &spring and &sine records. Checked against _api.input_field_names() at import.
 ARRAY_FIELDS = ("m", "mu", "mus", "x", "v", "f", "f_amp", "f_period", "f_phase", "k", "x_rest", "c",
                 "d_min", "r_min", "d_max", "r_max", "k_link", "d_rest", "c_link", "f_table")
 CONTACT_FIELDS = ("a", "b", "d_min", "r_min", "d_max", "r_max", "name")
 SPRING_FIELDS = ("a", "b", "k", "d_rest", "c")
+SINE_FIELDS = ("body", "amp", "period", "phase")
+# The record groups: Scene field, the core's prefix of its fields, the fields.
+_RECORD_GROUPS = (("contacts", "contact.", CONTACT_FIELDS), ("springs", "spring.", SPRING_FIELDS),
+                  ("sines", "sine.", SINE_FIELDS))
+_RECORD_NAMES = tuple(group for group, _, _ in _RECORD_GROUPS)
+# Record fields that are body numbers (whole numbers, as ints in a Scene).
+_BODY_NUMBER_FIELDS = ("a", "b", "body")
 # Array fields that are also the tutorial's scalars (d_min is d_min(1)): a sequence given
 # for one of these is the array.
 _SHARED_FIELDS = ("d_min", "r_min", "d_max", "r_max", "d_rest")
@@ -72,9 +79,10 @@ class Scene:
 
     N bodies (docs/formats.md, "Scenes of N bodies"): the arrays (`m=[...]`, `x=[...]`,
     ..., and `d_min`, `r_min`, `d_max`, `r_max`, `d_rest` given as sequences), `r_meet`,
-    and `contacts` / `springs`: lists of dicts with the &contact / &spring fields
-    (`{"a": 0, "b": 3, "d_min": -1.0, "name": "stop3"}`). One or two bodies given so run
-    as the tutorial's names; more, or any record, wait for the N-body engine (InputError).
+    and `contacts` / `springs` / `sines`: lists of dicts with the &contact / &spring /
+    &sine fields (`{"a": 0, "b": 3, "d_min": -1.0, "name": "stop3"}`, `{"body": 1, "amp":
+    2.0, "period": 0.5}`). One or two bodies given so run as the tutorial's names, with
+    their records; more wait for the N-body engine (InputError).
     """
 
     m1: Optional[float] = None
@@ -146,6 +154,7 @@ class Scene:
     r_meet: Optional[float] = None
     contacts: Optional[Sequence[dict]] = None
     springs: Optional[Sequence[dict]] = None
+    sines: Optional[Sequence[dict]] = None     # &sine records: {"body", "amp", "period", "phase"}
 
 
 def decode(text) -> str:
@@ -163,7 +172,7 @@ def _words(text) -> tuple:
 
 # Every input field as the core numbers them (id k: the k-th name).
 INPUT_FIELDS = REAL_FIELDS + TEXT_FIELDS + ARRAY_FIELDS + ("r_meet",) + \
-    tuple("contact." + name for name in CONTACT_FIELDS) + tuple("spring." + name for name in SPRING_FIELDS)
+    tuple(prefix + name for _, prefix, fields in _RECORD_GROUPS for name in fields)
 
 
 def _check_field_order() -> None:
@@ -179,7 +188,7 @@ _check_field_order()
 _SCENE_FIELDS = tuple(f.name for f in dataclasses.fields(Scene))
 # (the N-body fields after source: positional Scene(...) calls keep their meaning)
 _NBODY_FIELDS = tuple(name for name in ARRAY_FIELDS if name not in _SHARED_FIELDS) + \
-    ("r_meet", "contacts", "springs")
+    ("r_meet", "contacts", "springs", "sines")
 assert _SCENE_FIELDS == REAL_FIELDS + TEXT_FIELDS + ("source",) + _NBODY_FIELDS
 # Field ids: the scalars' and texts' by name, the arrays' apart (d_min is both).
 _ID = {name: k + 1 for k, name in reversed(list(enumerate(INPUT_FIELDS)))}
@@ -303,7 +312,7 @@ def to_assignments(scene: Scene):
     texts) in the numbering of INPUT_FIELDS (index 0 a scalar, else the element or record)."""
     numbers, texts = [], []
     for name, value in vars(scene).items():
-        if value is None or name in ("source", "contacts", "springs"):
+        if value is None or name in ("source",) + _RECORD_NAMES:
             continue
         if name in ARRAY_FIELDS and (_is_sequence(value) or name not in _SHARED_FIELDS):
             if not _is_sequence(value):
@@ -317,8 +326,7 @@ def to_assignments(scene: Scene):
             texts.append((_ID[name], 0, _text(name, value)))
         else:
             numbers.append((_ID[name], 0, _number(name, value)))
-    for group, fields in (("contacts", CONTACT_FIELDS), ("springs", SPRING_FIELDS)):
-        prefix = "contact." if group == "contacts" else "spring."
+    for group, prefix, fields in _RECORD_GROUPS:
         for j, record in _records(group, getattr(scene, group) or [], fields):
             for key, value in record.items():
                 if value is None:
@@ -343,15 +351,22 @@ def _packed(numbers, texts):
 
 
 def record_assignments(scene: Scene):
-    """The scene's &contact and &spring records as the api's simulate takes them (_packed;
-    none: counts 0). The rest of the scene goes as to_core's flat fields."""
-    if scene.contacts is None and scene.springs is None:
+    """The scene's &contact, &spring and &sine records as the api's simulate takes them
+    (_packed; none: counts 0). The rest of the scene goes as to_core's flat fields."""
+    records = record_fields(scene)
+    if not records:
         return _NO_RECORDS      # (a run of 50 us spent 9 us packing nothing)
-    numbers, texts = to_assignments(Scene(contacts=scene.contacts, springs=scene.springs))
+    numbers, texts = to_assignments(Scene(**records))
     return _packed(numbers, texts)
 
 
 _NO_RECORDS = _packed([], [])
+
+
+def record_fields(scene: Scene) -> dict:
+    """The scene's record lists that are given ({"contacts": [...], ...}; {} for none)."""
+    fields = vars(scene)
+    return {name: fields[name] for name in _RECORD_NAMES if fields[name] is not None}
 
 
 def _settled(scene: Scene):
@@ -428,7 +443,7 @@ def _put(kwargs: dict, name: str, index: int, value) -> None:
         group, key = name.split(".")
         records = kwargs.setdefault(group + "s", [])
         records.extend({} for _ in range(index - len(records)))
-        records[index - 1][key] = int(value) if key in ("a", "b") else value
+        records[index - 1][key] = int(value) if key in _BODY_NUMBER_FIELDS else value
     else:
         array = kwargs.setdefault(name, [])
         array.extend(None for _ in range(index - len(array)))

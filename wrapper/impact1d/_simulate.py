@@ -12,7 +12,7 @@ from typing import Optional
 import numpy as np
 
 from ._scene import (REAL_FIELDS, Scene, InputError, SimulationError, decode, raise_for_status, to_core, _words, _api,
-                     from_core, is_nbody_form, CoreForm, core_form, record_assignments,
+                     from_core, is_nbody_form, CoreForm, core_form, record_assignments, record_fields,
                      _STATUS_INTERRUPTED)
 from ._scene import STATUS_TOO_SMALL as _STATUS_TOO_SMALL
 
@@ -326,8 +326,7 @@ def _make_form(scene: Scene, overrides: dict) -> CoreForm:
     if not form.flat:
         # (written with arrays: the Result's scene is the one run, in the tutorial's names,
         # with its records)
-        scene = dataclasses.replace(from_core(*form.core, source=scene.source),
-                                    contacts=scene.contacts, springs=scene.springs)
+        scene = dataclasses.replace(from_core(*form.core, source=scene.source), **record_fields(scene))
     texts = form.core[2:]
     form.blob = b"".join(texts) or b" "           # (f2py refuses an empty string)
     form.text_end = np.array(list(itertools.accumulate(map(len, texts))), dtype=np.int32)

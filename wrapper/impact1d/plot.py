@@ -290,8 +290,9 @@ def _span(run, t_from, t_to):
 
 def _force_terms(result):
     """Each body's force terms from the result's scene: {"f1": (constant, table or None,
-    (amp, period, phase) or None), ...} (table: its corner times and values), "f2" only with
-    a second body. ValueError saying why when the result does not know its forces."""
+    [(amp, period, phase), ...]), ...} (table: its corner times and values; the sines: the
+    body's own, then its &sine records'), "f2" only with a second body. ValueError saying
+    why when the result does not know its forces."""
     scene = getattr(result, "scene", None)
     if scene is None:
         raise ValueError("the result has no scene to take its forces from")
@@ -308,8 +309,10 @@ def _force_terms(result):
         amp = _float_or_none(_scene_value(result, f"f{body}_amp"))
         period = _float_or_none(_scene_value(result, f"f{body}_period"))
         phase = _float_or_none(_scene_value(result, f"f{body}_phase")) or 0.0
-        sine = (amp, period, phase) if amp and period else None
-        terms[f"f{body}"] = (constant, table, sine)
+        sines = [(amp, period, phase)] if amp and period else []
+        sines += [(float(r["amp"]), float(r["period"]), float(r.get("phase") or 0.0))
+                  for r in (_scene_value(result, "sines") or []) if int(r["body"]) == body]
+        terms[f"f{body}"] = (constant, table, sines)
     return terms
 
 
@@ -327,15 +330,14 @@ def _force_table(path):
 
 
 def _force_values(terms, t):
-    """f_i(t) = f_i + table_i(t) + amp sin(2 pi t / period + phase), each term when named
-    (a table held at its end values outside its times, as the core does)."""
+    """f_i(t) = f_i + table_i(t) + sum of amp sin(2 pi t / period + phase), each term when
+    named (a table held at its end values outside its times, as the core does)."""
     out = {}
-    for name, (constant, table, sine) in terms.items():
+    for name, (constant, table, sines) in terms.items():
         f = np.full(t.shape, constant)
         if table is not None:
             f = f + np.interp(t, *table)
-        if sine is not None:
-            amp, period, phase = sine
+        for amp, period, phase in sines:
             f = f + amp * np.sin(2.0 * np.pi * t / period + phase)
         out[name] = f
     return out
@@ -352,18 +354,20 @@ def _force_times(terms, window):
     lo, hi = window.span
     t = window.t[(window.t >= lo) & (window.t <= hi)]
     parts = [t, np.array([lo, hi])]
-    for _, table, sine in terms.values():
+    for _, table, sines in terms.values():
         if table is not None:
             parts.append(table[0][(table[0] > lo) & (table[0] < hi)])
-        if sine is not None:
-            count = min(int(_SINE_POINTS * (hi - lo) / abs(sine[1])) + 2, _MAX_FORCE_POINTS)
+        if sines:
+            fastest = min(abs(period) for _, period, _ in sines)
+            count = min(int(_SINE_POINTS * (hi - lo) / fastest) + 2, _MAX_FORCE_POINTS)
             parts.append(np.linspace(lo, hi, count))
     return np.unique(np.concatenate(parts))
 
 
 def applied_forces(result, t=None) -> dict:
     """The applied forces of the result's scene, f_i(t) = f_i + table_i(t) + f_i_amp
-    sin(2 pi t / f_i_period + f_i_phase), at the times `t` (default: the result's samples):
+    sin(2 pi t / f_i_period + f_i_phase) + body i's &sine terms (Scene.sines), at the times
+    `t` (default: the result's samples):
     {"f1": array, "f2": array} ("f2" only with a second body). Springs, dampers, friction
     and contacts are not applied forces. ValueError saying why when the result does not
     know its forces: no scene, a file read back without its scene (the header does not
@@ -374,7 +378,7 @@ def applied_forces(result, t=None) -> dict:
 
 def _forces_vary(terms) -> bool:
     """Whether some force changes in time (a table or a sine): a constant one is flat."""
-    return any(table is not None or sine is not None for _, table, sine in terms.values())
+    return any(table is not None or sines for _, table, sines in terms.values())
 
 
 # ----------------------------------------------------------------------------

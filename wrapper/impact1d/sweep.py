@@ -115,7 +115,8 @@ def steady_state(result, settle: float) -> dict:
       oscillation's, not its offset's: a spring's rest position or a wall does not enter).
     - impacts_per_period: impacts (on any contact) in the window times the forcing period
       over the window's length; the period is f1_period when f1_amp is given and non-zero,
-      else f2_period likewise; NaN for a scene without a sine force.
+      else f2_period likewise; NaN for a scene without either (&sine records are not
+      read: several sines have no one period in general).
 
     Sampling error, for x = A cos(w t + phi) sampled every h (dt_out) over a window of
     length L = N h (N samples), w h <= pi/2: the sums of exp(i w t_k) and exp(2 i w t_k)
