@@ -229,8 +229,12 @@ contains
     input = flat_input(values, given, text_blob(:text_end(1)), text_blob(text_end(1) + 1:text_end(2)), &
       text_blob(text_end(2) + 1:text_end(3)), text_blob(text_end(3) + 1:text_end(4)), &
       text_blob(text_end(4) + 1:text_end(5)), text_blob(text_end(5) + 1:text_end(6)))
-    call apply_assignments(input, .true., n_numbers, n_texts, field, index, value, record_text_field, &
+    ! A scene of more than two bodies comes with its arrays among the assignments (one or
+    ! two bodies come as the tutorial's fields, settled by settle_scene).
+    call apply_assignments(input, .false., n_numbers, n_texts, field, index, value, record_text_field, &
       record_text_index, record_text_end, record_blob, error)
+    if (.not. allocated(error) .and. (any(field(:n_numbers) <= id_r_meet) .or. &
+        any(record_text_field(:n_texts) <= id_r_meet))) call settle_chain(input, error)
     if (.not. allocated(error)) call prepare_scene(input, scene, error)
     if (put_error(error, info, text_codes)) return
     warnings = trim(scene%warnings)

@@ -47,7 +47,7 @@ import nbody_scenes as ns  # noqa: E402
 INPUT = Path(__file__).resolve().parent.parent / "input"
 
 # --- the engine's expected failure, in one place ------------------------------------------
-ENGINE_LANDED = False
+ENGINE_LANDED = True
 REFUSAL = "more than two bodies need the cluster solver (issue 19, stage 4)"
 ENGINE_PENDING = (lambda test: test) if ENGINE_LANDED else pytest.mark.xfail(
     raises=impact1d.InputError, strict=True, reason="issue 19 stage 4: N-body engine not landed")

@@ -25,8 +25,8 @@ CHAIN = """&bodies  m = 5*1.0, mu = 5*0.1, mus = 5*0.15, g = 9.81 /
 """ + RUN
 
 
-# What a scene of more than two bodies gets until the cluster solver runs it.
-REFUSAL = "more than two bodies need the cluster solver (issue 19, stage 4)"
+# What a scene of more than two bodies gets with the tutorial's fixed-step method.
+REFUSAL = "method = 'vissim' is the tutorial's two-body scheme"
 
 
 def scene_file(tmp_path, text, name="scene.nml"):
@@ -36,7 +36,7 @@ def scene_file(tmp_path, text, name="scene.nml"):
 
 
 def refused(tmp_path, text, match):
-    """Refused when read, or (more than two bodies) when run."""
+    """Refused when read, or when run."""
     with pytest.raises(impact1d.InputError, match=match) as caught:
         impact1d.simulate(impact1d.load_scene(scene_file(tmp_path, text)))
     assert "\n" not in str(caught.value)
@@ -132,7 +132,8 @@ def test_record_faults(tmp_path, record, match):
 def test_records_are_repeatable_and_given_twice_is_per_record(tmp_path):
     """Two &contact groups are two records (another group given twice is still refused)."""
     text = CHAIN.replace("&spring ", "&spring a = 2, b = 4, c = 1.0 /\n&spring ")
-    refused(tmp_path, text, "more than two bodies need the cluster solver")
+    scene = impact1d.load_scene(scene_file(tmp_path, text))
+    assert len(scene.springs) == 2 and len(scene.contacts) == 2
     refused(tmp_path, CHAIN + "&walls x_left = -2 /\n", r"&walls is given twice")
 
 
@@ -145,19 +146,23 @@ def test_records_on_two_bodies_run(tmp_path, extra):
     assert res.events.size > 0 and (res.scene.contacts or res.scene.springs)
 
 
-def test_chain_is_read_checked_and_refused_by_the_cli(tmp_path):
+def test_chain_is_read_checked_and_run_by_the_cli(tmp_path):
+    """Five bodies run from the command line (the N-body engine); with the tutorial's
+    fixed-step method they are refused, and nothing is written."""
     cli = find_tool("impact1d")
     done = subprocess.run([cli, str(scene_file(tmp_path, CHAIN)), "-o", str(tmp_path / "out.dat")],
                           capture_output=True, text=True, timeout=60)
-    assert done.returncode == 1
-    assert REFUSAL in done.stderr
-    assert not (tmp_path / "out.dat").exists()
+    assert done.returncode == 0, done.stderr
+    assert (tmp_path / "out.dat").exists() and (tmp_path / "out.events.dat").exists()
+    done = subprocess.run([cli, str(scene_file(tmp_path, CHAIN)), "--method", "vissim", "-o",
+                           str(tmp_path / "v.dat")], capture_output=True, text=True, timeout=60)
+    assert done.returncode == 1 and REFUSAL in done.stderr
+    assert not (tmp_path / "v.dat").exists()
 
 
 def test_the_documented_examples_pass_every_check(tmp_path):
     """docs/formats.md's examples: the two-body scene with records runs (its events named
-    by the records, as the text says), the chain and records of five bodies wait for the
-    cluster solver."""
+    by the records, as the text says), and so does the chain of five bodies with records."""
     doc = (Path(__file__).resolve().parent.parent / "docs" / "formats.md").read_text()
     section = doc[doc.index("### Scenes of N bodies"):doc.index("## VisSim-style parameter file")]
     blocks = [[line.strip() for line in block.splitlines() if line.startswith("    &")]
@@ -167,7 +172,9 @@ def test_the_documented_examples_pass_every_check(tmp_path):
     assert len(two_body) == 7 and len(chain) == 9
     res = impact1d.simulate(impact1d.load_scene(scene_file(tmp_path, "\n".join(two_body) + "\n", "two.nml")))
     assert {"stop", "rest_stop", "wall1"} <= set(res.events["kind"])
-    refused(tmp_path, "\n".join(chain) + "\n" + RUN, re.escape(REFUSAL))
+    (tmp_path / "a.dat").write_text("0 0\n1 1\n")          # (the table the example names)
+    res = impact1d.simulate(impact1d.load_scene(scene_file(tmp_path, "\n".join(chain) + "\n" + RUN, "chain.nml")))
+    assert res.events.size > 0
 
 
 # --- Python: Scene arrays and records, through the core's assignments ------------------
@@ -195,8 +202,9 @@ def test_load_scene_of_a_chain_gives_arrays_and_records(tmp_path):
     assert scene.contacts == [{"a": 0, "b": 3, "d_min": -1.0, "r_min": 0.8, "name": "stop3"},
                               {"a": 2, "b": 5, "d_min": 0.1, "r_min": 0.5, "d_max": 1.0, "r_max": 0.0}]
     assert scene.springs == [{"a": 1, "b": 3, "k": 40.0, "d_rest": 0.5, "c": 0.1}]
+    assert impact1d.simulate(scene).events.size > 0
     with pytest.raises(impact1d.InputError, match=re.escape(REFUSAL)):
-        impact1d.simulate(scene)
+        impact1d.simulate(scene, method="vissim")
     # The same checks as a file's, on what Python changed.
     bad = dataclasses.replace(scene, contacts=scene.contacts + [{"a": 1, "b": 6, "d_min": 0.0}])
     with pytest.raises(impact1d.InputError, match=re.escape("&contact record 3: b = 6.0 is not a body")):

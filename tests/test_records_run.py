@@ -240,9 +240,13 @@ def test_records_events_are_named_by_their_rows():
     assert list(res.events["kind"][:2]) == ["stop1", "rest_stop1"]
 
 
-def test_more_than_two_bodies_still_refused():
-    with pytest.raises(impact1d.InputError, match=r"more than two bodies need the cluster solver \(issue 19, stage 4\)"):
-        impact1d.simulate(impact1d.Scene(m=[1.0] * 3, x=[0.0, 1.0, 2.0], t_end=1.0, dt=1e-3))
+def test_more_than_two_bodies_run_but_not_by_vissim():
+    scene = impact1d.Scene(m=[1.0] * 3, x=[0.0, 1.0, 2.0], v=[1.0, 0.0, 0.0], t_end=2.5, dt=1e-3)
+    assert [str(k) for k in impact1d.simulate(scene).events["kind"] if not str(k).startswith("rest")] == \
+        ["link1", "link2"]
+    assert list(impact1d.simulate(scene).events["t"][:2]) == [1.0, 2.0]
+    with pytest.raises(impact1d.InputError, match=r"method = 'vissim' is the tutorial's two-body scheme"):
+        impact1d.simulate(scene, method="vissim")
 
 
 def test_more_rows_than_the_kernels_hold_are_refused():

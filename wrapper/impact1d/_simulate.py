@@ -13,7 +13,7 @@ import numpy as np
 
 from ._scene import (REAL_FIELDS, Scene, InputError, SimulationError, decode, raise_for_status, to_core, _words, _api,
                      from_core, is_nbody_form, CoreForm, core_form, record_assignments, record_fields,
-                     _STATUS_INTERRUPTED)
+                     _STATUS_INTERRUPTED, to_assignments, _packed)
 from ._scene import STATUS_TOO_SMALL as _STATUS_TOO_SMALL
 
 __all__ = ["Result", "simulate", "COLUMNS", "EVENT_DTYPE", "ONE_BODY_EVENT_DTYPE"]
@@ -322,7 +322,8 @@ def _make_form(scene: Scene, overrides: dict) -> CoreForm:
     form = CoreForm()
     form.core = to_core(scene)
     form.flat = not is_nbody_form(scene)
-    form.records = record_assignments(scene)
+    form.records = record_assignments(scene) if form.flat or not _more_than_two(scene) else \
+        _packed(*to_assignments(scene))
     if not form.flat:
         # (written with arrays: the Result's scene is the one run, in the tutorial's names,
         # with its records)
@@ -333,6 +334,13 @@ def _make_form(scene: Scene, overrides: dict) -> CoreForm:
     form.fields = vars(scene)
     form.sample_capacity = _sample_capacity(scene)
     return form
+
+
+def _more_than_two(scene: Scene) -> bool:
+    """A scene written with arrays of more than two bodies: it goes to the core whole, as
+    assignments (one or two bodies go as the tutorial's fields)."""
+    masses = vars(scene).get("m")
+    return masses is not None and not isinstance(masses, (int, float)) and len(masses) > 2
 
 
 def _with_reals(base: CoreForm, overrides: dict) -> CoreForm:
