@@ -11,7 +11,7 @@ program impact1d_cli
     i_events, i_title, events_none, events_impacts, i_f1_table, i_f2_table
   use impact1d_io, only: read_scene_file, prepare_scene, lower
   use impact1d_output, only: file_sink, events_path, i_pe, i_work, i_friction_loss, i_impact_loss, i_damping_loss, &
-    class_impact, class_stick, class_slip, event_name, event_count
+    class_impact, class_stick, class_slip, event_name, event_count, check_bodies_out
   use impact1d_files, only: make_folders, resolve, write_text
   use impact1d_solver, only: run, run_stats
   use impact1d_version, only: version
@@ -41,7 +41,7 @@ program impact1d_cli
 
   character(len=*), parameter :: usage = &
     'usage: impact1d SCENE [--t-end T] [--dt DT] [--dt-out DT_OUT] [--method event|vissim] [-o OUT.dat]' // &
-    ' [--events all|impacts|none] [--events-file FILE] [--max-events N] [--quiet]'
+    ' [--events all|impacts|none] [--events-file FILE] [--max-events N] [--bodies-out I,J,..] [--quiet]'
   character(len=*), parameter :: nl = new_line('a')
   character(len=*), parameter :: help = usage // nl // nl // &
     'Runs SCENE (a namelist scene, or a VisSim-style .dat parameter file) and writes its samples' // nl // &
@@ -62,6 +62,8 @@ program impact1d_cli
     '  --events-file F  the event log goes to F (default OUT.events.dat)' // nl // &
     '  --max-events N   the log keeps the first N events (default 10^7); then it ends with a' // nl // &
     '                   note, the run goes on and the summary''s counts stay exact' // nl // &
+    '  --bodies-out L   the samples have x and v of the bodies listed (1,10,20: increasing),' // nl // &
+    '                   not of every body; ke and the ledger stay over every body' // nl // &
     '  --quiet          no progress line (a run of over a second on a terminal shows one on' // nl // &
     '                   stderr: the simulated time, events so far and the time left; never' // nl // &
     '                   in a pipe or a file)' // nl // &
@@ -79,6 +81,7 @@ program impact1d_cli
   type(error_type), allocatable :: error, close_error
   character(len=:), allocatable :: scene_path, out_path, option, value, events_file
   integer :: i, n_args, k, c, equals
+  integer, allocatable :: bodies_out(:)
   real(wp) :: overrides(4)
   logical :: overridden(4), has_value, out_given, quiet, stream
   character(len=64) :: method, events
@@ -118,7 +121,8 @@ program impact1d_cli
     case ('--quiet')
       if (has_value) call fail(status_input, '--quiet takes no value; ' // usage)
       quiet = .true.
-    case ('--t-end', '--dt', '--dt-out', '--max-events', '--method', '--events', '--events-file', '-o')
+    case ('--t-end', '--dt', '--dt-out', '--max-events', '--method', '--events', '--events-file', '-o', &
+        '--bodies-out')
       if (.not. has_value) then
         if (i > n_args) call fail(status_input, option // ' needs a value')
         value = argument_text(i)
@@ -149,6 +153,8 @@ program impact1d_cli
         call override(3)
       case ('--max-events')
         call override(4)
+      case ('--bodies-out')
+        call body_list(value, bodies_out)
       end select
     case default
       if (has_value) call fail(status_input, 'unknown option ' // option // '; ' // usage)
@@ -168,7 +174,9 @@ program impact1d_cli
   input%given(overridable) = input%given(overridable) .or. overridden
   if (len_trim(method) > 0) call set_text(input, i_method, trim(method))
   if (len_trim(events) > 0) call set_text(input, i_events, trim(events))
+  if (allocated(bodies_out)) input%bodies_out = bodies_out
   call prepare_scene(input, scene, error)
+  if (.not. allocated(error)) call check_bodies_out(input, error)
   if (allocated(error)) call fail(error%status, scene_path // ': ' // error%message)
 
   if (.not. out_given) out_path = 'output/' // stem(scene_path) // '.dat'
@@ -214,6 +222,19 @@ program impact1d_cli
   call summary()
 
 contains
+
+  !> --bodies-out's list: integers separated by commas ('1,10,20').
+  subroutine body_list(text, bodies)
+    character(len=*), intent(in) :: text
+    integer, allocatable, intent(out) :: bodies(:)
+    integer :: ios
+    character(len=256) :: message
+    if (len_trim(text) == 0 .or. verify(trim(text), '0123456789, ') > 0) &
+      call fail(status_input, '--bodies-out needs body numbers separated by commas (1,10,20), got ''' // text // '''')
+    allocate(bodies(count([(text(k:k) == ',', k = 1, len(text))]) + 1))
+    read(text, *, iostat=ios, iomsg=message) bodies
+    if (ios /= 0) call fail(status_input, '--bodies-out ' // text // ': ' // trim(message))
+  end subroutine body_list
 
   !> What the summary says of the event log: its file and what it holds (&run events).
   function event_log_text() result(text)
