@@ -9,9 +9,9 @@ program impact1d_cli
   use impact1d_error, only: error_type, status_input, status_simulation, fmt
   use impact1d_scene, only: scene_input, scene_type, set_text, i_t_end, i_dt, i_dt_out, i_max_events, i_method, &
     i_events, i_title, events_none, events_impacts, i_f1_table, i_f2_table
-  use impact1d_io, only: read_scene_file, prepare_scene, lower
-  use impact1d_output, only: file_sink, events_path, i_pe, i_work, i_friction_loss, i_impact_loss, i_damping_loss, &
-    class_impact, class_stick, class_slip, event_name, event_count, check_bodies_out
+  use impact1d_io, only: read_scene_file, prepare_scene, lower, read_body_list
+  use impact1d_output, only: file_sink, events_path, class_impact, class_stick, class_slip, event_name, event_count, &
+    check_bodies_out, row_ledger
   use impact1d_files, only: make_folders, resolve, write_text
   use impact1d_solver, only: run, run_stats
   use impact1d_version, only: version
@@ -83,7 +83,7 @@ program impact1d_cli
   integer :: i, n_args, k, c, equals
   integer, allocatable :: bodies_out(:)
   real(wp) :: overrides(4)
-  logical :: overridden(4), has_value, out_given, quiet, stream
+  logical :: overridden(4), has_value, out_given, quiet, stream, ok
   character(len=64) :: method, events
   !> The fields --t-end, --dt, --dt-out, --max-events override, in that order.
   integer, parameter :: overridable(4) = [i_t_end, i_dt, i_dt_out, i_max_events]
@@ -154,7 +154,9 @@ program impact1d_cli
       case ('--max-events')
         call override(4)
       case ('--bodies-out')
-        call body_list(value, bodies_out)
+        call read_body_list(value, bodies_out, ok)
+        if (.not. ok) call fail(status_input, '--bodies-out needs body numbers separated by commas (1,10,20), ' // &
+          'got ''' // value // '''')
       end select
     case default
       if (has_value) call fail(status_input, 'unknown option ' // option // '; ' // usage)
@@ -223,18 +225,29 @@ program impact1d_cli
 
 contains
 
-  !> --bodies-out's list: integers separated by commas ('1,10,20').
-  subroutine body_list(text, bodies)
-    character(len=*), intent(in) :: text
-    integer, allocatable, intent(out) :: bodies(:)
-    integer :: ios
-    character(len=256) :: message
-    if (len_trim(text) == 0 .or. verify(trim(text), '0123456789, ') > 0) &
-      call fail(status_input, '--bodies-out needs body numbers separated by commas (1,10,20), got ''' // text // '''')
-    allocate(bodies(count([(text(k:k) == ',', k = 1, len(text))]) + 1))
-    read(text, *, iostat=ios, iomsg=message) bodies
-    if (ios /= 0) call fail(status_input, '--bodies-out ' // text // ': ' // trim(message))
-  end subroutine body_list
+  !> The summary's line of the final state: t, then x and v of the bodies written (&run
+  !> bodies_out, or every body; the first ten of them).
+  subroutine final_state(text)
+    character(len=:), allocatable, intent(inout) :: text
+    real(wp), allocatable :: final(:)
+    integer, allocatable :: bodies(:)
+    integer :: j
+    character(len=16) :: name
+    final = stats%last_row
+    if (allocated(stats%row)) final = stats%row
+    if (allocated(input%bodies_out)) then
+      bodies = input%bodies_out
+    else
+      bodies = [(j, j = 1, scene%n_bodies)]
+    end if
+    text = text // '  final     t =' // es(final(1))
+    do j = 1, min(size(bodies), 10)
+      write(name, '(i0)') bodies(j)
+      text = text // '  x' // trim(name) // ' =' // es(final(2 * bodies(j))) // '  v' // trim(name) // ' =' // &
+        es(final(2 * bodies(j) + 1))
+    end do
+    if (size(bodies) > 10) text = text // '  ...'
+  end subroutine final_state
 
   !> What the summary says of the event log: its file and what it holds (&run events).
   function event_log_text() result(text)
@@ -263,6 +276,13 @@ contains
   subroutine summary()
     character(len=:), allocatable :: text, line, where
     character(len=16) :: number
+    real(wp), allocatable :: final(:)
+    integer :: l
+    ! The last full row: emit_sample's (one or two bodies) or emit_bodies' (N), the ledger
+    ! after the bodies' x and v.
+    final = stats%last_row
+    if (allocated(stats%row)) final = stats%row
+    l = row_ledger(scene%n_bodies)
     text = 'impact1d: ' // trim(input%text(i_title)%s) // nl
     text = text // '  scene     ' // scene_path // ' (method ' // scene%method // ', dt = ' // &
       trim(fmt(scene%dt)) // ' s, t_end = ' // trim(fmt(scene%t_end)) // ' s)' // nl
@@ -283,14 +303,12 @@ contains
     end do
     if (len(line) == 0) line = ' none'
     text = text // '  events   ' // line // nl
-    text = text // '  final     t =' // es(stats%last_row(1)) // '  x1 =' // es(stats%last_row(2)) // &
-      '  v1 =' // es(stats%last_row(3))
-    if (scene%n_bodies == 2) text = text // '  x2 =' // es(stats%last_row(4)) // '  v2 =' // es(stats%last_row(5))
-    text = text // nl // '  energy    KE =' // es(stats%last_row(6))
-    if (scene%springs%has_spring) text = text // '  PE =' // es(stats%last_row(i_pe))
-    text = text // ' J' // nl // '  ledger    work =' // es(stats%last_row(i_work)) // '  friction loss =' // &
-      es(stats%last_row(i_friction_loss)) // '  impact loss =' // es(stats%last_row(i_impact_loss))
-    if (scene%springs%has_damper) text = text // '  damping loss =' // es(stats%last_row(i_damping_loss))
+    call final_state(text)
+    text = text // nl // '  energy    KE =' // es(final(l + 1))
+    if (scene%springs%has_spring) text = text // '  PE =' // es(final(l + 2))
+    text = text // ' J' // nl // '  ledger    work =' // es(final(l + 3)) // '  friction loss =' // &
+      es(final(l + 4)) // '  impact loss =' // es(final(l + 5))
+    if (scene%springs%has_damper) text = text // '  damping loss =' // es(final(l + 6))
     write(number, '(es10.2e3)') stats%max_residual
     text = text // '  |residual| <=' // trim(number) // ' J' // nl
     text = text // '  steps     ' // trim(fmt(stats%steps)) // ' RK4 steps' // nl

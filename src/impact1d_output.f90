@@ -10,7 +10,8 @@ module impact1d_output
   use impact1d_scene, only: scene_input, real_names, n_real, i_title, i_method, i_g, i_dt_out, &
     events_all, events_impacts, events_none, events_kept, name_len, &
     i_dt, default_gravity, i_m2, springs_named, is_nbody
-  use impact1d_fields, only: n_contact_fields, contact_fields, n_spring_fields, spring_fields, r_name
+  use impact1d_fields, only: n_contact_fields, contact_fields, n_spring_fields, spring_fields, r_name, n_arrays, &
+    array_names, array_is_text
   use impact1d_files, only: output_target, make_temporary, resolve_output, lock_folders, unlock_folders, write_text, &
     lock_timed_out, lock_wait
   implicit none
@@ -759,6 +760,7 @@ contains
         call self%put_line(self%unit, '# dt_out = ' // trim(fmt(input%value(i_dt))))
       end if
     end do
+    if (self%n_bodies > 2) call put_arrays(self, input)
     call put_records(self, input)
     if (self%n_bodies > 2) call self%put_line(self%unit, '# bodies = ' // trim(fmt(self%n_bodies)))
     call names_of(self%columns, self%n_bodies, header)
@@ -825,6 +827,26 @@ contains
     write(line, '(es25.16e3, 1x, a, 2(1x, i0), 4es25.16e3)') t, trim(kind), a, b, v
     call self%put_line(self%event_unit, trim(line))
   end subroutine put_pair_event
+
+  !> The number arrays of a scene of more than two bodies in the header, a line each with
+  !> its values ('# m = 1.0 2.0 5.0'), so that a reader rebuilds the scene (read_output);
+  !> like the tutorial's table names, the force tables' names are not written.
+  subroutine put_arrays(self, input)
+    class(file_sink), intent(inout) :: self
+    type(scene_input), intent(in) :: input
+    character(len=:), allocatable :: line
+    integer :: a, i
+    do a = 1, n_arrays
+      associate (array => input%chain%array(a))
+        if (array%n == 0 .or. array_is_text(a)) cycle
+        line = '# ' // trim(array_names(a)) // ' ='
+        do i = 1, array%n
+          line = line // ' ' // trim(fmt(array%v(i)))
+        end do
+        call self%put_line(self%unit, line)
+      end associate
+    end do
+  end subroutine put_arrays
 
   !> The scene's &contact and &spring records in the header, a line per given field in the
   !> form of the others ('# contact.2.d_min = 0.5', '# spring.1.k = 40.0'), so that a reader

@@ -19,6 +19,9 @@ HEADER = """# impact1d output
 # g = 9.80665
 # dt = 0.001
 # dt_out = 0.001
+# m = 1.0 2.0 3.0 4.0 5.0
+# x = 0.0 1.0 2.0 3.0 4.0
+# d_min = 0.25 0.25 0.25 0.25
 # bodies = 5
 """
 
@@ -60,6 +63,9 @@ def test_read_output_of_five_bodies(tmp_path):
     np.testing.assert_array_equal(res.samples, rows)
     assert list(res.to_dataframe().columns) == columns
     assert res.energy_residual == np.max(np.abs(rows[:, -1]))
+    # the scene's arrays from the header
+    assert res.scene.m == [1.0, 2.0, 3.0, 4.0, 5.0] and res.scene.d_min == [0.25] * 4
+    assert res.scene.title == "five" and res.scene.dt == 0.001
     # events: the pair and its velocities
     assert res.events.dtype == NBODY_EVENT_DTYPE
     assert list(res.events["kind"]) == ["stop3", "link_2_5", "stick4"]
@@ -150,3 +156,32 @@ def test_cli_bodies_out_limits_the_bodies_written(tmp_path):
         proc = subprocess.run([cli, case, *common, "--bodies-out", bad, "-o", tmp_path / "bad.dat"],
                               capture_output=True, text=True)
         assert proc.returncode == 1 and "bodies" in proc.stderr, (bad, proc.stderr)
+
+
+NAMELIST = """&bodies m1 = 1.0, m2 = 2.0 /
+&initial x1 = 0.0, v1 = 1.0, x2 = 5.0, v2 = -0.5 /
+&run t_end = 0.1, dt = 1e-3, {} /
+"""
+
+
+def test_namelist_bodies_out(tmp_path):
+    """&run bodies_out = ... in a namelist limits the CLI's columns as --bodies-out does (the
+    list ends where the next variable starts); a bad list is bad input naming the line; Python's
+    load_scene refuses it rather than drop it (its Scene has no bodies_out yet)."""
+    import subprocess
+    from tools import find_tool
+    cli = find_tool("impact1d")
+    scene = tmp_path / "two.nml"
+    scene.write_text(NAMELIST.format("bodies_out = 2, dt_out = 0.01"))
+    subprocess.run([cli, scene, "--quiet", "-o", tmp_path / "two.dat"], check=True, capture_output=True)
+    res = impact1d.read_output(tmp_path / "two.dat")
+    assert res.columns == ("t", "x2", "v2", "ke", "work", "friction_loss", "impact_loss", "residual")
+    assert len(res.t) == 11 and res.x2[-1] == 5.0 - 0.05
+    for bad, message in (("bodies_out = 1.5", "not a list of body numbers"), ("bodies_out = 3", "does not have"),
+                         ("bodies_out = 2, 1", "increasing order"), ("bodies_out = 1, bodies_out = 2", "twice")):
+        scene.write_text(NAMELIST.format(bad))
+        proc = subprocess.run([cli, scene, "--quiet", "-o", tmp_path / "bad.dat"], capture_output=True, text=True)
+        assert proc.returncode == 1 and message in proc.stderr, (bad, proc.stderr)
+    scene.write_text(NAMELIST.format("bodies_out = 2"))
+    with pytest.raises(impact1d.InputError, match="bodies_out is read by the command line"):
+        impact1d.load_scene(scene)

@@ -10,6 +10,7 @@ program test_output
   use impact1d_scene, only: scene_input
   use impact1d_output, only: memory_sink, file_sink, run_stats, emit_bodies, emit_sample, present_columns, &
     row_length, class_impact, class_stick, column_word
+  use impact1d_fields, only: a_m
   use testing, only: check, finish
   implicit none
   integer, parameter :: n = 5
@@ -20,6 +21,8 @@ program test_output
   character(len=*), parameter :: path = 'build/test_output_nbody.dat'
 
   input%chain%n_bodies = n
+  input%chain%array(a_m)%n = n
+  input%chain%array(a_m)%v = mass
   call memory_rows()
   input%bodies_out = [2, 5]
   call memory_rows()
@@ -75,7 +78,7 @@ contains
     type(error_type), allocatable :: error
     character(len=1024) :: line, last_comment, kind
     character(len=:), allocatable :: names
-    integer :: unit, ios, a, b, n_rows, n_lines
+    integer :: unit, ios, a, b, n_rows, n_lines, n_masses
     real(wp) :: values(2 * n + 8), t, ev(4)
     call sink%open(path, input, error)
     call check(.not. allocated(error), 'the file sink opens')
@@ -96,6 +99,7 @@ contains
     open(newunit=unit, file=path, status='old', action='read')
     n_rows = 0
     n_lines = 0
+    n_masses = 0
     do
       read(unit, '(a)', iostat=ios) line
       if (ios /= 0) exit
@@ -103,6 +107,7 @@ contains
       if (line(1:1) == '#') then
         last_comment = line
         if (line == '# bodies = 5') n_lines = -1000
+        if (line == '# m = 1.0 2.0 3.0 4.0 5.0') n_masses = n_masses + 1
         cycle
       end if
       n_rows = n_rows + 1
@@ -110,6 +115,7 @@ contains
     end do
     close(unit)
     call check(n_lines < 0, 'the header says bodies = 5')
+    call check(n_masses == 1, 'the header has the masses as written: # m = 1.0 2.0 3.0 4.0 5.0')
     call check(trim(last_comment) == '# ' // names, 'the last header line names the columns: ' // trim(last_comment))
     call check(n_rows == 1, 'one row written')
     if (allocated(input%bodies_out)) then

@@ -7,7 +7,7 @@ import os
 
 import numpy as np
 
-from ._scene import (REAL_FIELDS, TEXT_FIELDS, Scene, InputError, load_scene, is_nbody_form, from_core, to_core,
+from ._scene import (REAL_FIELDS, TEXT_FIELDS, ARRAY_FIELDS, Scene, InputError, load_scene, is_nbody_form, from_core, to_core,
                      _put)
 from ._files import check_input
 from ._simulate import LEDGER, Result, event_dtype, result_from_columns
@@ -93,11 +93,17 @@ def read_output(path, scene=None) -> Result:
 
     kwargs = {}
     for name in REAL_FIELDS:
-        if name in header:
+        if name in header and not (n_bodies > 2 and name in ARRAY_FIELDS):
             kwargs[name] = float(header[name])
     for name in TEXT_FIELDS:
         if name in header:
             kwargs[name] = header[name]
+    if n_bodies > 2:
+        # The arrays of more than two bodies: '# m = 1.0 2.0 5.0' (the force tables' names,
+        # texts, are not written).
+        for name in ARRAY_FIELDS:
+            if name in header and name != "f_table":
+                kwargs[name] = [float(value) for value in header[name].split()]
     # The records: '# contact.2.d_min = 0.5', '# spring.1.k = 40.0' (in record order).
     for key, value in header.items():
         group, _, rest = key.partition(".")
