@@ -185,3 +185,45 @@ def test_namelist_bodies_out(tmp_path):
     scene.write_text(NAMELIST.format("bodies_out = 2"))
     with pytest.raises(impact1d.InputError, match="bodies_out is read by the command line"):
         impact1d.load_scene(scene)
+
+
+def test_flat_api_output_of_five_bodies_becomes_a_result():
+    """What simulate() does with the flat API's arrays of a run of five bodies (the engine
+    is not merged: the arrays are made here as the core fills them, api.f90's simulate):
+    has_column over the full row of 2 N + 8 columns, info(8) = N, events with their pair.
+    The Result has x, v (samples, 5) with x1 .. x5 views, and NBODY_EVENT_DTYPE events
+    named from the run's rows."""
+    from types import SimpleNamespace
+    from impact1d._simulate import _column_layout, _fill_result, _fill_events, row_length, row_names
+    n, rows = 5, 4
+    assert row_length(n) == 18 and row_names(n)[:3] == ("t", "x1", "v1") and row_names(n)[11:] == \
+        ("ke", "pe", "work", "friction_loss", "impact_loss", "damping_loss", "residual")
+    has_column = np.ones(row_length(n), dtype=np.int32)
+    has_column[[12, 16]] = 0                                    # no pe, no damping_loss
+    names = _column_layout(has_column.tobytes(), n)
+    samples = np.asfortranarray(_rows(rows, row_length(n)))    # (the core's room: all columns)
+    result = object.__new__(Result)
+    _fill_result(vars(result), samples, names)
+    vars(result).update(scene=None, events=None)
+    assert result.columns == names and len(names) == 16
+    assert result.x.shape == (rows, n) and result.bodies == (1, 2, 3, 4, 5)
+    for i in range(1, n + 1):
+        column = getattr(result, f"x{i}")
+        assert np.shares_memory(column, result.x) and (column == samples[:, 2 * i - 1]).all()
+        assert (getattr(result, f"v{i}") == samples[:, 2 * i]).all()
+    assert (result.ke == samples[:, 11]).all() and (result.residual == samples[:, 15]).all()
+    assert result.pe is None
+    # events: (class, index, a, b) and [t, va-, vb-, va+, vb+]; rows 'stop3' and 'link_2_5'
+    codes = np.full((32, 2), ord(" "), dtype=np.int32, order="F")
+    for k, name in enumerate(("stop3", "link_2_5")):
+        codes[:len(name), k] = [ord(c) for c in name]
+    buffers = SimpleNamespace(
+        event_real=np.asfortranarray([[1.5, 0.0, -2.0, 0.0, 1.0], [2.0, 1.0, 2.0, 3.0, 4.0],
+                                      [2.5, 0.5, 0.0, 0.0, 0.0]]),
+        event_int=np.asfortranarray(np.array([[1, 1, 0, 3], [2, 2, 2, 5], [4, 4, 4, 0]], dtype=np.int32)),
+        row_name_codes=codes)
+    events = np.empty(3, dtype=NBODY_EVENT_DTYPE)
+    _fill_events(events, buffers, 3, 2, n)
+    assert list(events["kind"]) == ["stop3", "rest_link_2_5", "stick4"]
+    assert list(events["a"]) == [0, 2, 4] and list(events["b"]) == [3, 5, 0]
+    assert list(events["va_after"]) == [0.0, 3.0, 0.0] and list(events["vb_before"]) == [-2.0, 2.0, 0.0]
