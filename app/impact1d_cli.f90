@@ -11,7 +11,7 @@ program impact1d_cli
     i_events, i_title, events_none, events_impacts, i_f1_table, i_f2_table
   use impact1d_io, only: read_scene_file, prepare_scene, lower, read_body_list
   use impact1d_output, only: file_sink, events_path, class_impact, class_stick, class_slip, event_name, event_count, &
-    check_bodies_out, row_ledger
+    check_bodies_out, row_ledger, final_row
   use impact1d_files, only: make_folders, resolve, write_text
   use impact1d_solver, only: run, run_stats
   use impact1d_version, only: version
@@ -233,8 +233,7 @@ contains
     integer, allocatable :: bodies(:)
     integer :: j
     character(len=16) :: name
-    final = stats%last_row
-    if (allocated(stats%row)) final = stats%row
+    final = final_row(stats)
     if (allocated(input%bodies_out)) then
       bodies = input%bodies_out
     else
@@ -278,10 +277,8 @@ contains
     character(len=16) :: number
     real(wp), allocatable :: final(:)
     integer :: l
-    ! The last full row: emit_sample's (one or two bodies) or emit_bodies' (N), the ledger
-    ! after the bodies' x and v.
-    final = stats%last_row
-    if (allocated(stats%row)) final = stats%row
+    ! The last full row (one, two or N bodies), the ledger after the bodies' x and v.
+    final = final_row(stats)
     l = row_ledger(scene%n_bodies)
     text = 'impact1d: ' // trim(input%text(i_title)%s) // nl
     text = text // '  scene     ' // scene_path // ' (method ' // scene%method // ', dt = ' // &

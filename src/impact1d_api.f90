@@ -16,8 +16,8 @@ module impact1d_api
     assign_text, scene_assignments
   use impact1d_fields, only: text_item
   use impact1d_output, only: memory_sink, summary_sink, column_names_text => column_names, event_names, &
-    n_columns, event_impact, event_rest, present_columns, class_impact, impacts_on, i_impact_loss, &
-    i_friction_loss, i_pe, i_damping_loss, row_length
+    n_columns, event_impact, event_rest, present_columns, class_impact, impacts_on, &
+    row_length, row_ledger, final_row
   use impact1d_solver, only: run, run_stats
   implicit none
   private
@@ -331,7 +331,8 @@ contains
     type(summary_sink) :: sink
     type(error_type), allocatable :: error
     character(len=message_length) :: message
-    integer :: j, k
+    real(wp), allocatable :: final(:)
+    integer :: j, k, l
 
     summary = ieee_value(1.0_c_double, ieee_quiet_nan)
     message_codes = ichar(' ')
@@ -372,11 +373,14 @@ contains
         end if
         cycle
       end if
-      summary(:, j) = [stats%last_row([2, 3, 4, 5, 6]), &
+      ! (x1 v1 x2 v2 of the full row of one, two or N bodies, the ledger at row_ledger's)
+      final = final_row(stats)
+      l = row_ledger(scene%n_bodies)
+      summary(:, j) = [final([2, 3, 4, 5, l + 1]), &
         real(sum(stats%row_events(class_impact, :)), wp), &
         real([(impacts_on(stats, scene%row_name, event_names(k)), k = event_impact + 1, event_rest)], wp), &
-        sink%rest_time(stats%last_row), stats%last_row([i_impact_loss, i_friction_loss]), &
-        stats%max_residual, real(stats%steps, wp), stats%last_row([i_pe, i_damping_loss])]
+        sink%rest_time(final), final([l + 5, l + 4]), &
+        stats%max_residual, real(stats%steps, wp), final([l + 2, l + 6])]
       ! A one-body scene has no x2_end, v2_end.
       if (scene%n_bodies == 1) summary(3:4, j) = ieee_value(1.0_c_double, ieee_quiet_nan)
     end do

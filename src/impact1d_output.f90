@@ -21,7 +21,7 @@ module impact1d_output
   public :: class_impact, class_rest, class_release, class_stick, class_slip, event_name, start_counts, &
     count_event, event_count, impacts_on
   public :: emit_sample, emit_bodies, events_path, present_columns, i_pe, i_work, i_friction_loss, i_impact_loss, &
-    i_damping_loss, row_length, row_columns, column_word, bodies_of, row_ledger, check_bodies_out
+    i_damping_loss, row_length, row_columns, column_word, bodies_of, row_ledger, check_bodies_out, final_row
 
   !> Every column a run can have; a scene's output carries those it has (present_columns):
   !> pe only with springs, damping_loss only with dampers.
@@ -313,6 +313,18 @@ contains
       call sink%put_sample(row)
     end associate
   end subroutine emit_bodies
+
+  !> The run's last full row: emit_sample's (one or two bodies: t x1 v1 x2 v2, the ledger)
+  !> or emit_bodies' (N); the ledger's k-th at row_ledger(N) + k either way.
+  pure function final_row(stats) result(row)
+    type(run_stats), intent(in) :: stats
+    real(wp), allocatable :: row(:)
+    if (allocated(stats%row)) then
+      row = stats%row
+    else
+      row = stats%last_row
+    end if
+  end function final_row
 
   !> A sample that is not finite: the run cannot go on.
   subroutine not_finite(t, ke, ke0, error)
@@ -610,7 +622,9 @@ contains
     class(summary_sink), intent(inout) :: self
     real(wp), intent(in) :: t, v(4)
     integer, intent(in) :: class, index, a, b
-    ! (With one or two bodies the pair is every body.)
+    ! With one or two bodies the pair is every body; with more an event does not say whether
+    ! the others move: the samples alone decide (rest_time to the sample).
+    if (self%n_bodies > 2) return
     if (any(v(3:4) /= 0.0_wp)) then
       self%rest_event = huge(1.0_wp)
       self%rest_sample = huge(1.0_wp)
@@ -623,11 +637,12 @@ contains
   !> shows a velocity up to t_end: the event that stopped the last body (a stick, a rest at
   !> an accumulation time, an impact leaving both still), or without one (a stop by the
   !> vissim method's threshold) the first sample at rest; NaN if a body moves at t_end.
+  !> (last_row: the run's last full row, final_row's.)
   real(wp) function rest_time(self, last_row)
     class(summary_sink), intent(in) :: self
-    real(wp), intent(in) :: last_row(n_columns)
+    real(wp), intent(in) :: last_row(:)
     rest_time = ieee_value(1.0_wp, ieee_quiet_nan)
-    if (last_row(3) /= 0.0_wp .or. last_row(5) /= 0.0_wp) return
+    if (any(last_row(3:size(last_row) - n_ledger:2) /= 0.0_wp)) return
     rest_time = min(self%rest_event, self%rest_sample)
   end function rest_time
 

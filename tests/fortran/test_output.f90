@@ -5,11 +5,12 @@
 !> emit_sample's row bit for bit.
 program test_output
   use, intrinsic :: iso_fortran_env, only: int64
+  use, intrinsic :: ieee_arithmetic, only: ieee_is_nan
   use impact1d_kinds, only: wp
   use impact1d_error, only: error_type
   use impact1d_scene, only: scene_input
-  use impact1d_output, only: memory_sink, file_sink, run_stats, emit_bodies, emit_sample, present_columns, &
-    row_length, class_impact, class_stick, column_word
+  use impact1d_output, only: memory_sink, file_sink, summary_sink, run_stats, emit_bodies, emit_sample, &
+    present_columns, row_length, class_impact, class_stick, column_word, final_row
   use impact1d_fields, only: a_m
   use testing, only: check, finish
   implicit none
@@ -30,6 +31,7 @@ program test_output
   deallocate(input%bodies_out)
   call file_rows()
   call two_bodies_as_emit_sample()
+  call summary_of_five_bodies()
   call finish('test_output')
 
 contains
@@ -166,5 +168,29 @@ contains
     call check(all(transfer(sink%samples(1, :), 1_int64, 12) == transfer(sink%samples(2, :), 1_int64, 12)), &
       'two bodies: the same bits in the sink')
   end subroutine two_bodies_as_emit_sample
+
+  !> A sweep's summary of five bodies: at rest only when every body is (v1 = v2 = 0 with v4
+  !> moving is not rest), from the samples (an event reports its pair only).
+  subroutine summary_of_five_bodies()
+    type(summary_sink) :: sink
+    type(run_stats) :: stats
+    type(error_type), allocatable :: error
+    real(wp) :: moving(n), still(n)
+    real(wp), allocatable :: row(:)
+    moving = 0.0_wp
+    moving(4) = 1.0_wp
+    still = 0.0_wp
+    sink = summary_sink(n_bodies=n)
+    call emit_bodies(sink, stats, 1.0_wp, x, moving, mass, 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, .false., &
+      [0.0_wp, 0.0_wp, 0.0_wp], error)
+    ! (an impact leaving its pair at rest while body 4 moves: not the rest of the run)
+    call sink%put_event(1.5_wp, class_impact, 1, 1, 2, [1.0_wp, 1.0_wp, 0.0_wp, 0.0_wp])
+    call check(ieee_is_nan(sink%rest_time(final_row(stats))), 'body 4 moves at the end: no rest time')
+    call emit_bodies(sink, stats, 2.0_wp, x, still, mass, 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, .false., &
+      [0.0_wp, 0.0_wp, 0.0_wp], error)
+    call check(sink%rest_time(final_row(stats)) == 2.0_wp, 'every body at rest from the sample at t = 2')
+    row = final_row(stats)
+    call check(size(row) == row_length(n) .and. row(1) == 2.0_wp, 'final_row is the N-body row')
+  end subroutine summary_of_five_bodies
 
 end program test_output
