@@ -9,9 +9,9 @@ program impact1d_cli
   use impact1d_error, only: error_type, status_input, status_simulation, fmt
   use impact1d_scene, only: scene_input, scene_type, set_text, i_t_end, i_dt, i_dt_out, i_max_events, i_method, &
     i_events, i_title, events_none, events_impacts, i_f1_table, i_f2_table
-  use impact1d_io, only: read_scene_file, prepare_scene, lower
-  use impact1d_output, only: file_sink, events_path, i_pe, i_work, i_friction_loss, i_impact_loss, i_damping_loss, &
-    class_impact, class_stick, class_slip, event_name, event_count
+  use impact1d_io, only: read_scene_file, prepare_scene, lower, read_body_list
+  use impact1d_output, only: file_sink, events_path, class_impact, class_stick, class_slip, event_name, event_count, &
+    check_bodies_out, row_ledger, final_row
   use impact1d_files, only: make_folders, resolve, write_text
   use impact1d_solver, only: run, run_stats
   use impact1d_version, only: version
@@ -41,7 +41,7 @@ program impact1d_cli
 
   character(len=*), parameter :: usage = &
     'usage: impact1d SCENE [--t-end T] [--dt DT] [--dt-out DT_OUT] [--method event|vissim] [-o OUT.dat]' // &
-    ' [--events all|impacts|none] [--events-file FILE] [--max-events N] [--quiet]'
+    ' [--events all|impacts|none] [--events-file FILE] [--max-events N] [--bodies-out I,J,..] [--quiet]'
   character(len=*), parameter :: nl = new_line('a')
   character(len=*), parameter :: help = usage // nl // nl // &
     'Runs SCENE (a namelist scene, or a VisSim-style .dat parameter file) and writes its samples' // nl // &
@@ -62,6 +62,8 @@ program impact1d_cli
     '  --events-file F  the event log goes to F (default OUT.events.dat)' // nl // &
     '  --max-events N   the log keeps the first N events (default 10^7); then it ends with a' // nl // &
     '                   note, the run goes on and the summary''s counts stay exact' // nl // &
+    '  --bodies-out L   the samples have x and v of the bodies listed (1,10,20: increasing),' // nl // &
+    '                   not of every body; ke and the ledger stay over every body' // nl // &
     '  --quiet          no progress line (a run of over a second on a terminal shows one on' // nl // &
     '                   stderr: the simulated time, events so far and the time left; never' // nl // &
     '                   in a pipe or a file)' // nl // &
@@ -79,8 +81,9 @@ program impact1d_cli
   type(error_type), allocatable :: error, close_error
   character(len=:), allocatable :: scene_path, out_path, option, value, events_file
   integer :: i, n_args, k, c, equals
+  integer, allocatable :: bodies_out(:)
   real(wp) :: overrides(4)
-  logical :: overridden(4), has_value, out_given, quiet, stream
+  logical :: overridden(4), has_value, out_given, quiet, stream, ok
   character(len=64) :: method, events
   !> The fields --t-end, --dt, --dt-out, --max-events override, in that order.
   integer, parameter :: overridable(4) = [i_t_end, i_dt, i_dt_out, i_max_events]
@@ -118,7 +121,8 @@ program impact1d_cli
     case ('--quiet')
       if (has_value) call fail(status_input, '--quiet takes no value; ' // usage)
       quiet = .true.
-    case ('--t-end', '--dt', '--dt-out', '--max-events', '--method', '--events', '--events-file', '-o')
+    case ('--t-end', '--dt', '--dt-out', '--max-events', '--method', '--events', '--events-file', '-o', &
+        '--bodies-out')
       if (.not. has_value) then
         if (i > n_args) call fail(status_input, option // ' needs a value')
         value = argument_text(i)
@@ -149,6 +153,10 @@ program impact1d_cli
         call override(3)
       case ('--max-events')
         call override(4)
+      case ('--bodies-out')
+        call read_body_list(value, bodies_out, ok)
+        if (.not. ok) call fail(status_input, '--bodies-out needs body numbers separated by commas (1,10,20), ' // &
+          'got ''' // value // '''')
       end select
     case default
       if (has_value) call fail(status_input, 'unknown option ' // option // '; ' // usage)
@@ -168,7 +176,9 @@ program impact1d_cli
   input%given(overridable) = input%given(overridable) .or. overridden
   if (len_trim(method) > 0) call set_text(input, i_method, trim(method))
   if (len_trim(events) > 0) call set_text(input, i_events, trim(events))
+  if (allocated(bodies_out)) input%bodies_out = bodies_out
   call prepare_scene(input, scene, error)
+  if (.not. allocated(error)) call check_bodies_out(input, error)
   if (allocated(error)) call fail(error%status, scene_path // ': ' // error%message)
 
   if (.not. out_given) out_path = 'output/' // stem(scene_path) // '.dat'
@@ -215,6 +225,29 @@ program impact1d_cli
 
 contains
 
+  !> The summary's line of the final state: t, then x and v of the bodies written (&run
+  !> bodies_out, or every body; the first ten of them).
+  subroutine final_state(text)
+    character(len=:), allocatable, intent(inout) :: text
+    real(wp), allocatable :: final(:)
+    integer, allocatable :: bodies(:)
+    integer :: j
+    character(len=16) :: name
+    final = final_row(stats)
+    if (allocated(input%bodies_out)) then
+      bodies = input%bodies_out
+    else
+      bodies = [(j, j = 1, scene%n_bodies)]
+    end if
+    text = text // '  final     t =' // es(final(1))
+    do j = 1, min(size(bodies), 10)
+      write(name, '(i0)') bodies(j)
+      text = text // '  x' // trim(name) // ' =' // es(final(2 * bodies(j))) // '  v' // trim(name) // ' =' // &
+        es(final(2 * bodies(j) + 1))
+    end do
+    if (size(bodies) > 10) text = text // '  ...'
+  end subroutine final_state
+
   !> What the summary says of the event log: its file and what it holds (&run events).
   function event_log_text() result(text)
     character(len=:), allocatable :: text
@@ -242,6 +275,11 @@ contains
   subroutine summary()
     character(len=:), allocatable :: text, line, where
     character(len=16) :: number
+    real(wp), allocatable :: final(:)
+    integer :: l
+    ! The last full row (one, two or N bodies), the ledger after the bodies' x and v.
+    final = final_row(stats)
+    l = row_ledger(scene%n_bodies)
     text = 'impact1d: ' // trim(input%text(i_title)%s) // nl
     text = text // '  scene     ' // scene_path // ' (method ' // scene%method // ', dt = ' // &
       trim(fmt(scene%dt)) // ' s, t_end = ' // trim(fmt(scene%t_end)) // ' s)' // nl
@@ -262,14 +300,12 @@ contains
     end do
     if (len(line) == 0) line = ' none'
     text = text // '  events   ' // line // nl
-    text = text // '  final     t =' // es(stats%last_row(1)) // '  x1 =' // es(stats%last_row(2)) // &
-      '  v1 =' // es(stats%last_row(3))
-    if (scene%n_bodies == 2) text = text // '  x2 =' // es(stats%last_row(4)) // '  v2 =' // es(stats%last_row(5))
-    text = text // nl // '  energy    KE =' // es(stats%last_row(6))
-    if (scene%springs%has_spring) text = text // '  PE =' // es(stats%last_row(i_pe))
-    text = text // ' J' // nl // '  ledger    work =' // es(stats%last_row(i_work)) // '  friction loss =' // &
-      es(stats%last_row(i_friction_loss)) // '  impact loss =' // es(stats%last_row(i_impact_loss))
-    if (scene%springs%has_damper) text = text // '  damping loss =' // es(stats%last_row(i_damping_loss))
+    call final_state(text)
+    text = text // nl // '  energy    KE =' // es(final(l + 1))
+    if (scene%springs%has_spring) text = text // '  PE =' // es(final(l + 2))
+    text = text // ' J' // nl // '  ledger    work =' // es(final(l + 3)) // '  friction loss =' // &
+      es(final(l + 4)) // '  impact loss =' // es(final(l + 5))
+    if (scene%springs%has_damper) text = text // '  damping loss =' // es(final(l + 6))
     write(number, '(es10.2e3)') stats%max_residual
     text = text // '  |residual| <=' // trim(number) // ' J' // nl
     text = text // '  steps     ' // trim(fmt(stats%steps)) // ' RK4 steps' // nl

@@ -16,18 +16,19 @@ module impact1d_io
   use impact1d_files, only: check_input_file
   implicit none
   private
-  public :: read_scene_file, prepare_scene, read_table, lower
+  public :: read_scene_file, prepare_scene, read_table, lower, read_body_list
 
   character(len=*), parameter :: known_groups(11) = [character(len=7) :: &
     'scene', 'bodies', 'walls', 'link', 'initial', 'forces', 'springs', 'run', 'contact', 'spring', 'sine']
   !> The groups that may be given any number of times, each occurrence a record.
-  integer, parameter :: g_contact = 9, g_spring = 10, g_sine = 11
+  integer, parameter :: g_contact = 9, g_spring = 10, g_sine = 11, g_run = 8
   !> Each group's variables: which group a name belongs to, and the message about a misspelt one.
-  character(len=*), parameter :: group_variables(size(known_groups)) = [character(len=112) :: &
+  character(len=*), parameter :: group_variables(size(known_groups)) = [character(len=124) :: &
     'title', 'm1, m2, mu1, mu2, mus1, mus2, g', 'x_left, r_left, x_right, r_right', 'd_min, r_min, d_max, r_max', &
     'x1, v1, x2, v2', 'f1, f2, f1_table, f2_table, f1_amp, f1_period, f1_phase, f2_amp, f2_period, f2_phase', &
     'k1, x1_rest, c1, k2, x2_rest, c2, k12, d_rest, c12', &
-    't_end, dt, dt_out, method, zero_vel, max_rows, max_impulses, max_step_events, substeps, events, max_events', &
+    't_end, dt, dt_out, method, zero_vel, max_rows, max_impulses, max_step_events, substeps, events, max_events, ' // &
+    'bodies_out', &
     'a, b, d_min, r_min, d_max, r_max, name', 'a, b, k, d_rest, c', 'body, amp, period, phase']
 
   !> The tutorial's parameter files list these, in its Table 1 order; g is 10 there.
@@ -292,12 +293,15 @@ contains
     type(error_type), allocatable, intent(inout) :: error
     character(len=:), allocatable :: name, value, context
     integer :: finish, field, k, line
+    logical :: bodies_out
     line = line_at(nml, j)
     context = nml%path // ':' // trim(fmt(line)) // ': in &' // trim(known_groups(nml%open_group)) // ': '
     finish = name_end(nml%flat, j)
     name = lower(nml%flat(j:finish))
     field = field_index(name, nml%open_group)
-    if (field == 0) then
+    ! (&run bodies_out: a list of bodies, not a field of the scene's assignments)
+    bodies_out = name == 'bodies_out' .and. nml%open_group == g_run
+    if (field == 0 .and. .not. bodies_out) then
       k = scan(nml%flat(j:) // ' ', ' ,;=/')
       call raise(error, status_input, context // 'unknown variable ''' // nml%flat(j:j + k - 2) // ''' (&' // &
         trim(known_groups(nml%open_group)) // ' has: ' // trim(group_variables(nml%open_group)) // ')' // &
@@ -314,20 +318,57 @@ contains
       end if
       return
     end if
-    if (nml%given_line(field) > 0) then
-      call raise(error, status_input, context // name // ' is given twice (lines ' // &
-        trim(fmt(nml%given_line(field))) // ' and ' // trim(fmt(line)) // ')')
-      return
+    if (.not. bodies_out) then
+      if (nml%given_line(field) > 0) then
+        call raise(error, status_input, context // name // ' is given twice (lines ' // &
+          trim(fmt(nml%given_line(field))) // ' and ' // trim(fmt(line)) // ')')
+        return
+      end if
     end if
     j = value_end(nml%flat, k + 1, nml%open_group)
     value = trim(adjustl(nml%flat(k + 1:j - 1)))
     if (len(value) > 0) then
       if (scan(value(len(value):), ',;') > 0) value = trim(value(:len(value) - 1))
     end if
+    if (bodies_out) then
+      call take_bodies_out(value, context, input, error)
+      return
+    end if
     call take_value(nml%path, field, name, value, input, error)
     if (allocated(error)) error%message = context // error%message
     nml%given_line(field) = line
   end subroutine assignment
+
+  !> &run bodies_out = 1, 10, 20: the bodies whose x and v the output has (impact1d_output's
+  !> check_bodies_out checks them against the scene).
+  subroutine take_bodies_out(value, context, input, error)
+    character(len=*), intent(in) :: value, context
+    type(scene_input), intent(inout) :: input
+    type(error_type), allocatable, intent(inout) :: error
+    logical :: ok
+    if (allocated(input%bodies_out)) then
+      call raise(error, status_input, context // 'bodies_out is given twice')
+      return
+    end if
+    call read_body_list(value, input%bodies_out, ok)
+    if (.not. ok) call raise(error, status_input, context // 'bodies_out = ' // value // &
+      ' is not a list of body numbers (write bodies_out = 1, 10, 20)')
+  end subroutine take_bodies_out
+
+  !> A list of body numbers, whole numbers separated by commas ('1, 10, 20'; &run bodies_out,
+  !> --bodies-out); ok false for anything else (bodies then not allocated).
+  subroutine read_body_list(text, bodies, ok)
+    character(len=*), intent(in) :: text
+    integer, allocatable, intent(out) :: bodies(:)
+    logical, intent(out) :: ok
+    integer :: ios, i
+    ok = len_trim(text) > 0 .and. verify(text, '0123456789, ') == 0 .and. index(text, ',,') == 0
+    if (.not. ok) return
+    allocate(bodies(count([(text(i:i) == ',', i = 1, len(text))]) + 1))
+    read(text, *, iostat=ios) bodies
+    ok = ios == 0
+    if (.not. ok) deallocate(bodies)
+  end subroutine read_body_list
 
   !> Where the value that starts at k ends: at the next '/', group mark or item outside
   !> quotes. An item starts at a name after a comma, a name followed by '=', or a variable

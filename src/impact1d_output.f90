@@ -9,8 +9,9 @@ module impact1d_output
   use impact1d_interrupt, only: interrupt_count
   use impact1d_scene, only: scene_input, real_names, n_real, i_title, i_method, i_g, i_dt_out, &
     events_all, events_impacts, events_none, events_kept, name_len, &
-    i_dt, default_gravity, i_m2, springs_named
-  use impact1d_fields, only: n_contact_fields, contact_fields, spring_fields, sine_fields, r_name, record_input
+    i_dt, default_gravity, i_m2, springs_named, is_nbody
+  use impact1d_fields, only: n_contact_fields, contact_fields, spring_fields, sine_fields, r_name, record_input, &
+    n_arrays, array_names, array_is_text
   use impact1d_files, only: output_target, make_temporary, resolve_output, lock_folders, unlock_folders, write_text, &
     lock_timed_out, lock_wait
   implicit none
@@ -20,7 +21,7 @@ module impact1d_output
   public :: class_impact, class_rest, class_release, class_stick, class_slip, event_name, start_counts, &
     count_event, event_count, impacts_on
   public :: emit_sample, emit_bodies, events_path, present_columns, i_pe, i_work, i_friction_loss, i_impact_loss, &
-    i_damping_loss
+    i_damping_loss, row_length, row_columns, column_word, bodies_of, row_ledger, check_bodies_out, final_row
 
   !> Every column a run can have; a scene's output carries those it has (present_columns):
   !> pe only with springs, damping_loss only with dampers.
@@ -28,8 +29,12 @@ module impact1d_output
     i_damping_loss = 11
   character(len=*), parameter :: column_names = &
     't x1 v1 x2 v2 ke pe work friction_loss impact_loss damping_loss residual'
-  character(len=*), parameter :: column_words(n_columns) = [character(len=13) :: 't', 'x1', 'v1', &
-    'x2', 'v2', 'ke', 'pe', 'work', 'friction_loss', 'impact_loss', 'damping_loss', 'residual']
+  !> A run's full row (emit_bodies' for N bodies, emit_sample's 12 for one or two) is
+  !> t, x1 v1 .. xM vM (M = max(N, 2)), then these, the ledger, in this order: its length is
+  !> row_length(N), the ledger's k-th at row_ledger(N) + k. N <= 2 gives the 12 above.
+  integer, parameter :: n_ledger = 7
+  character(len=*), parameter :: ledger_words(n_ledger) = [character(len=13) :: 'ke', 'pe', 'work', &
+    'friction_loss', 'impact_loss', 'damping_loss', 'residual']
 
   !> Events are (class, index): an impact, rest or release of row index, a stick or slip of
   !> body index; each carries the velocities of a pair of bodies (a, b; 0: none), before and
@@ -60,6 +65,8 @@ module impact1d_output
     integer :: n_events = 0
     integer, allocatable :: row_events(:, :), body_events(:, :)
     real(wp) :: last_row(n_columns) = 0.0_wp
+    !> An N-body run's last full row (emit_bodies; row_length(N) long), in place of last_row.
+    real(wp), allocatable :: row(:)
     real(wp) :: max_residual = 0.0_wp
     !> The interrupt count when the run started (impact1d_interrupt): a run ends when it moves on.
     integer :: interrupt_epoch = 0
@@ -91,11 +98,14 @@ module impact1d_output
   end type sink_type
 
   abstract interface
-    !> One output row: t x1 v1 x2 v2 ke work friction_loss impact_loss residual.
+    !> One full row (row_length(N): emit_sample's 12 for one or two bodies, emit_bodies' for
+    !> N); the sink keeps or writes the columns it was given (row_columns). Assumed size,
+    !> not shape: a descriptor per sample cost emit_sample's hot path 10% (case 3, a sample
+    !> every step).
     subroutine put_sample_interface(self, row)
-      import :: sink_type, wp, n_columns
+      import :: sink_type, wp
       class(sink_type), intent(inout) :: self
-      real(wp), intent(in) :: row(n_columns)
+      real(wp), intent(in) :: row(*)
     end subroutine put_sample_interface
     !> One event: time, class and index, the pair of bodies it reports (a, b; 0: none) and
     !> their velocities [v_a-, v_b-, v_a+, v_b+] (0 for a missing body).
@@ -129,6 +139,8 @@ module impact1d_output
   !> row comes in run_stats; here, since the bodies were last seen moving, the first event
   !> that left both at rest and the first sample at rest (see rest_time).
   type, extends(sink_type) :: summary_sink
+    !> The run's bodies (more than two: the velocities past v2 are read too).
+    integer :: n_bodies = 2
     real(wp) :: rest_event = huge(1.0_wp)    !< first event since then leaving both at rest
     real(wp) :: rest_sample = huge(1.0_wp)   !< first sample since then with both at rest
   contains
@@ -164,8 +176,11 @@ module impact1d_output
     !> close alike), so a file is only trusted once its size on disk is what was written.
     integer(int64) :: bytes(2) = 0
     integer :: sample_bytes = 0, event_bytes = 0
-    !> Velocities of the bodies the scene has, in an event line.
+    !> The scene's bodies: one or two give an event line of their velocities (v1 or v1 v2
+    !> before and after), more the pair's: a b va_before vb_before va_after vb_after.
     integer :: n_bodies = 2
+    !> A stream's sample line, made once (its length is the run's columns').
+    character(len=:), allocatable :: line
   contains
     procedure :: put_sample => file_put_sample
     procedure :: put_event => file_put_event
@@ -236,8 +251,7 @@ contains
         row(n_columns) = ke - ke0 - work + friction_loss + impact_loss
       end if
       if (.not. all(abs(row) <= huge(1.0_wp))) then
-        call raise(error, status_simulation, 'at t = ' // trim(fmt(t)) // ': the kinetic energy or the ' // &
-          'energy ledger is no longer finite (KE = ' // trim(fmt(ke)) // ', KE0 = ' // trim(fmt(ke0)) // ' J)')
+        call not_finite(t, ke, ke0, error)
         return
       end if
       stats%max_residual = max(stats%max_residual, abs(row(n_columns)))
@@ -245,43 +259,178 @@ contains
     end associate
   end subroutine emit_sample
 
-  !> TEMPORARY (integrator's branch, replaced by the outputs branch's N-column row): an
-  !> N-body sample as the first two bodies' columns.
+  !> Send one sample of an N-body run (x, v, mass: every body's, N long) to a sink, as
+  !> emit_sample does for one or two: the full row (row_length(N): t, x1 v1 .. xN vN, ke, pe,
+  !> work, friction_loss, impact_loss, damping_loss, residual) in stats%row, the residual by
+  !> emit_sample's formula, max_residual; the sink writes the columns it was given
+  !> (row_columns: the bodies of &run bodies_out, pe and damping_loss with springs), while ke
+  !> and the ledger are over every body. The row is allocated once, at the run's first sample.
   subroutine emit_bodies(sink, stats, t, x, v, mass, ke0, work, friction_loss, impact_loss, &
       with_springs, springs, error)
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
-    real(wp), contiguous, intent(in) :: x(:), v(:), mass(:)
     real(wp), intent(in) :: t, ke0, work, friction_loss, impact_loss
+    real(wp), contiguous, intent(in) :: x(:), v(:), mass(:)
     logical, intent(in) :: with_springs
     real(wp), intent(in) :: springs(3)
     type(error_type), allocatable, intent(out) :: error
-    call emit_sample(sink, stats, t, x(1:2), v(1:2), mass(1:2), ke0, work, friction_loss, impact_loss, &
-      with_springs, springs, error)
+    real(wp) :: ke
+    integer :: n, i, l
+    n = size(x)
+    l = row_ledger(n)
+    if (.not. allocated(stats%row)) allocate(stats%row(row_length(n)))
+    if (size(stats%row) /= row_length(n)) then
+      deallocate(stats%row)
+      allocate(stats%row(row_length(n)))
+    end if
+    ! (dot_product: for N <= 2 the sum emit_sample makes, bit for bit)
+    ke = 0.5_wp * dot_product(mass, v**2)
+    associate (row => stats%row)
+      row(1) = t
+      do i = 1, n
+        row(2 * i) = x(i)
+        row(2 * i + 1) = v(i)
+      end do
+      row(2 * n + 2:l) = 0.0_wp          ! (one body: x2, v2 of the two-body layout)
+      row(l + 1) = ke
+      row(l + 3) = work
+      row(l + 4) = friction_loss
+      row(l + 5) = impact_loss
+      if (with_springs) then
+        row(l + 2) = springs(1)
+        row(l + 6) = springs(3)
+        row(l + 7) = ((ke + springs(1)) - (ke0 + springs(2))) - work + friction_loss + impact_loss + springs(3)
+      else
+        row(l + 2) = 0.0_wp
+        row(l + 6) = 0.0_wp
+        row(l + 7) = ke - ke0 - work + friction_loss + impact_loss
+      end if
+      if (.not. all(abs(row) <= huge(1.0_wp))) then
+        call not_finite(t, ke, ke0, error)
+        return
+      end if
+      stats%max_residual = max(stats%max_residual, abs(row(l + 7)))
+      call sink%put_sample(row)
+    end associate
   end subroutine emit_bodies
 
-  !> The columns a scene's output has, as indices into the full row: all but pe when it names
-  !> no spring and damping_loss when it names no damper (a component a scene does not name
-  !> is absent from its output too).
+  !> The run's last full row: emit_sample's (one or two bodies: t x1 v1 x2 v2, the ledger)
+  !> or emit_bodies' (N); the ledger's k-th at row_ledger(N) + k either way.
+  pure function final_row(stats) result(row)
+    type(run_stats), intent(in) :: stats
+    real(wp), allocatable :: row(:)
+    if (allocated(stats%row)) then
+      row = stats%row
+    else
+      row = stats%last_row
+    end if
+  end function final_row
+
+  !> A sample that is not finite: the run cannot go on.
+  subroutine not_finite(t, ke, ke0, error)
+    real(wp), intent(in) :: t, ke, ke0
+    type(error_type), allocatable, intent(out) :: error
+    call raise(error, status_simulation, 'at t = ' // trim(fmt(t)) // ': the kinetic energy or the ' // &
+      'energy ledger is no longer finite (KE = ' // trim(fmt(ke)) // ', KE0 = ' // trim(fmt(ke0)) // ' J)')
+  end subroutine not_finite
+
+  !> Length of the full row of a run of n_bodies bodies: t, x and v of max(N, 2) bodies, the
+  !> ledger (12 for one or two bodies: emit_sample's row).
+  pure integer function row_length(n_bodies)
+    integer, intent(in) :: n_bodies
+    row_length = row_ledger(n_bodies) + n_ledger
+  end function row_length
+
+  !> Where the ledger starts in the full row: ke is at row_ledger + 1, residual at + 7.
+  pure integer function row_ledger(n_bodies)
+    integer, intent(in) :: n_bodies
+    row_ledger = 2 * max(n_bodies, 2) + 1
+  end function row_ledger
+
+  !> The columns a run writes, as indices into its full row: t; x and v of the bodies named
+  !> (bodies: &run bodies_out; none named: every body); ke; pe when named(1) (a spring);
+  !> work, friction_loss, impact_loss; damping_loss when named(2) (a damper); residual.
+  pure function row_columns(n_bodies, bodies, named) result(columns)
+    integer, intent(in) :: n_bodies, bodies(:)
+    logical, intent(in) :: named(2)
+    integer, allocatable :: columns(:)
+    integer :: l, i
+    l = row_ledger(n_bodies)
+    if (size(bodies) > 0) then
+      columns = [1, (2 * bodies(i), 2 * bodies(i) + 1, i = 1, size(bodies))]
+    else
+      columns = [1, (i, i = 2, 2 * n_bodies + 1)]
+    end if
+    columns = [columns, l + 1]
+    if (named(1)) columns = [columns, l + 2]
+    columns = [columns, l + 3, l + 4, l + 5]
+    if (named(2)) columns = [columns, l + 6]
+    columns = [columns, l + 7]
+  end function row_columns
+
+  !> The name of column k of a run of n_bodies bodies ('t', 'x3', 'v3', 'ke', ...).
+  pure function column_word(k, n_bodies) result(word)
+    integer, intent(in) :: k, n_bodies
+    character(len=16) :: word     ! blank padded: callers trim
+    integer :: l
+    l = row_ledger(n_bodies)
+    if (k == 1) then
+      word = 't'
+    else if (k <= l) then
+      write(word, '(a, i0)') merge('x', 'v', mod(k, 2) == 0), k / 2
+    else
+      word = ledger_words(k - l)
+    end if
+  end function column_word
+
+  !> The number of bodies of a scene as written: its arrays' (more than two), else 2 with
+  !> an m2, 1 without.
+  pure integer function bodies_of(input)
+    type(scene_input), intent(in) :: input
+    bodies_of = merge(2, 1, input%given(i_m2))
+    if (is_nbody(input)) bodies_of = input%chain%n_bodies
+  end function bodies_of
+
+  !> The columns a scene's output has, as indices into its full row (row_columns): the
+  !> bodies of &run bodies_out (every body when it names none), pe and damping_loss only
+  !> when the scene names springs or dampers (a component a scene does not name is absent
+  !> from its output too). One or two bodies: indices into emit_sample's 12.
   function present_columns(input) result(columns)
     type(scene_input), intent(in) :: input
     integer, allocatable :: columns(:)
-    logical :: keep(n_columns)
-    integer :: k
-    keep = .true.
-    keep([4, 5]) = input%given(i_m2)           ! x2, v2: only with a second body
-    keep([i_pe, i_damping_loss]) = springs_named(input)
-    columns = pack([(k, k = 1, n_columns)], keep)
+    integer :: none(0)
+    if (allocated(input%bodies_out)) then
+      columns = row_columns(bodies_of(input), input%bodies_out, springs_named(input))
+    else
+      columns = row_columns(bodies_of(input), none, springs_named(input))
+    end if
   end function present_columns
 
-  !> The names of the given columns, each after a space.
-  subroutine names_of(columns, text)
-    integer, intent(in) :: columns(:)
+  !> &run bodies_out (--bodies-out), when given, names bodies of the scene in increasing order.
+  subroutine check_bodies_out(input, error)
+    type(scene_input), intent(in) :: input
+    type(error_type), allocatable, intent(out) :: error
+    integer :: n
+    if (.not. allocated(input%bodies_out)) return
+    n = size(input%bodies_out)
+    if (n == 0) then
+      call raise(error, status_input, 'bodies_out names no body')
+    else if (any(input%bodies_out < 1 .or. input%bodies_out > bodies_of(input))) then
+      call raise(error, status_input, 'bodies_out names a body the scene does not have (it has ' // &
+        trim(fmt(bodies_of(input))) // ')')
+    else if (any(input%bodies_out(2:) <= input%bodies_out(:n - 1))) then
+      call raise(error, status_input, 'bodies_out must name bodies in increasing order, each once')
+    end if
+  end subroutine check_bodies_out
+
+  !> The names of the given columns of a run of n_bodies bodies, each after a space.
+  subroutine names_of(columns, n_bodies, text)
+    integer, intent(in) :: columns(:), n_bodies
     character(len=:), allocatable, intent(out) :: text
     integer :: k
     text = ''
     do k = 1, size(columns)
-      text = text // ' ' // trim(column_words(columns(k)))
+      text = text // ' ' // trim(column_word(columns(k), n_bodies))
     end do
   end subroutine names_of
 
@@ -453,8 +602,15 @@ contains
 
   subroutine summary_put_sample(self, row)
     class(summary_sink), intent(inout) :: self
-    real(wp), intent(in) :: row(n_columns)
-    if (row(3) /= 0.0_wp .or. row(5) /= 0.0_wp) then
+    real(wp), intent(in) :: row(*)
+    integer :: i
+    logical :: moving
+    ! (v1, v2 of a two-body row; v1 .. vN of an N-body one: t, x1 v1 .. xN vN, the ledger)
+    moving = row(3) /= 0.0_wp .or. row(5) /= 0.0_wp
+    do i = 3, self%n_bodies
+      moving = moving .or. row(2 * i + 1) /= 0.0_wp
+    end do
+    if (moving) then
       self%rest_event = huge(1.0_wp)
       self%rest_sample = huge(1.0_wp)
     else if (self%rest_sample == huge(1.0_wp)) then
@@ -466,7 +622,9 @@ contains
     class(summary_sink), intent(inout) :: self
     real(wp), intent(in) :: t, v(4)
     integer, intent(in) :: class, index, a, b
-    ! (With one or two bodies the pair is every body.)
+    ! With one or two bodies the pair is every body; with more an event does not say whether
+    ! the others move: the samples alone decide (rest_time to the sample).
+    if (self%n_bodies > 2) return
     if (any(v(3:4) /= 0.0_wp)) then
       self%rest_event = huge(1.0_wp)
       self%rest_sample = huge(1.0_wp)
@@ -479,17 +637,18 @@ contains
   !> shows a velocity up to t_end: the event that stopped the last body (a stick, a rest at
   !> an accumulation time, an impact leaving both still), or without one (a stop by the
   !> vissim method's threshold) the first sample at rest; NaN if a body moves at t_end.
+  !> (last_row: the run's last full row, final_row's.)
   real(wp) function rest_time(self, last_row)
     class(summary_sink), intent(in) :: self
-    real(wp), intent(in) :: last_row(n_columns)
+    real(wp), intent(in) :: last_row(:)
     rest_time = ieee_value(1.0_wp, ieee_quiet_nan)
-    if (last_row(3) /= 0.0_wp .or. last_row(5) /= 0.0_wp) return
+    if (any(last_row(3:size(last_row) - n_ledger:2) /= 0.0_wp)) return
     rest_time = min(self%rest_event, self%rest_sample)
   end function rest_time
 
   subroutine memory_put_sample(self, row)
     class(memory_sink), intent(inout) :: self
-    real(wp), intent(in) :: row(n_columns)
+    real(wp), intent(in) :: row(*)
     self%n_samples = self%n_samples + 1
     if (associated(self%into)) then
       self%into(self%n_samples, :size(self%columns)) = row(self%columns)
@@ -596,8 +755,9 @@ contains
     self%bytes = 0
     self%columns = present_columns(input)
     self%sample_bytes = line_bytes(row_format, 0.0_wp, size(self%columns))
-    self%n_bodies = merge(2, 1, input%given(i_m2))
-    self%event_bytes = line_bytes(event_format, 0.0_wp, 2 * self%n_bodies, event_names(1))
+    allocate(character(len=25 * size(self%columns)) :: self%line)
+    self%n_bodies = bodies_of(input)
+    self%event_bytes = line_bytes(event_format, 0.0_wp, 2 * min(self%n_bodies, 2), event_names(1))
     call self%put_line(self%unit, '# impact1d output')
     call self%put_line(self%unit, '# title = ' // trim(input%text(i_title)%s))
     if (allocated(input%source)) call self%put_line(self%unit, '# scene = ' // input%source)
@@ -615,12 +775,16 @@ contains
         call self%put_line(self%unit, '# dt_out = ' // trim(fmt(input%value(i_dt))))
       end if
     end do
+    if (self%n_bodies > 2) call put_arrays(self, input)
     call put_records(self, input)
-    call names_of(self%columns, header)
+    if (self%n_bodies > 2) call self%put_line(self%unit, '# bodies = ' // trim(fmt(self%n_bodies)))
+    call names_of(self%columns, self%n_bodies, header)
     call self%put_line(self%unit, '#' // header)
     if (self%events == events_none) return
     call self%put_line(self%event_unit, '# impact1d events')
-    if (self%n_bodies == 2) then
+    if (self%n_bodies > 2) then
+      call self%put_line(self%event_unit, '# t kind a b va_before vb_before va_after vb_after')
+    else if (self%n_bodies == 2) then
       call self%put_line(self%event_unit, '# t kind v1_before v2_before v1_after v2_after')
     else
       call self%put_line(self%event_unit, '# t kind v1_before v1_after')
@@ -629,14 +793,13 @@ contains
 
   subroutine file_put_sample(self, row)
     class(file_sink), intent(inout) :: self
-    real(wp), intent(in) :: row(n_columns)
+    real(wp), intent(in) :: row(*)
     integer :: ios
     character(len=512) :: message
-    character(len=25 * n_columns) :: line
     if (allocated(self%write_failure)) return
     if (self%stream) then
-      write(line, row_format) row(self%columns)
-      call self%stream_put(trim(line))
+      write(self%line, row_format) row(self%columns)
+      call self%stream_put(trim(self%line))
       return
     end if
     write(self%unit, row_format, iostat=ios, iomsg=message) row(self%columns)
@@ -652,8 +815,12 @@ contains
     character(len=512) :: message
     if (allocated(self%write_failure)) return
     if (.not. self%logs_event(class)) return
-    ! One or two bodies: the pair is (1, 2), or (1, 0) with one body, whose line has v1 only.
-    if (self%n_bodies == 2) then
+    ! One or two bodies: the pair is (1, 2), or (1, 0) with one body, whose line has v1 only;
+    ! more: the pair's ends, named (a line of its own length, counted as written).
+    if (self%n_bodies > 2) then
+      call put_pair_event(self, t, event_name(self%row_names, class, index), a, b, v)
+      return
+    else if (self%n_bodies == 2) then
       write(self%event_unit, event_format, iostat=ios, iomsg=message) t, &
         event_name(self%row_names, class, index), v
     else
@@ -663,6 +830,38 @@ contains
     if (ios /= 0) self%write_failure = self%event_path // ': ' // trim(reason(message))
     self%bytes(2) = self%bytes(2) + self%event_bytes
   end subroutine file_put_event
+
+  !> An N-body event line: t kind a b va_before vb_before va_after vb_after (the kind as
+  !> long as it is: the line's length is counted as written).
+  subroutine put_pair_event(self, t, kind, a, b, v)
+    class(file_sink), intent(inout) :: self
+    real(wp), intent(in) :: t, v(4)
+    character(len=*), intent(in) :: kind
+    integer, intent(in) :: a, b
+    character(len=25 * 5 + 2 * 12 + event_name_len + 1) :: line
+    write(line, '(es25.16e3, 1x, a, 2(1x, i0), 4es25.16e3)') t, trim(kind), a, b, v
+    call self%put_line(self%event_unit, trim(line))
+  end subroutine put_pair_event
+
+  !> The number arrays of a scene of more than two bodies in the header, a line each with
+  !> its values ('# m = 1.0 2.0 5.0'), so that a reader rebuilds the scene (read_output);
+  !> like the tutorial's table names, the force tables' names are not written.
+  subroutine put_arrays(self, input)
+    class(file_sink), intent(inout) :: self
+    type(scene_input), intent(in) :: input
+    character(len=:), allocatable :: line
+    integer :: a, i
+    do a = 1, n_arrays
+      associate (array => input%chain%array(a))
+        if (array%n == 0 .or. array_is_text(a)) cycle
+        line = '# ' // trim(array_names(a)) // ' ='
+        do i = 1, array%n
+          line = line // ' ' // trim(fmt(array%v(i)))
+        end do
+        call self%put_line(self%unit, line)
+      end associate
+    end do
+  end subroutine put_arrays
 
   !> The scene's &contact, &spring and &sine records in the header, a line per given field in
   !> the form of the others ('# contact.2.d_min = 0.5', '# spring.1.k = 40.0', '# sine.1.amp

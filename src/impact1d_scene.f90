@@ -114,6 +114,9 @@ module impact1d_scene
     character(len=16) :: spelled(n_real) = ''
     !> Arrays of more than two bodies and &contact / &spring records (impact1d_fields).
     type(chain_input) :: chain
+    !> The bodies whose x and v the output has (&run bodies_out, --bodies-out; impact1d_output's
+    !> present_columns): not allocated, every body.
+    integer, allocatable :: bodies_out(:)
   end type scene_input
 
   !> The checked model: the constant part of a run (what changes is impact1d_state's), as

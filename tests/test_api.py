@@ -281,13 +281,13 @@ def test_progress_only_when_asked(capfd):
 def _flat_run(core, rows, events, row_room, records=None):
     """One call of the flat API's simulate (core: to_core's fields, records: record_assignments';
     none by default) with arrays of the given room: its info array [status, n_samples,
-    n_events, n_rows, steps, message length, warnings length] and the arrays it filled."""
+    n_events, n_rows, steps, message length, warnings length, N] and the arrays it filled."""
     from impact1d._scene import _api, _NO_RECORDS
     from impact1d._simulate import COLUMNS
     texts = core[2:]
     out = dict(samples=np.zeros((rows, len(COLUMNS)), order="F"), has_column=np.zeros(len(COLUMNS), np.int32),
                event_real=np.zeros((events, 5), order="F"), event_int=np.zeros((events, 4), np.int32, order="F"),
-               row_name_codes=np.zeros((32, row_room), np.int32, order="F"), info=np.zeros(7, np.int32),
+               row_name_codes=np.zeros((32, row_room), np.int32, order="F"), info=np.zeros(8, np.int32),
                energy_residual=np.zeros(1), text_codes=np.zeros((16384, 2), np.int32, order="F"))
     _api.simulate(core[0], core[1], b"".join(texts) or b" ", np.cumsum([len(t) for t in texts], dtype=np.int32),
                   *(_NO_RECORDS if records is None else records), 0, *out.values())

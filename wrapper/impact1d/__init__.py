@@ -15,7 +15,7 @@ A thin Python layer over the Fortran engine (the f2py extension impact1d._core):
 from importlib import import_module as _import_module
 
 from ._scene import Scene, InputError, SimulationError, load_scene
-from ._simulate import Result, simulate, COLUMNS, EVENT_DTYPE, ONE_BODY_EVENT_DTYPE, event_kinds
+from ._simulate import Result, simulate, COLUMNS, EVENT_DTYPE, ONE_BODY_EVENT_DTYPE, NBODY_EVENT_DTYPE, event_kinds
 from .sweep import sweep, SUMMARY_COLUMNS
 from ._output import read_output
 
@@ -31,7 +31,7 @@ except ImportError:  # pragma: no cover
 __all__ = [
     "Scene", "Result", "InputError", "SimulationError",
     "load_scene", "simulate", "sweep", "SUMMARY_COLUMNS", "read_output", "event_kinds",
-    "COLUMNS", "EVENT_DTYPE", "ONE_BODY_EVENT_DTYPE", "plot", "__version__",
+    "COLUMNS", "EVENT_DTYPE", "ONE_BODY_EVENT_DTYPE", "NBODY_EVENT_DTYPE", "plot", "__version__",
 ]
 
 # Submodules loaded on first attribute access, so that `import impact1d` stays free of

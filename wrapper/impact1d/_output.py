@@ -7,11 +7,10 @@ import os
 
 import numpy as np
 
-from ._scene import (REAL_FIELDS, TEXT_FIELDS, Scene, InputError, load_scene, is_nbody_form, from_core, to_core,
+from ._scene import (REAL_FIELDS, TEXT_FIELDS, ARRAY_FIELDS, Scene, InputError, load_scene, is_nbody_form, from_core, to_core,
                      _put)
 from ._files import check_input
-from ._simulate import (COLUMNS, OPTIONAL_COLUMNS, EVENT_DTYPE, ONE_BODY_EVENT_DTYPE, Result,
-                        result_from_columns)
+from ._simulate import LEDGER, Result, event_dtype, result_from_columns
 
 __all__ = ["read_output", "events_path"]
 
@@ -48,11 +47,11 @@ def _read_header(path):
 _CUT_NOTE = "the event log was cut at "
 
 
-def _read_events(path, one_body=False):
+def _read_events(path, n_bodies=2):
     """The events of an events file, and its notes (a log cut at max_events says so in a
     comment line: it becomes a warning of the Result)."""
     rows, notes = [], []
-    dtype = ONE_BODY_EVENT_DTYPE if one_body else EVENT_DTYPE
+    dtype = event_dtype(n_bodies)
     with open(path, encoding="utf-8") as handle:
         for number, line in enumerate(handle, 1):
             if line.startswith("# " + _CUT_NOTE):
@@ -63,8 +62,11 @@ def _read_events(path, one_body=False):
             if len(text) != len(dtype.names):
                 raise InputError(f"{path}:{number}: expected {len(dtype.names)} entries "
                                  f"({' '.join(dtype.names)})")
-            t, kind, *velocities = text
-            rows.append((float(t), kind, *map(float, velocities)))
+            t, kind, *numbers = text
+            if n_bodies > 2:      # t kind a b va_before vb_before va_after vb_after
+                rows.append((float(t), kind, int(numbers[0]), int(numbers[1]), *map(float, numbers[2:])))
+            else:
+                rows.append((float(t), kind, *map(float, numbers)))
     return np.array(rows, dtype=dtype), tuple(notes)
 
 
@@ -81,12 +83,7 @@ def read_output(path, scene=None) -> Result:
     check_input(path, "output file")
     header, columns = _read_header(path)
     names = tuple(columns.split()) if columns is not None else ()
-    required = tuple(name for name in COLUMNS if name not in OPTIONAL_COLUMNS)
-    if tuple(name for name in names if name not in OPTIONAL_COLUMNS) != required or \
-            names != tuple(name for name in COLUMNS if name in names):
-        raise InputError(f"{path}: the last header line must name the columns "
-                         f"'{' '.join(required)}' (with pe after ke and damping_loss after "
-                         f"impact_loss when the scene has them), got {columns!r}")
+    n_bodies = _check_names(path, names, header)
     samples = np.loadtxt(path, comments="#", ndmin=2)
     if samples.size == 0:
         samples = np.empty((0, len(names)))
@@ -96,11 +93,17 @@ def read_output(path, scene=None) -> Result:
 
     kwargs = {}
     for name in REAL_FIELDS:
-        if name in header:
+        if name in header and not (n_bodies > 2 and name in ARRAY_FIELDS):
             kwargs[name] = float(header[name])
     for name in TEXT_FIELDS:
         if name in header:
             kwargs[name] = header[name]
+    if n_bodies > 2:
+        # The arrays of more than two bodies: '# m = 1.0 2.0 5.0' (the force tables' names,
+        # texts, are not written).
+        for name in ARRAY_FIELDS:
+            if name in header and name != "f_table":
+                kwargs[name] = [float(value) for value in header[name].split()]
     # The records: '# contact.2.d_min = 0.5', '# spring.1.k = 40.0', '# sine.1.amp = 2.0'
     # (in record order).
     for key, value in header.items():
@@ -111,17 +114,41 @@ def read_output(path, scene=None) -> Result:
     header_scene = Scene(**kwargs, source=header.get("scene"))
 
     events_file = events_path(path)
-    one_body = "x2" not in names
     if os.path.exists(events_file):
         check_input(events_file, "events file")     # a FIFO there would block the read
-        events, notes = _read_events(events_file, one_body)
+        events, notes = _read_events(events_file, n_bodies)
     else:
-        events, notes = np.empty(0, dtype=ONE_BODY_EVENT_DTYPE if one_body else EVENT_DTYPE), ()
+        events, notes = np.empty(0, dtype=event_dtype(n_bodies)), ()
     residual = samples[:, names.index("residual")]
     energy_residual = float(np.max(np.abs(residual))) if residual.size else 0.0
     result = result_from_columns(samples, events, names, energy_residual=energy_residual,
                                  steps=None, scene=header_scene, forces_known=False, warnings=notes)
     return result if scene is None else with_forces_of(result, scene, path)
+
+
+def _check_names(path, names, header) -> int:
+    """The number of bodies of an output whose last header line names `names`: t, x<i> v<i>
+    of bodies in increasing order, then ke, [pe,] work, friction_loss, impact_loss,
+    [damping_loss,] residual (InputError otherwise). N is the header's `bodies` (written for
+    more than two), else 2 with an m2 or an x2 column, else 1."""
+    bodies = []
+    k = 1
+    while k + 1 < len(names) and names[k][:1] == "x" and names[k][1:].isdigit() and \
+            names[k + 1] == "v" + names[k][1:]:
+        bodies.append(int(names[k][1:]))
+        k += 2
+    ledger = names[k:]
+    if not names or names[0] != "t" or not bodies or bodies != sorted(set(bodies)) or bodies[0] < 1 or \
+            ledger != tuple(name for name in LEDGER if name in ledger) or \
+            not {"ke", "work", "friction_loss", "impact_loss", "residual"} <= set(ledger):
+        raise InputError(f"{path}: the last header line must name the columns 't x1 v1 [x2 v2 ...] ke "
+                         f"work friction_loss impact_loss residual' (with pe after ke and damping_loss "
+                         f"after impact_loss when the scene has them), got {' '.join(names)!r}")
+    n_bodies = int(header["bodies"]) if header.get("bodies", "").isdigit() else \
+        2 if "m2" in header or 2 in bodies else 1
+    if bodies[-1] > max(n_bodies, 1):
+        raise InputError(f"{path}: the columns name body {bodies[-1]} of a scene of {n_bodies}")
+    return n_bodies
 
 
 def with_forces_of(result: Result, scene, path) -> Result:

@@ -16,7 +16,7 @@ from ._scene import (REAL_FIELDS, Scene, InputError, SimulationError, decode, ra
                      _STATUS_INTERRUPTED, to_assignments, _packed)
 from ._scene import STATUS_TOO_SMALL as _STATUS_TOO_SMALL
 
-__all__ = ["Result", "simulate", "COLUMNS", "EVENT_DTYPE", "ONE_BODY_EVENT_DTYPE"]
+__all__ = ["Result", "simulate", "COLUMNS", "EVENT_DTYPE", "ONE_BODY_EVENT_DTYPE", "NBODY_EVENT_DTYPE"]
 
 # Every sample column the api (and the CLI output) can have, checked against the core
 # below. A run has those its scene has: pe only with springs, damping_loss only with
@@ -24,6 +24,9 @@ __all__ = ["Result", "simulate", "COLUMNS", "EVENT_DTYPE", "ONE_BODY_EVENT_DTYPE
 COLUMNS = ("t", "x1", "v1", "x2", "v2", "ke", "pe", "work", "friction_loss",
            "impact_loss", "damping_loss", "residual")
 OPTIONAL_COLUMNS = ("x2", "v2", "pe", "damping_loss")
+# After the bodies' x and v, every run's row ends with these (pe and damping_loss optional):
+# an N-body run's columns are t x1 v1 .. xN vN, then LEDGER (the core's full row).
+LEDGER = ("ke", "pe", "work", "friction_loss", "impact_loss", "damping_loss", "residual")
 
 # Longest event kind is "release_slot_min" (16 characters).
 EVENT_DTYPE = np.dtype([("t", "f8"), ("kind", "U20"), ("v1_before", "f8"),
@@ -31,6 +34,29 @@ EVENT_DTYPE = np.dtype([("t", "f8"), ("kind", "U20"), ("v1_before", "f8"),
 # A one-body scene's events (no m2: the scene has no body 2).
 ONE_BODY_EVENT_DTYPE = np.dtype([("t", "f8"), ("kind", "U20"), ("v1_before", "f8"),
                                  ("v1_after", "f8")])
+# The events of a scene of more than two bodies: each names the pair it reports, a and b (a
+# contact row's ends, 0 the ground; a stick or slip: the body and 0), and their velocities
+# (0 for the ground). Kinds are a prefix (8) and a row's name (32).
+NBODY_EVENT_DTYPE = np.dtype([("t", "f8"), ("kind", "U40"), ("a", "i4"), ("b", "i4"),
+                              ("va_before", "f8"), ("vb_before", "f8"), ("va_after", "f8"),
+                              ("vb_after", "f8")])
+
+
+def event_dtype(n_bodies: int) -> np.dtype:
+    """The events' dtype of a run of n_bodies bodies."""
+    return ONE_BODY_EVENT_DTYPE if n_bodies == 1 else EVENT_DTYPE if n_bodies == 2 else NBODY_EVENT_DTYPE
+
+
+def row_length(n_bodies: int) -> int:
+    """The core's full row of a run of n_bodies: t, x and v of max(N, 2) bodies, LEDGER."""
+    return 2 * max(n_bodies, 2) + 1 + len(LEDGER)
+
+
+@lru_cache(maxsize=64)
+def row_names(n_bodies: int) -> tuple:
+    """The names of the core's full row (impact1d_output's column_word): COLUMNS for N <= 2."""
+    bodies = range(1, max(n_bodies, 2) + 1)
+    return ("t", *(f"{c}{i}" for i in bodies for c in "xv"), *LEDGER)
 
 if _words(_api.column_names()) != COLUMNS:
     raise ImportError("impact1d._core sample columns do not match impact1d.COLUMNS: "
@@ -62,7 +88,7 @@ class _Buffers(threading.local):
         self.event_real = np.zeros((events, 5), dtype=np.float64, order="F")
         self.event_int = np.zeros((events, 4), dtype=np.int32, order="F")
         self.row_name_codes = np.zeros((32, rows), dtype=np.int32, order="F")
-        self.info = np.zeros(7, dtype=np.int32)
+        self.info = np.zeros(8, dtype=np.int32)
         self.energy_residual = np.zeros(1, dtype=np.float64)
         self.text_codes = np.zeros((_TEXT_ROOM, 2), dtype=np.int32, order="F")
 
@@ -126,16 +152,15 @@ def _summary_names() -> tuple:
     return _words(_api.summary_column_names())
 
 
-_ABSENT = {name: None for name in OPTIONAL_COLUMNS}
+_ABSENT = {name: None for name in ("x1", "v1", *OPTIONAL_COLUMNS)}
 
 
-@lru_cache(maxsize=None)
-def _column_layout(has_column: bytes):
-    """The core's has_column flags (as bytes: a few layouts recur) -> (the present columns'
-    names in order, whether the scene has one body)."""
+@lru_cache(maxsize=64)
+def _column_layout(has_column: bytes, n_bodies: int):
+    """The core's has_column flags (as bytes: a few layouts recur) of a run of n_bodies ->
+    the present columns' names in order."""
     flags = np.frombuffer(has_column, dtype=np.int32)
-    names = tuple(name for name, flag in zip(COLUMNS, flags) if flag)
-    return names, "x2" not in names
+    return tuple(name for name, flag in zip(row_names(n_bodies), flags) if flag)
 
 
 def _sample_capacity(scene) -> int:
@@ -169,9 +194,8 @@ def event_kinds(scene=None) -> tuple:
     simulate(scene, t_end=_NO_TIME, dt_out=None)
     # simulate leaves the run's rows in this thread's buffers until the next call
     rows, n_rows = _buffers.row_name_codes, int(_buffers.info[3])
-    one_body = _column_layout(_buffers.has_column.tobytes())[1]
     table, _ = _kind_table(np.ascontiguousarray(rows[:, :n_rows].T).tobytes(), n_rows,
-                           1 if one_body else 2)
+                           int(_buffers.info[7]))
     return tuple(str(kind) for kind in table[:-1])      # (without 'unknown')
 
 
@@ -201,7 +225,7 @@ def _kind_table(row_name_codes: bytes, n_rows: int, n_bodies: int):
     row_names = [decode(row.astype(np.uint8).tobytes()) for row in codes]
     table = np.array([p + name for p in _ROW_PREFIXES for name in row_names]
                      + [f"{p}{i}" for p in _BODY_PREFIXES for i in range(1, n_bodies + 1)]
-                     + ["unknown"], dtype=EVENT_DTYPE["kind"])
+                     + ["unknown"], dtype=NBODY_EVENT_DTYPE["kind"])
     position = np.full((6, max(n_rows, n_bodies) + 1), len(table) - 1)
     for c in (1, 2, 3):
         position[c, 1:n_rows + 1] = (c - 1) * n_rows + np.arange(n_rows)
@@ -230,7 +254,13 @@ class Result:
     log, the run's accuracy monitor and the scene actually run. pe (the springs' potential
     energy) and damping_loss (what the dampers dissipated) are None for a scene without
     springs or dampers, and x2 and v2 for a one-body scene (no m2; its events then have no
-    v2 fields either): `columns` names the columns the run has."""
+    v2 fields either): `columns` names the columns the run has.
+
+    `x` and `v` are (samples, len(bodies)) arrays of the positions and velocities of the
+    bodies written (`bodies`: every body, or those of &run bodies_out), and `x1`, `v1`, ...
+    `xN`, `vN` views of their columns (None for a body not written; beyond the second they
+    are attributes, not fields). A scene of more than two bodies has events of
+    NBODY_EVENT_DTYPE: t, kind, a, b, va_before, vb_before, va_after, vb_after."""
 
     t: np.ndarray = field(default_factory=_empty)
     x1: np.ndarray = field(default_factory=_empty)
@@ -255,11 +285,42 @@ class Result:
     # back without its scene (its header records every force value but not the force
     # tables' names); read_output(path, scene=...) makes it True.
     forces_known: bool = True
+    # The bodies' positions and velocities, (samples, len(bodies)) (x1 ... are views of
+    # their columns), and the body numbers of their columns; () for a Result made from the
+    # tutorial's columns alone (x and v are then made from x1, x2 when asked for).
+    x: Optional[np.ndarray] = None
+    v: Optional[np.ndarray] = None
+    bodies: tuple = ()
+
+    def __post_init__(self):
+        if self.x is None and self.x1 is not None:
+            # (x2, v2 default to empty arrays: a body of no samples is not written)
+            written = [i for i in (1, 2) if getattr(self, f"x{i}") is not None and
+                       len(getattr(self, f"x{i}")) == len(self.x1)]
+            self.x = np.column_stack([getattr(self, f"x{i}") for i in written])
+            self.v = np.column_stack([getattr(self, f"v{i}") for i in written])
+            self.bodies = tuple(written)
+
+    def __getattr__(self, name):
+        # x3, v3, ...: the columns of x and v of a body past the second (x1 .. v2 are fields)
+        if name[:1] in ("x", "v") and name[1:].isdigit() and name[1:2] != "0":
+            bodies = vars(self).get("bodies", ())
+            body = int(name[1:])
+            if body in bodies:
+                return vars(self)[name[0]][:, bodies.index(body)]
+            if body > 2 and body <= _body_count(vars(self).get("scene")):
+                return None
+        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
 
     @property
     def columns(self) -> tuple:
-        """The names of the columns this run has, in COLUMNS order."""
-        return tuple(name for name in COLUMNS if getattr(self, name) is not None)
+        """The names of the columns this run has, in the core's order: t, x and v of each
+        body written, then ke, [pe,] work, friction_loss, impact_loss, [damping_loss,]
+        residual (COLUMNS' order for one or two bodies)."""
+        if not self.bodies:
+            return tuple(name for name in COLUMNS if getattr(self, name) is not None)
+        return ("t", *(f"{c}{i}" for i in self.bodies for c in "xv"),
+                *(name for name in LEDGER if getattr(self, name) is not None))
 
     @property
     def samples(self) -> np.ndarray:
@@ -294,16 +355,43 @@ def _lines(text) -> tuple:
 
 def result_from_columns(samples: np.ndarray, events: np.ndarray, names=COLUMNS, **extra) -> Result:
     """Build a Result from an (n, len(names)) sample array whose columns are `names`
-    (in COLUMNS order; the optional ones may be missing)."""
+    (the core's order: t, x and v of each body written, the ledger; the optional ones may
+    be missing)."""
     names = tuple(names)
     samples = np.asarray(samples, dtype=np.float64).reshape(-1, len(names))
     # Each column a contiguous view: as the core's column-major arrays already are (no
     # copy), a copy of a row-major table (np.loadtxt) otherwise. Absent columns are None.
     if samples.shape[0] > 1 and samples.strides[0] != samples.itemsize:
         samples = np.asfortranarray(samples)
-    columns = dict(_ABSENT)
-    columns.update((name, samples[:, j]) for j, name in enumerate(names))
-    return Result(**columns, events=events, **extra)
+    result = object.__new__(Result)
+    _fill_result(vars(result), samples, names)
+    vars(result).update(events=events, **{"energy_residual": 0.0, "steps": None, "scene": None,
+                                          "warnings": (), "forces_known": True, **extra})
+    return result
+
+
+def _fill_result(columns: dict, samples: np.ndarray, names: tuple) -> None:
+    """A Result's sample fields from the (rows, >= len(names)) column-major samples whose
+    first columns are `names`: each a view of its column, x and v views of every other
+    column from the first x (the core writes x1 v1 x2 v2 ...), x1 ... views of theirs."""
+    columns.update(_ABSENT)
+    # (the present columns first: zip stops at the last name)
+    columns.update(zip(names, samples.T))
+    n_written = sum(1 for name in names if name[0] == "x")
+    columns["x"] = samples[:, 1:2 * n_written:2]
+    columns["v"] = samples[:, 2:2 * n_written + 1:2]
+    columns["bodies"] = tuple(int(name[1:]) for name in names[1:2 * n_written:2])
+    for name in names[1:2 * n_written + 1]:
+        if name[1:] not in ("1", "2"):
+            del columns[name]      # (x3 ...: __getattr__'s views of x, v)
+
+
+def _body_count(scene) -> int:
+    """The bodies of a scene (a Scene, or its fields as a dict): its arrays' length; 2 if
+    it has none (one body or two: the same full row)."""
+    fields = scene if isinstance(scene, dict) else vars(scene) if scene is not None else {}
+    m = fields.get("m")
+    return len(m) if isinstance(m, (list, tuple)) else 2
 
 
 _REAL_INDEX = {name: k for k, name in enumerate(REAL_FIELDS)}
@@ -381,31 +469,34 @@ def simulate(scene: Scene, *, progress: bool = False, _interrupt_epoch: Optional
     # The samples are made for this call (the Result's columns are views of them); the rest
     # is the thread's buffers, read out below (so threads may run at once).
     buffers = _buffers
-    samples = np.empty((form.sample_capacity, len(COLUMNS)), dtype=np.float64, order="F")
+    # (columns: the full row of the scene's bodies, has_column as long; N is the core's)
+    samples = np.empty((form.sample_capacity, row_length(_body_count(form.fields))), dtype=np.float64, order="F")
     while True:
+        if len(buffers.has_column) != samples.shape[1]:
+            buffers.has_column = np.zeros(samples.shape[1], dtype=np.int32)
         _api.simulate(values, given, form.blob, form.text_end, *form.records, 1 if progress else 0, samples,
                       buffers.has_column, buffers.event_real, buffers.event_int, buffers.row_name_codes, buffers.info,
                       buffers.energy_residual, buffers.text_codes, interrupt_epoch=epoch)
-        status, n_samples, n_events, n_rows, steps, message_length, warnings_length = buffers.info.tolist()
+        status, n_samples, n_events, n_rows, steps, message_length, warnings_length, n_bodies = \
+            buffers.info.tolist()
         if status != _STATUS_TOO_SMALL:
             break
-        if n_samples > samples.shape[0]:
-            samples = np.empty((n_samples, len(COLUMNS)), dtype=np.float64, order="F")
+        n_columns = max(row_length(n_bodies), samples.shape[1])
+        if n_samples > samples.shape[0] or n_columns > samples.shape[1]:
+            samples = np.empty((max(n_samples, samples.shape[0]), n_columns), dtype=np.float64, order="F")
         buffers.make(max(n_events, buffers.event_int.shape[0]), max(n_rows, buffers.row_name_codes.shape[1]))
     if status:
         raise_for_status(status, _codes_text(buffers.text_codes[:message_length, 0]))
-    names, one_body = _column_layout(buffers.has_column.tobytes())
-    events = np.empty(n_events, dtype=ONE_BODY_EVENT_DTYPE if one_body else EVENT_DTYPE)
+    names = _column_layout(buffers.has_column[:row_length(n_bodies)].tobytes(), n_bodies)
+    events = np.empty(n_events, dtype=event_dtype(n_bodies))
     if n_events > 0:
-        _fill_events(events, buffers, n_events, n_rows, one_body)
+        _fill_events(events, buffers, n_events, n_rows, n_bodies)
     if buffers.event_int.shape[0] > _EVENT_CAPACITY_KEPT:
         buffers.make(_EVENT_CAPACITY, buffers.row_name_codes.shape[1])
     # The Result made without dataclass __init__ (every field set here): a short run's time.
     result = object.__new__(Result)
     columns = vars(result)
-    columns.update(_ABSENT)
-    # (the present columns first: zip stops at the last name)
-    columns.update(zip(names, (samples if n_samples == len(samples) else samples[:n_samples]).T))
+    _fill_result(columns, samples if n_samples == len(samples) else samples[:n_samples], names)
     run_scene = object.__new__(Scene)
     vars(run_scene).update(form.fields)
     columns.update(events=events, energy_residual=float(buffers.energy_residual[0]), steps=steps,
@@ -419,12 +510,18 @@ def _codes_text(codes) -> bytes:
     return codes.astype(np.uint8).tobytes()
 
 
-def _fill_events(events, buffers, n_events, n_rows, one_body) -> None:
-    """The event log from the core's event arrays (the kinds named by _event_names)."""
+def _fill_events(events, buffers, n_events, n_rows, n_bodies) -> None:
+    """The event log from the core's event arrays (the kinds named by _event_names): one or
+    two bodies' velocities (the pair is (1, 2), or (1, 0)), or the pair and theirs."""
     event_real, event_int = buffers.event_real, buffers.event_int
     events["t"] = event_real[:n_events, 0]
     events["kind"] = _event_names(event_int[:n_events, 0], event_int[:n_events, 1],
-                                  buffers.row_name_codes[:, :n_rows], 1 if one_body else 2)
+                                  buffers.row_name_codes[:, :n_rows], n_bodies)
+    if n_bodies > 2:
+        events["a"], events["b"] = event_int[:n_events, 2], event_int[:n_events, 3]
+        for k, name in enumerate(("va_before", "vb_before", "va_after", "vb_after"), 1):
+            events[name] = event_real[:n_events, k]
+        return
     events["v1_before"], events["v1_after"] = event_real[:n_events, 1], event_real[:n_events, 3]
-    if not one_body:
+    if n_bodies == 2:
         events["v2_before"], events["v2_after"] = event_real[:n_events, 2], event_real[:n_events, 4]
