@@ -7,8 +7,7 @@ Each yardstick comes twice:
   against exact_nbody, to EXACT): these run today and prove the yardstick;
 - `test_engine_*` runs the engine on the same scene and holds it to the reference with the
   tolerances of tests/test_reference.py (EVENT_TIME_TOL on every event time, STATE_TOL on
-  the final state). Until the engine lands, `build_scene` refuses N > 2 and these are
-  expected failures (ENGINE_PENDING: the refusal and only the refusal).
+  the final state).
 
 (a) Newton's cradle, equal masses, r = 1, no gaps (input/newtons_cradle.nml and k balls
     in): k balls out at the incoming speed, the others at rest.
@@ -22,15 +21,12 @@ Each yardstick comes twice:
 And the N-body scenes of input/ against the reference (the ball stack against its closed
 form, tests/nbody_scenes.py falling_stack).
 
-How the integrator turns the expected failures off: set ENGINE_LANDED = True below (one
-place); tests/golden/check_golden.py skips the same input/ scenes (nbody_pending).
 The engine's N-body Result is read in two helpers only, `engine_events` and
 `engine_samples` (DESIGN "Mechanisms as data": `Result.x`, `Result.v` (samples, N)).
 """
 
 from __future__ import annotations
 
-import re
 from pathlib import Path
 
 import numpy as np
@@ -47,10 +43,6 @@ import nbody_scenes as ns  # noqa: E402
 INPUT = Path(__file__).resolve().parent.parent / "input"
 
 # --- the engine's expected failure, in one place ------------------------------------------
-ENGINE_LANDED = True
-REFUSAL = "more than two bodies need the cluster solver (issue 19, stage 4)"
-ENGINE_PENDING = (lambda test: test) if ENGINE_LANDED else pytest.mark.xfail(
-    raises=impact1d.InputError, strict=True, reason="issue 19 stage 4: N-body engine not landed")
 
 # --- tolerances -----------------------------------------------------------------------------
 EVENT_TIME_TOL = 1e-9    # s: every event time (tests/test_reference.py, tests/test_records_run.py)
@@ -148,14 +140,8 @@ def load(name: str) -> impact1d.Scene:
 # --- the engine's results ----------------------------------------------------------------------
 
 def run_engine(scene: impact1d.Scene, **overrides):
-    """impact1d.simulate; an InputError other than the N-body refusal is a fault of the test's
-    scene, not the expected failure (ENGINE_PENDING would hide it)."""
-    try:
-        return impact1d.simulate(scene, **overrides)
-    except impact1d.InputError as exc:
-        if REFUSAL not in str(exc):
-            raise AssertionError(f"the scene is refused for another reason: {exc}") from exc
-        raise
+    """impact1d.simulate (the N-body engine for more than two bodies)."""
+    return impact1d.simulate(scene, **overrides)
 
 
 def engine_events(res) -> list:
@@ -283,7 +269,6 @@ def test_reference_cradle_k_in_k_out(k):
         assert [e.after for e in impacts][-1] == (0, 0, 0, 0, mpf(0.5))
 
 
-@ENGINE_PENDING
 @pytest.mark.parametrize("k", (1, 2, 3))
 def test_engine_cradle_k_in_k_out(k):
     scene = cradle(k)
@@ -339,7 +324,6 @@ def test_reference_galperin_with_a_third_body(ratio, count):
         assert abs(got - want) < EXACT
 
 
-@ENGINE_PENDING
 @pytest.mark.parametrize("ratio, count", [(1, 3), (16, 12), (100, 31), (10_000, 314)])
 def test_engine_galperin_with_a_third_body(ratio, count):
     scene = galperin3(ratio)
@@ -391,7 +375,6 @@ def test_reference_random_chains_are_what_the_engine_reads(chains):
     assert compared >= 3 * len(CHAIN_SEEDS)
 
 
-@ENGINE_PENDING
 @pytest.mark.parametrize("seed", CHAIN_SEEDS)
 def test_engine_random_chain(seed, chains):
     sol = chains[seed]
@@ -441,7 +424,6 @@ def test_reference_momentum_without_friction_or_walls(seed):
         assert abs(sum(a * u for a, u in zip(m, x)) / sum(m) - centre) < EXACT
 
 
-@ENGINE_PENDING
 @pytest.mark.parametrize("seed", MOMENTUM_SEEDS)
 def test_engine_momentum_without_friction_or_walls(seed):
     scene = free_chain(seed)
@@ -551,7 +533,6 @@ def test_reference_train_start_up(friction):
         assert abs(float((200 - 0.002 * 9.81 * 440) / 440) - 0.435) < 1e-3
 
 
-@ENGINE_PENDING
 @pytest.mark.parametrize("friction", [(0.0, 0.0), (0.002, 0.004)], ids=["frictionless", "train.nml"])
 def test_engine_train_start_up(friction):
     scene = train(mu=friction[0], mus=friction[1])
@@ -604,7 +585,6 @@ def test_reference_cradle_file_one_out():
     assert [e.kind for e in sol.impacts()] == ["link1", "link2", "link3", "link4"]
 
 
-@ENGINE_PENDING
 @pytest.mark.parametrize("name", NBODY_FILES)
 def test_engine_input_scene_matches_reference(name):
     scene = load(name)
@@ -614,20 +594,11 @@ def test_engine_input_scene_matches_reference(name):
     assert_final_matches(res, *sol.final)
 
 
-def test_input_scenes_of_n_bodies_wait_for_the_engine():
-    """The scenes of more than two bodies in input/ are these; until ENGINE_LANDED the engine
-    refuses each (and only with the refusal) and tests/golden/check_golden.py leaves them out
-    of its hashes (nbody_pending); once it has landed that skip must be gone (their hashes
-    stored), so the two are lifted together."""
-    import sys
-    sys.path.insert(0, str(Path(__file__).resolve().parent / "golden"))
-    import check_golden
+def test_input_scenes_of_n_bodies_are_guarded_by_the_golden_hashes():
+    """The scenes of more than two bodies in input/ are these, and tests/golden/hashes.json
+    holds their samples' and events' hashes (a change of their results is seen)."""
+    import json
     many = sorted(path.name for path in INPUT.glob("*.nml") if len(load(path.name).m or ()) > 2)
     assert many == sorted(NBODY_FILES)
-    if ENGINE_LANDED:
-        assert not hasattr(check_golden, "nbody_pending"), "store their golden hashes: remove the skip"
-        return
-    for name in many:
-        assert check_golden.nbody_pending(load(name))
-        with pytest.raises(impact1d.InputError, match=re.escape(REFUSAL)):
-            impact1d.simulate(load(name))
+    hashes = json.loads((Path(__file__).resolve().parent / "golden" / "hashes.json").read_text())
+    assert all(f"input/{name}" in hashes for name in many)

@@ -7,7 +7,7 @@ the event log (t, kind, velocities before/after) with tests/golden/hashes.json.
 
 The scenes: the seed cases input/case*.nml at their own dt, at dt = 0.1 and under
 method='vissim'; the other input/*.nml scenes (springs, dampers, static friction, one
-body, contact records) but those of more than two bodies (NBODY_PENDING); the bench
+body, contact records, more than two bodies); the bench
 scenes bench/scenes/*.nml; the one-body and spring/damper scenes of
 SCENES (from tests/test_model_widening.py and tests/test_exact_springs.py); and
 GENERATED scenes of tests/test_reference.py (its own generator, fixed indices) at two
@@ -37,20 +37,6 @@ import impact1d  # noqa: E402
 GENERATED = sorted(set(range(0, 150, 4)) | {6, 12, 56, 90})
 GENERATED_DT = (1e-2, 1e-3)
 COARSE_DT = 0.1
-
-# The scenes of more than two bodies in input/ (newtons_cradle, train, ball_stack) wait for
-# the N-body engine: build_scene refuses them until issue 19 stage 4 lands. They are not
-# hashed until then (an error string would guard nothing); when the engine runs them,
-# delete this skip and store their hashes (--update).
-NBODY_PENDING = "issue 19 stage 4: the N-body engine has not landed (N > 2 refused)"
-
-
-def nbody_pending(scene) -> bool:
-    """Whether a scene has more than two bodies (skipped: NBODY_PENDING)."""
-    return scene.m is not None and len(scene.m) > 2
-
-
-SKIPPED = []   # the scenes scenes() left out (nbody_pending), for main's report
 
 # One body (the engine keeps a phantom second body for it: its tolerances read min(m1, 1),
 # so m1 on either side of 1) and every spring and damper element, both methods.
@@ -116,9 +102,6 @@ def scenes():
     try:
         for path in sorted((ROOT / "input").glob("*.nml")):
             scene = impact1d.load_scene(str(path.relative_to(ROOT)))
-            if nbody_pending(scene):
-                SKIPPED.append(f"input/{path.name}")
-                continue
             yield f"input/{path.name}", _run(scene)
             if path.name.startswith("case"):
                 yield f"input/{path.name}@dt={COARSE_DT}", _run(scene, dt=COARSE_DT)
@@ -150,8 +133,6 @@ def main(argv) -> int:
     for name in differing:
         print(f"CHANGED: {name}")
     print(f"{len(got) - len(differing)}/{len(got)} scenes bit-identical")
-    if SKIPPED:
-        print(f"not hashed ({NBODY_PENDING}): {', '.join(sorted(set(SKIPPED)))}")
     return 1 if differing else 0
 
 
