@@ -13,6 +13,7 @@
 !> speeds fall (the issue 19 scene: durations 0.57 per cycle, speeds 0.90), and all of them
 !> reach rest at the limit. One contact's series is summed exactly by the Zeno rule instead.
 module impact1d_accumulation
+  use, intrinsic :: iso_fortran_env, only: int64
   use impact1d_kinds, only: wp
   use impact1d_clusters, only: uf_join, group_means
   implicit none
@@ -34,6 +35,9 @@ module impact1d_accumulation
     integer :: n = 0                               !< points held (up to kept)
     integer :: newest = 0                          !< column of the newest point (a ring)
     real(wp) :: t(kept) = 0.0_wp
+    !> Each point's rows hit as one number (a sum of the rows' own odd multipliers): patterns
+    !> are compared by these first, the rows themselves only where they agree.
+    integer(int64) :: signature(kept) = 0
     logical, allocatable :: hit(:, :)              !< (nr, kept) rows that took an impulse
     real(wp), allocatable :: u(:, :)               !< (nr, kept) normal velocities after
   contains
@@ -71,7 +75,19 @@ contains
     self%t(self%newest) = t
     self%hit(:, self%newest) = hit
     self%u(:, self%newest) = u
+    self%signature(self%newest) = signature_of(hit)
   end subroutine record
+
+  !> The rows hit as one number: distinct sets rarely agree (and find_cycle compares the
+  !> rows themselves where they do).
+  pure integer(int64) function signature_of(hit) result(h)
+    logical, intent(in) :: hit(:)
+    integer :: k
+    h = 0_int64
+    do k = 1, size(hit)
+      if (hit(k)) h = ieor(h, int(k, int64) * 2654435761_int64 + 1_int64)
+    end do
+  end function signature_of
 
   !> The column of the point `back` points before the newest.
   pure integer function at(self, back)
@@ -96,9 +112,20 @@ contains
     found = .false.
     remaining = huge(1.0_wp)
     rows = .false.
+    ! A series whose remaining time is below the cut has passages far shorter than it: the
+    ! common case (points a step or more apart) costs one test (a ratio rho below 1e-3 per
+    ! period is let through to the next points).
+    if (self%n < 3) return
+    if (self%t(at(self, 0)) - self%t(at(self, 1)) > 1.0e3_wp * max(cycle_cut * dt, min_time)) return
     do p = 1, cycle_points
       if (self%n < 2 * p + 1) return
+      ! (the signatures first: most periods fail on the newest point at once)
       repeats = .true.
+      do j = 0, p
+        repeats = self%signature(at(self, j)) == self%signature(at(self, j + p))
+        if (.not. repeats) exit
+      end do
+      if (.not. repeats) cycle
       do j = 0, p
         repeats = repeats .and. all(self%hit(:, at(self, j)) .eqv. self%hit(:, at(self, j + p)))
       end do
@@ -109,7 +136,8 @@ contains
       end do
       ! One contact's series, or several independent ones at the same instants (two bodies
       ! each settling on its own wall): the Zeno rule sums each exactly.
-      if (count(rows) < 2 .or. .not. connected(row_body, rows)) cycle
+      ! (the longer periods that repeat are multiples of this one, over the same rows)
+      if (count(rows) < 2 .or. .not. connected(row_body, rows)) return
       ! The durations of the last three periods shrink by one ratio (the cycle map's
       ! dominant rate), and the rows' normal velocities do not grow.
       if (self%n < 3 * p + 1) return

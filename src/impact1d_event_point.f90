@@ -203,24 +203,27 @@ contains
     type(event_log_type), intent(inout) :: event_log
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
-    real(wp) :: u(scene%n_rows), remaining, v(max_lanes)
-    logical :: rows(scene%n_rows), found
-    integer :: k
-    do k = 1, scene%n_rows
+    ! (fixed-size: gfortran puts arrays of run-time size on the heap, an allocation an event)
+    real(wp) :: u(pair_rows), remaining, v(max_lanes)
+    logical :: rows(pair_rows), found
+    integer :: k, nr
+    nr = scene%n_rows
+    do k = 1, nr
       u(k) = normal_velocity(scene, k, s%v)
     end do
-    call event_log%cycles%record(s%t, hit(:scene%n_rows), u)
-    call event_log%cycles%find_cycle(scene%row_body, scene%dt, time_rounding * max(abs(s%t), scene%dt), rows, remaining, found)
+    call event_log%cycles%record(s%t, hit(:nr), u(:nr))
+    call event_log%cycles%find_cycle(scene%row_body, scene%dt, time_rounding * max(abs(s%t), scene%dt), rows(:nr), &
+      remaining, found)
     if (.not. found) return
     call event_log%cycles%forget()
-    closed(:scene%n_rows) = closed(:scene%n_rows) .or. rows
-    do k = 1, scene%n_rows
+    closed(:nr) = closed(:nr) .or. rows(:nr)
+    do k = 1, nr
       if (rows(k)) call snap(scene, k, closed, s)
     end do
     v = s%v
-    call join_cycle(scene%row_body, rows, scene%body_mass, v(:scene%n_bodies))
+    call join_cycle(scene%row_body, rows(:nr), scene%body_mass, v(:scene%n_bodies))
     call apply(scene, s, v)
-    do k = 1, scene%n_rows
+    do k = 1, nr
       if (rows(k)) call event_log%begin_rest(scene, k, s%t, s%t + remaining, s%v, sink, stats)
     end do
   end subroutine cut_cycle
