@@ -11,7 +11,7 @@ module impact1d_contacts
   use impact1d_lanes, only: max_lanes
   implicit none
   private
-  public :: gap, gap_tolerance, gap_tolerance_along, displacement, snap, rigid_pair, u_tolerance, u_tolerances
+  public :: gap, gap_tolerance, gap_tolerance_along, displacement, snap, snap_row, rigid_pair, u_tolerance, u_tolerances
 
 contains
 
@@ -71,20 +71,31 @@ contains
     displacement = dot_product(abs(scene%pair%normal(:, k)), abs((b%x - a%x) + (b%x_lo - a%x_lo)))
   end function displacement
 
-  !> Put closed row k exactly on its constraint (gap = 0, no roundoff penetration). A ground
-  !> row puts its body at -offset / n_b; a row between bodies puts x_b - x_a on its limit
-  !> by moving the end that no closed ground row holds (b if neither is held).
+  !> Put closed row k exactly on its constraint (gap = 0, no roundoff penetration): the
+  !> state in lanes (snap_row on its positions).
   pure subroutine snap(scene, k, closed, s)
     type(scene_type), intent(in) :: scene
     integer, intent(in) :: k
     logical, intent(in) :: closed(pair_rows)
     type(lane_state_type), intent(inout) :: s
+    call snap_row(scene, k, closed(:scene%n_rows), s%x, s%x_lo)
+  end subroutine snap
+
+  !> Put closed row k exactly on its constraint, on positions x + x_lo (lanes or N-long: both
+  !> engines). A ground row puts its body at -offset / n_b; a row between bodies puts
+  !> x_b - x_a on its limit by moving the end that no closed ground row holds (b if neither
+  !> is held).
+  pure subroutine snap_row(scene, k, closed, x, x_lo)
+    type(scene_type), intent(in) :: scene
+    integer, intent(in) :: k
+    logical, intent(in) :: closed(:)
+    real(wp), intent(inout) :: x(:), x_lo(:)
     real(wp) :: limit
     integer :: j
     associate (a => scene%row_body(1, k), b => scene%row_body(2, k))
       if (a == 0) then
-        s%x(b) = -scene%row_offset(k) / scene%row_normal(2, k)
-        s%x_lo(b) = 0.0_wp
+        x(b) = -scene%row_offset(k) / scene%row_normal(2, k)
+        x_lo(b) = 0.0_wp
         return
       end if
       ! x_b = x_a + d exactly, the sum's rounding kept in the low part (d = -offset / n_b:
@@ -92,17 +103,17 @@ contains
       limit = -scene%row_offset(k) / scene%row_normal(2, k)
       do j = 1, scene%n_rows
         if (closed(j) .and. scene%row_body(1, j) == 0 .and. scene%row_body(2, j) == b) then
-          s%x(a) = s%x(b)
-          s%x_lo(a) = s%x_lo(b)
-          call add_compensated(s%x(a), s%x_lo(a), -limit)
+          x(a) = x(b)
+          x_lo(a) = x_lo(b)
+          call add_compensated(x(a), x_lo(a), -limit)
           return
         end if
       end do
-      s%x(b) = s%x(a)
-      s%x_lo(b) = s%x_lo(a)
-      call add_compensated(s%x(b), s%x_lo(b), limit)
+      x(b) = x(a)
+      x_lo(b) = x_lo(a)
+      call add_compensated(x(b), x_lo(b), limit)
     end associate
-  end subroutine snap
+  end subroutine snap_row
 
   !> Both limits of a link closed (a rigid link, d_min = d_max, whose row_partner the event
   !> point closed with its row): its bodies are one. A record's two rows are adjacent, so

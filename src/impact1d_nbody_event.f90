@@ -15,6 +15,7 @@ module impact1d_nbody_event
   use impact1d_event_point, only: bounce_series_time
   use impact1d_clusters, only: uf_join, uf_find
   use impact1d_accumulation, only: join_cycle
+  use impact1d_contacts, only: snap_row
   use impact1d_cluster_impact, only: impact_work_type, impact_reserve, cluster_projection
   use impact1d_lcp, only: lcp_solved
   use impact1d_body_mode, only: body_mode_type, mode_work_type, solve_body_mode, mode_solved
@@ -133,40 +134,9 @@ contains
       if (scene%row_partner(k) > 0) closed(k) = closed(k) .or. closed(scene%row_partner(k))
     end do
     do k = 1, scene%n_rows
-      if (closed(k)) call snap(scene, k, closed, s)
+      if (closed(k)) call snap_row(scene, k, closed, s%x, s%x_lo)
     end do
   end subroutine close_rows
-
-  !> Put closed row k exactly on its constraint: a ground row puts its body at -offset / n_b;
-  !> a row between bodies puts x_b - x_a on its limit by moving the end that no closed ground
-  !> row holds (b if neither is).
-  pure subroutine snap(scene, k, closed, s)
-    type(scene_type), intent(in) :: scene
-    integer, intent(in) :: k
-    logical, intent(in) :: closed(:)
-    type(state_type), intent(inout) :: s
-    real(wp) :: limit
-    integer :: j
-    associate (a => scene%row_body(1, k), b => scene%row_body(2, k))
-      limit = -scene%row_offset(k) / scene%row_normal(2, k)
-      if (a == 0) then
-        s%x(b) = limit
-        s%x_lo(b) = 0.0_wp
-        return
-      end if
-      do j = 1, scene%n_rows
-        if (closed(j) .and. scene%row_body(1, j) == 0 .and. scene%row_body(2, j) == b) then
-          s%x(a) = s%x(b)
-          s%x_lo(a) = s%x_lo(b)
-          call add_compensated(s%x(a), s%x_lo(a), -limit)
-          return
-        end if
-      end do
-      s%x(b) = s%x(a)
-      s%x_lo(b) = s%x_lo(a)
-      call add_compensated(s%x(b), s%x_lo(b), limit)
-    end associate
-  end subroutine snap
 
   !> Bodies joined by rigid links whose two rows are closed (d_min = d_max) are one body: the
   !> groups (work%rigid, 0 the ground for a link to it) and their masses; each group moves
@@ -348,7 +318,7 @@ contains
     call event_log%cycles%forget()
     closed = closed .or. rows
     do k = 1, scene%n_rows
-      if (rows(k)) call snap(scene, k, closed, s)
+      if (rows(k)) call snap_row(scene, k, closed, s%x, s%x_lo)
     end do
     v = s%v
     call join_cycle(scene%row_body, rows, scene%body_mass, v)
