@@ -238,12 +238,8 @@ contains
     input = flat_input(values, given, text_blob(:text_end(1)), text_blob(text_end(1) + 1:text_end(2)), &
       text_blob(text_end(2) + 1:text_end(3)), text_blob(text_end(3) + 1:text_end(4)), &
       text_blob(text_end(4) + 1:text_end(5)), text_blob(text_end(5) + 1:text_end(6)))
-    ! A scene of more than two bodies comes with its arrays among the assignments (one or
-    ! two bodies come as the tutorial's fields, settled by settle_scene).
-    call apply_assignments(input, .false., n_numbers, n_texts, field, index, value, record_text_field, &
+    call apply_scene_assignments(input, n_numbers, n_texts, field, index, value, record_text_field, &
       record_text_index, record_text_end, record_blob, error)
-    if (.not. allocated(error) .and. (any(field(:n_numbers) <= id_r_meet) .or. &
-        any(record_text_field(:n_texts) <= id_r_meet))) call settle_chain(input, error)
     if (.not. allocated(error)) call prepare_scene(input, scene, error)
     if (put_error(error, info, text_codes)) return
     warnings = trim(scene%warnings)
@@ -350,7 +346,7 @@ contains
       return
     end if
     base = flat_input(values, given, title, f1_table, f2_table, method, substeps, events)
-    call apply_assignments(base, .true., n_numbers, n_texts, field, index, value, text_field, text_index, &
+    call apply_scene_assignments(base, n_numbers, n_texts, field, index, value, text_field, text_index, &
       text_end, text_blob, error)
     if (allocated(error)) then
       status = int(error%status, c_int)
@@ -392,6 +388,22 @@ contains
   !> Assignments (read_scene's form; texts as one blob, text k ending at text_end(k)) made
   !> to input, their ids, indices and ends checked first; with records_only, only the
   !> &contact and &spring record fields may be assigned (simulate's records).
+  !> A scene's records (and, for more than two bodies, its arrays: one or two come as the
+  !> tutorial's fields, settled by settle_scene) assigned onto its flat fields, a chain's
+  !> arrays then settled as settle_scene does.
+  subroutine apply_scene_assignments(input, n_numbers, n_texts, field, index, value, text_field, text_index, &
+      text_end, text_blob, error)
+    type(scene_input), intent(inout) :: input
+    integer(c_int), intent(in) :: n_numbers, n_texts, field(:), index(:), text_field(:), text_index(:), text_end(:)
+    real(c_double), intent(in) :: value(:)
+    character(len=*), intent(in) :: text_blob
+    type(error_type), allocatable, intent(out) :: error
+    call apply_assignments(input, .false., n_numbers, n_texts, field, index, value, text_field, text_index, &
+      text_end, text_blob, error)
+    if (allocated(error)) return
+    if (any(field(:n_numbers) <= id_r_meet) .or. any(text_field(:n_texts) <= id_r_meet)) call settle_chain(input, error)
+  end subroutine apply_scene_assignments
+
   subroutine apply_assignments(input, records_only, n_numbers, n_texts, field, index, value, text_field, &
       text_index, text_end, text_blob, error)
     type(scene_input), intent(inout) :: input

@@ -602,3 +602,17 @@ def test_input_scenes_of_n_bodies_are_guarded_by_the_golden_hashes():
     assert many == sorted(NBODY_FILES)
     hashes = json.loads((Path(__file__).resolve().parent / "golden" / "hashes.json").read_text())
     assert all(f"input/{name}" in hashes for name in many)
+
+
+def test_sweep_of_an_n_body_scene_agrees_with_its_runs():
+    """impact1d.sweep runs scenes of more than two bodies through the summary path (the
+    core's batch, threads too): each row's final state and counts are its own run's."""
+    scene = load("newtons_cradle.nml")
+    ends = [0.25, 0.5, 1.0]
+    for workers in (None, 2):
+        table = impact1d.sweep(scene, {"t_end": ends}, workers=workers)
+        assert list(table["error"]) == [""] * len(ends)
+        for row, t_end in zip(table.itertuples(), ends):
+            res = impact1d.simulate(scene, t_end=t_end)
+            assert row.x1_end == res.x1[-1] and row.v2_end == res.v2[-1]
+            assert row.n_impacts == sum(not str(k).startswith(RESERVED) for k in res.events["kind"])
