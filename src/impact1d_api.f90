@@ -385,9 +385,6 @@ contains
     end do
   end subroutine simulate_summaries
 
-  !> Assignments (read_scene's form; texts as one blob, text k ending at text_end(k)) made
-  !> to input, their ids, indices and ends checked first; with records_only, only the
-  !> &contact and &spring record fields may be assigned (simulate's records).
   !> A scene's records (and, for more than two bodies, its arrays: one or two come as the
   !> tutorial's fields, settled by settle_scene) assigned onto its flat fields, a chain's
   !> arrays then settled as settle_scene does.
@@ -404,6 +401,9 @@ contains
     if (any(field(:n_numbers) <= id_r_meet) .or. any(text_field(:n_texts) <= id_r_meet)) call settle_chain(input, error)
   end subroutine apply_scene_assignments
 
+  !> Assignments (read_scene's form; texts as one blob, text k ending at text_end(k)) made
+  !> to input, their ids, indices and ends checked first; with records_only, only the
+  !> record fields may be assigned.
   subroutine apply_assignments(input, records_only, n_numbers, n_texts, field, index, value, text_field, &
       text_index, text_end, text_blob, error)
     type(scene_input), intent(inout) :: input
