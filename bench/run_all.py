@@ -239,11 +239,12 @@ def _at(study, dt):
     return next(r for r in study["methods"]["event"]["rows"] if r["dt"] == dt)
 
 
-def core_regression_section() -> str:
-    """The hand-measured section on the core since 7f0f942 (bench/results/core_regression.md),
-    kept as it was written: its numbers come from builds of other commits, not from this run."""
-    path = common.RESULTS / "core_regression.md"
-    return "\n" + path.read_text().rstrip() + "\n" if path.exists() else ""
+def kept_sections() -> str:
+    """The sections measured apart from this run, kept as they were written: the core since
+    7f0f942 (bench/results/core_regression.md: builds of other commits) and long chains
+    (bench/results/chains.md: bench/chains.py, many minutes of runs)."""
+    paths = [common.RESULTS / name for name in ("core_regression.md", "chains.md")]
+    return "".join("\n" + path.read_text().rstrip() + "\n" for path in paths if path.exists())
 
 
 def performance_md(perf, info, cvode=None, siconos=None) -> str:
@@ -422,7 +423,7 @@ def main(argv):
         performance_md(perf, info, cvode, peer).rstrip() + "\n\n"
         + siconos_peer.performance_section(peer).rstrip()
         + "\n\n" + sweep_study.performance_section(sweeps).rstrip()
-        + "\n\n" + call_profile.performance_section(calls).rstrip() + "\n" + core_regression_section())
+        + "\n\n" + call_profile.performance_section(calls).rstrip() + "\n" + kept_sections())
     print("wrote docs/accuracy.md, docs/performance.md and docs/*.png")
 
 

@@ -119,7 +119,8 @@ contains
     if (self%t(at(self, 0)) - self%t(at(self, 1)) > 1.0e3_wp * max(cycle_cut * dt, min_time)) return
     do p = 1, cycle_points
       if (self%n < 2 * p + 1) return
-      ! (the signatures first: most periods fail on the newest point at once)
+      ! (the signatures first: most periods fail on the newest point at once; then the rows,
+      ! the first point that differs ending the comparison)
       repeats = .true.
       do j = 0, p
         repeats = self%signature(at(self, j)) == self%signature(at(self, j + p))
@@ -127,7 +128,8 @@ contains
       end do
       if (.not. repeats) cycle
       do j = 0, p
-        repeats = repeats .and. all(self%hit(:, at(self, j)) .eqv. self%hit(:, at(self, j + p)))
+        repeats = all(self%hit(:, at(self, j)) .eqv. self%hit(:, at(self, j + p)))
+        if (.not. repeats) exit
       end do
       if (.not. repeats) cycle
       rows = .false.

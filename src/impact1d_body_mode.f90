@@ -19,11 +19,15 @@ module impact1d_body_mode
   use impact1d_scene, only: scene_type
   use impact1d_clusters, only: uf_join, uf_find
   use impact1d_cluster_mode, only: cluster_work_type, cluster_reserve, cluster_mode, cluster_solved
+  use impact1d_lcp, only: lcp_too_large
   implicit none
   private
   public :: body_mode_type, mode_work_type, new_mode, solve_body_mode, same_mode, mode_solved
 
   integer, parameter :: mode_solved = cluster_solved   !< otherwise an impact1d_lcp status
+  !> The largest cluster problem solved (rows + 2 bodies' unknowns): its dense matrices take
+  !> about 24 n^2 bytes, 2.4 GB here (issue 20: a factored solve for chains lifts this).
+  integer, parameter, public :: max_dense_unknowns = 10000
 
   type :: body_mode_type
     logical, allocatable :: active(:)        !< (nr) rows held closed
@@ -208,6 +212,10 @@ contains
     integer :: nb, nr, j, i, k
     nb = work%first(c + 1) - work%first(c)
     nr = work%first_row(c + 1) - work%first_row(c)
+    ! The solve is dense: a cluster past max_dense_unknowns (a long train with every coupler
+    ! closed) is refused with a status, not an allocation the machine cannot make.
+    status = lcp_too_large
+    if (max(nr, 1) + 2 * nb > max_dense_unknowns) return
     call reserve(work, nb, nr)
     work%local(0) = 0
     do j = 1, nb

@@ -153,6 +153,11 @@ contains
     logical, intent(in) :: first
     integer :: i
     real(wp) :: col_tol, divisor, best_divisor
+    !> Each row's largest |B^-1| entry, found when a tie first needs it (-1: not yet): the
+    !> ties of a degenerate problem (a train at rest) compared them again for every pair, a
+    !> strided pass over the row each time, most of a solve's time.
+    real(wp) :: row_size(n)
+    row_size = -1.0_wp
     best = 0
     best_divisor = 1.0_wp
     col_tol = rel_tol * maxval(abs(work%table(1:n, e)))
@@ -165,18 +170,20 @@ contains
       if (best == 0) then
         best = i
         best_divisor = divisor
-      else if (lex_less(work, n, i, divisor, best, best_divisor)) then
+      else if (lex_less(work, n, i, divisor, best, best_divisor, row_size)) then
         best = i
         best_divisor = divisor
       end if
     end do
   end function leaving_row
 
-  !> Row i's key divided by di below row j's divided by dj (equal within the zero levels).
-  logical function lex_less(work, n, i, di, j, dj)
+  !> Row i's key divided by di below row j's divided by dj (equal within the zero levels);
+  !> row_size: the rows' largest |B^-1| entries, filled where still -1.
+  logical function lex_less(work, n, i, di, j, dj, row_size)
     type(lcp_work_type), intent(in) :: work
     integer, intent(in) :: n, i, j
     real(wp), intent(in) :: di, dj
+    real(wp), intent(inout) :: row_size(:)
     real(wp) :: x, y, tol
     integer :: c
     associate (t => work%table)
@@ -190,8 +197,12 @@ contains
       end do
       ! B^-1's entries: equal within rounding of the rows' sizes (an exact zero against a
       ! rounded one is a tie, not a decision by noise).
-      tol = rel_tol * (maxval(abs(t(i, 1:n))) / di + maxval(abs(t(j, 1:n))) / dj)
+      if (row_size(i) < 0.0_wp) row_size(i) = maxval(abs(t(i, 1:n)))
+      if (row_size(j) < 0.0_wp) row_size(j) = maxval(abs(t(j, 1:n)))
+      tol = rel_tol * (row_size(i) / di + row_size(j) / dj)
       do c = n, 1, -1
+        ! (two zeros are equal at any tolerance: no divisions for them)
+        if (t(i, c) == 0.0_wp .and. t(j, c) == 0.0_wp) cycle
         x = t(i, c) / di
         y = t(j, c) / dj
         if (abs(x - y) > tol) then
