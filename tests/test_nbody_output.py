@@ -227,3 +227,23 @@ def test_flat_api_output_of_five_bodies_becomes_a_result():
     assert list(events["kind"]) == ["stop3", "rest_link_2_5", "stick4"]
     assert list(events["a"]) == [0, 2, 4] and list(events["b"]) == [3, 5, 0]
     assert list(events["va_after"]) == [0.0, 3.0, 0.0] and list(events["vb_before"]) == [-2.0, 2.0, 0.0]
+
+
+def test_cli_writes_a_thousand_bodies(tmp_path):
+    """A row of 1000 bodies is 2008 values (50 kB): the CLI measured its sample line in a
+    buffer of 1024 characters and ended with a Fortran runtime error ('End of record',
+    status 2, a backtrace). Now it writes the file, which reads back whole."""
+    import subprocess
+    from tools import find_tool
+    n = 1000
+    scene = tmp_path / "chain.nml"
+    scene.write_text(f"&bodies m = {n}*1.0 /\n"
+                     f"&initial x = {', '.join(f'{0.25 * i:g}' for i in range(n))}, v = 1.0, {n - 1}*0.0 /\n"
+                     f"&link d_min = {n - 1}*0.1 /\n&run t_end = 0.2, dt = 0.01, dt_out = 0.1 /\n")
+    done = subprocess.run([find_tool("impact1d"), scene, "--quiet", "-o", tmp_path / "chain.dat"],
+                          capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    res = impact1d.read_output(tmp_path / "chain.dat")
+    assert res.x.shape == (3, n) and res.bodies == tuple(range(1, n + 1))
+    np.testing.assert_allclose(res.x1, [0.0, 0.1, 0.15], atol=1e-12)    # ball 1 meets ball 2 at 0.15 s
+    np.testing.assert_allclose(res.v[-1, :3], [0.0, 1.0, 0.0], atol=1e-12)
