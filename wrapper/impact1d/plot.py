@@ -894,15 +894,28 @@ class _Mechanism:
         self.events = [e for e in self.log if self.span[0] <= e.t <= self.span[1]]
         self.ends = {row.name: (row.a, row.b) for row in self.rows}
         self.ends.update((e.contact, e.ends) for e in self.log if e.contact and e.ends)
+        self._paths = {}            # body -> path(body)
         self.by_kind = {}           # kind -> [(index in the log, event)]
         for index, e in enumerate(self.log):
             self.by_kind.setdefault(e.kind, []).append((index, e))
 
     def position(self, body, times):
-        """Body `body`'s position at `times`, linear between samples (NaN: not written)."""
+        """Body `body`'s position at `times`, linear along its path (NaN: not written)."""
         if body not in self.column:
             return np.full(np.shape(times), np.nan)
-        return np.interp(times, self.t, self.X[:, self.column[body]])
+        return np.interp(times, *self.path(body))
+
+    def path(self, body):
+        """(times, positions) of a written body: its samples and, where the log gives the
+        velocities of its impacts (va_before ... of more than two bodies), its position at
+        each impact in the window, so that a line reaches the wall or the other body where
+        the marker is instead of cutting the corner between samples (_impact_positions)."""
+        if body not in self._paths:
+            k = self.column[body]
+            times, x = _impact_positions(self, body, self.X[:, k], self.V[:, k])
+            order = np.argsort(np.concatenate([self.t, times]), kind="stable")
+            self._paths[body] = (np.concatenate([self.t, times])[order], np.concatenate([self.X[:, k], x])[order])
+        return self._paths[body]
 
     def held(self, begin, end):
         """(start, end) of each interval from a `begin` event to an `end` one (or the run's
@@ -916,6 +929,41 @@ class _Mechanism:
                 if b >= lo and a <= hi]
 
 
+def _impact_positions(mech, body, x, v):
+    """(times, positions) of body `body` at its impacts in the window, from the log's
+    velocities (va_before, vb_before, va_after, vb_after: runs of more than two bodies):
+    from the point before (a sample, or the impact before with its velocity after),
+    x_e = x_p + (v_p + v_before) (t_e - t_p) / 2, exact under constant forces between the
+    two. None known (another log): no points."""
+    events = getattr(mech.result, "events", None)
+    names = getattr(getattr(events, "dtype", None), "names", None) or ()
+    if "va_before" not in names or len(events) == 0:
+        return np.empty(0), np.empty(0)
+    if not hasattr(mech, "_impacts"):
+        kinds = [_kind_str(k) for k in events["kind"]]
+        mech._impacts = np.array([_is_impact(k) for k in kinds], dtype=bool) & \
+            (events["t"] >= mech.t[0]) & (events["t"] <= mech.t[-1])
+    ends_a, ends_b = events["a"] == body, events["b"] == body
+    mine = np.flatnonzero(mech._impacts & (ends_a | ends_b))
+    times, positions = [], []
+    last = (None, None, None)             # the impact before: (t, x, v after)
+    for j in mine[np.argsort(events["t"][mine], kind="stable")]:
+        te = float(events["t"][j])
+        before, after = (("va_before", "va_after") if ends_a[j] else ("vb_before", "vb_after"))
+        k = int(np.searchsorted(mech.t, te, side="right")) - 1
+        if last[0] is not None and (k < 0 or last[0] >= mech.t[k]):
+            tp, xp, vp = last
+        elif k >= 0:
+            tp, xp, vp = mech.t[k], x[k], v[k]
+        else:
+            continue
+        xe = xp + 0.5 * (vp + float(events[before][j])) * (te - tp)
+        times.append(te)
+        positions.append(xe)
+        last = (te, xe, float(events[after][j]))
+    return np.array(times), np.array(positions)
+
+
 def _body_colors(n):
     """The default cycle for a few bodies (1 and 2 keep today's blue and orange), a
     sequential map over the body index for more."""
@@ -927,7 +975,7 @@ def _body_colors(n):
 def _impact_points(mech):
     """{contact: (times, positions, on the ground)} of the impacts in the window: at the
     wall's position for a contact with the ground (its limit, when the scene gives it),
-    midway between the ends' positions for two bodies (linear between samples; at the one
+    midway between the ends' positions for two bodies (linear along their paths; at the one
     end written, when an output of &run bodies_out has only one)."""
     walls = {row.name: row.limit for row in mech.rows if row.a == 0}
     lo, hi = mech.span
@@ -1042,7 +1090,7 @@ def _draw_paths(ax, mech):
     _draw_ground_rows(ax, mech, colors)
     width = 1.4 if mech.n <= _LEGEND_UP_TO else 0.8
     for k, i in enumerate(mech.numbers):
-        ax.plot(mech.t, mech.X[:, k], color=colors[i - 1], linewidth=width, gid=f"x{i}",
+        ax.plot(*mech.path(i), color=colors[i - 1], linewidth=width, gid=f"x{i}",
                 label=f"x{i} (body {i})" if len(mech.numbers) <= _LEGEND_UP_TO else "_nolegend_")
     _draw_impact_marks(ax, mech)
     walls = [row.limit for row in mech.rows if row.a == 0]
@@ -1159,7 +1207,8 @@ def spacetime(result, *, mode="auto", quantity="v", t_from=None, t_to=None, path
     sequential colour map with a colour bar of the body index above 10 bodies, a legend up
     to 10), each impact where it happens (``impact:<contact>``: a cross at the wall for a
     contact with the ground, a circle midway between the two bodies' positions for a
-    contact between bodies, positions linear between samples), walls and stops
+    contact between bodies, positions linear along the paths: the samples and, for more than
+    two bodies, each body's position at its impacts from the log's velocities), walls and stops
     (``wall:<name>``), and what holds: a grey band over a body stuck by friction
     (``stuck<i>``, stick<i> to slip<i>) and an orange one over a body held on a wall, or
     between two bodies held together (``rest:<contact>``). ``mode="map"``: a colour map
