@@ -260,8 +260,11 @@ def test_many_bodies_get_a_map_of_velocity_over_body_and_time():
     np.testing.assert_allclose(dots.get_xdata(), hits)
     np.testing.assert_allclose(dots.get_ydata(), np.arange(1, 1000) + 0.5)
     assert "x1" not in gids(fig)
-    gap = artist(plot.spacetime(result, quantity="gap"), "map:gap").get_array()
+    gap_fig = plot.spacetime(result, quantity="gap")
+    gap = artist(gap_fig, "map:gap").get_array()
     assert gap.shape == (999, 2000)
+    # (an impact of balls k, k+1 on the row of their gap, k: it was drawn at k + 0.5, between rows)
+    np.testing.assert_allclose(artist(gap_fig, "impacts").get_ydata(), np.arange(1, 1000))
     np.testing.assert_allclose(gap[:, 0], 0.01)             # the initial gaps, d_min taken off
     few, _ = long_cradle(20, 200)
     fig = plot.spacetime(few)

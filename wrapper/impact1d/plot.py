@@ -1157,8 +1157,14 @@ def _draw_map(ax, mech, quantity):
                       interpolation="antialiased", gid=f"map:{quantity}", **style)
     clipped = bool(data.size) and (data.max() > style["vmax"] or data.min() < style["vmin"])
     _inset_bar(ax, image, label, extend="both" if clipped else "neither")
-    hits = [(e.t, 0.5 * (e.ends[0] + e.ends[1]) if e.ends[0] else e.ends[1])
-            for e in mech.events if _is_impact(e.kind) and e.ends]
+    # Velocity rows are bodies (a contact of two midway between them); gap rows are the
+    # gaps after body a (a neighbours' contact on its gap's row; the ground's below body b's).
+    if quantity == "gap":
+        hits = [(e.t, e.ends[0] if e.ends[0] else e.ends[1] - 0.5)
+                for e in mech.events if _is_impact(e.kind) and e.ends]
+    else:
+        hits = [(e.t, 0.5 * (e.ends[0] + e.ends[1]) if e.ends[0] else e.ends[1])
+                for e in mech.events if _is_impact(e.kind) and e.ends]
     if hits:
         # Fainter as they crowd: thousands of dots at full strength hide the map under them.
         ax.plot(*np.array(hits).T, linestyle="none", marker=".", markersize=1.5, color="black",
