@@ -18,9 +18,9 @@ export MPLBACKEND ?= Agg
 # compile serves the wheel and the Fortran unit tests, and re-runs are no-ops.
 BUILDDIR := $(CURDIR)/build/py
 # The tutorial's six cases, then the mechanisms beyond it (springs, dampers, static friction,
-# contact records).
+# contact records), then scenes of N bodies (their plots: the space-time picture).
 SCENES   := case1 case2 case3 case4 case5 case6 impact_oscillator stick_slip gear_rattle breakaway mounted_stop \
-            inner_stop
+            inner_stop newtons_cradle train ball_stack
 
 # What the installed package is made of: a change re-installs it (folders too,
 # so that a deleted file counts).
@@ -35,8 +35,8 @@ INSTALL_STAMP := $(VENV)/.installed
 help:
 	@echo "make setup   gfortran (apt, if missing), .venv, pip install .[test]"
 	@echo "make demo    run the scenes in input/ (the six cases, springs, stick-slip, rattle, break-away,"
-	@echo "             contact records),"
-	@echo "             plot them, animate case 3 (docs/case3.gif)"
+	@echo "             contact records, Newton's cradle, a train, a ball stack),"
+	@echo "             plot them, animate case 3, the cradle and the train (docs/*.gif)"
 	@echo "make test    Fortran unit tests (meson test), then pytest"
 	@echo "make study   case 5's rest time over (r_left, r_right), the impact oscillator's bifurcation diagram"
 	@echo "make bench   accuracy and speed studies, Siconos and CVODE as peers (apt, if missing)"
@@ -87,8 +87,10 @@ demo: setup
 	  impact1d input/$$name.nml; \
 	  impact1d-plot output/$$name.dat; \
 	done
-	@echo "== case3 animated (README)"
+	@echo "== case3, Newton's cradle and the train animated (README)"
 	impact1d-plot --animate output/case3.dat -o docs/case3.gif --max-frames 150 --fps 15
+	impact1d-plot --animate output/newtons_cradle.dat -o docs/cradle.gif --fps 20
+	impact1d-plot --animate output/train.dat -o docs/train.gif --t-to 2 --max-frames 80 --fps 10
 
 # An example study (README): 400 runs of case 5 on every core, then the heatmap.
 study: setup

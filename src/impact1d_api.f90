@@ -17,7 +17,7 @@ module impact1d_api
   use impact1d_fields, only: text_item
   use impact1d_output, only: memory_sink, summary_sink, column_names_text => column_names, event_names, &
     n_columns, event_impact, event_rest, present_columns, class_impact, impacts_on, &
-    row_length, row_ledger, final_row
+    row_length, row_ledger, final_row, check_bodies_out
   use impact1d_solver, only: run, run_stats
   implicit none
   private
@@ -95,11 +95,6 @@ contains
     field = 0; index = 0; value = 0.0_c_double; text_field = 0; text_index = 0
     text_codes = ichar(' '); text_lengths = 0; n_numbers = 0; n_texts = 0
     call read_scene_file(path, input, error)
-    ! (bodies_out is not a field of the assignments yet: dropped, it would change the output
-    ! without a word)
-    if (.not. allocated(error) .and. allocated(input%bodies_out)) call raise(error, status_input, path // &
-      ': &run bodies_out is read by the command line (impact1d) only for now: Python''s Scene has no ' // &
-      'bodies_out yet (remove it to load the scene here; a Result has every body: Result.x, Result.v)')
     if (failed(error, status, message)) return
     call scene_assignments(input, fields, indices, values, k, text_field, text_index, texts, n_texts)
     n_numbers = k
@@ -241,6 +236,7 @@ contains
     call apply_scene_assignments(input, n_numbers, n_texts, field, index, value, record_text_field, &
       record_text_index, record_text_end, record_blob, error)
     if (.not. allocated(error)) call prepare_scene(input, scene, error)
+    if (.not. allocated(error)) call check_bodies_out(input, error)
     if (put_error(error, info, text_codes)) return
     warnings = trim(scene%warnings)
     info(8) = scene%n_bodies

@@ -19,15 +19,16 @@ module impact1d_chain
   implicit none
   private
   public :: settle_chain, validate_chain, input_records, mechanism_records, n_bodies_of, slot_of, alias_slot
-  public :: id_arrays, id_r_meet, id_contact, id_spring, id_sine, n_ids, field_name, field_is_text, assign_number, &
+  public :: id_arrays, id_r_meet, id_contact, id_spring, id_sine, id_bodies_out, n_ids, field_name, field_is_text, assign_number, &
     assign_text, scene_assignments
 
   !> The input fields' numbering (the namelist reader's and the flat API's): 1..n_real the
   !> tutorial's scalars, then its texts, the arrays (impact1d_fields' order), r_meet, the
-  !> &contact record fields, the &spring record fields, the &sine record fields.
+  !> &contact record fields, the &spring record fields, the &sine record fields, &run
+  !> bodies_out (element i: the i-th body written).
   integer, parameter :: id_arrays = n_real + n_text, id_r_meet = id_arrays + n_arrays + 1, &
     id_contact = id_r_meet, id_spring = id_contact + n_contact_fields, id_sine = id_spring + n_spring_fields, &
-    n_ids = id_sine + n_sine_fields
+    id_bodies_out = id_sine + n_sine_fields + 1, n_ids = id_bodies_out
 
 
   !> alias_slot(j, i) for i = 1, 2 (0: no such name), impact1d_fields' array order:
@@ -842,8 +843,10 @@ contains
       name = 'contact.' // contact_fields(id - id_contact)
     else if (id > id_spring .and. id <= id_sine) then
       name = 'spring.' // spring_fields(id - id_spring)
-    else if (id > id_sine .and. id <= n_ids) then
+    else if (id > id_sine .and. id < id_bodies_out) then
       name = 'sine.' // sine_fields(id - id_sine)
+    else if (id == id_bodies_out) then
+      name = 'bodies_out'
     end if
   end function field_name
 
@@ -874,10 +877,32 @@ contains
       call set_record_field(input%chain%contacts, index, id - id_contact, value)
     else if (id > id_spring .and. id <= id_sine) then
       call set_record_field(input%chain%springs, index, id - id_spring, value)
-    else if (id > id_sine .and. id <= n_ids) then
+    else if (id > id_sine .and. id < id_bodies_out) then
       call set_record_field(input%chain%sines, index, id - id_sine, value)
+    else if (id == id_bodies_out) then
+      call set_body_out(input, index, value)
     end if
   end subroutine assign_number
+
+  !> Element index of bodies_out := value (grown to index, bodies skipped 0; a value that is
+  !> not a whole number is -1: check_bodies_out refuses either as a body the scene lacks).
+  pure subroutine set_body_out(input, index, value)
+    type(scene_input), intent(inout) :: input
+    integer, intent(in) :: index
+    real(wp), intent(in) :: value
+    integer, allocatable :: bodies(:)
+    if (.not. allocated(input%bodies_out)) allocate(input%bodies_out(0))
+    if (size(input%bodies_out) < index) then
+      allocate(bodies(index))
+      bodies = 0
+      bodies(:size(input%bodies_out)) = input%bodies_out
+      call move_alloc(bodies, input%bodies_out)
+    end if
+    input%bodies_out(index) = -1
+    if (abs(value) < 1.0e9_wp) then
+      if (value == aint(value)) input%bodies_out(index) = nint(value)
+    end if
+  end subroutine set_body_out
 
   !> Field f of record index := value (the records grown to index).
   pure subroutine set_record_field(records, index, f, value)
@@ -955,7 +980,8 @@ contains
       if (id > id_arrays .and. id < id_r_meet) last = input%chain%array(id - id_arrays)%n
       if (id > id_contact .and. id <= id_spring .and. allocated(input%chain%contacts)) last = size(input%chain%contacts)
       if (id > id_spring .and. id <= id_sine .and. allocated(input%chain%springs)) last = size(input%chain%springs)
-      if (id > id_sine .and. allocated(input%chain%sines)) last = size(input%chain%sines)
+      if (id > id_sine .and. id < id_bodies_out .and. allocated(input%chain%sines)) last = size(input%chain%sines)
+      if (id == id_bodies_out .and. allocated(input%bodies_out)) last = size(input%bodies_out)
       if (id <= id_arrays .or. id == id_r_meet) then
         call put_field(input, id, 0, field, index, value, n_numbers, text_field, text_index, texts, n_texts)
       end if
@@ -1020,8 +1046,11 @@ contains
       call record_value(input%chain%contacts(i), id - id_contact, given, number, text)
     else if (id <= id_sine) then
       call record_value(input%chain%springs(i), id - id_spring, given, number, text)
-    else
+    else if (id < id_bodies_out) then
       call record_value(input%chain%sines(i), id - id_sine, given, number, text)
+    else
+      number = real(input%bodies_out(i), wp)
+      given = .true.
     end if
     if (field_is_text(id) .and. id /= id_arrays + a_f_table) given = len(text) > 0
   end subroutine field_value

@@ -299,7 +299,8 @@ contains
     finish = name_end(nml%flat, j)
     name = lower(nml%flat(j:finish))
     field = field_index(name, nml%open_group)
-    ! (&run bodies_out: a list of bodies, not a field of the scene's assignments)
+    ! (&run bodies_out: a list of bodies in one line, read by read_body_list as the CLI's
+    ! --bodies-out is; the flat API gives it as field id_bodies_out, one element a body)
     bodies_out = name == 'bodies_out' .and. nml%open_group == g_run
     if (field == 0 .and. .not. bodies_out) then
       k = scan(nml%flat(j:) // ' ', ' ,;=/')

@@ -1022,8 +1022,14 @@ contains
     real(wp), intent(in) :: value
     integer, intent(in) :: n_values
     character(len=*), intent(in), optional :: name
-    character(len=1024) :: line
+    ! (as long as the line may be: es25.16e3 is 25 characters a value, and 1000 bodies
+    ! write 2008 values; a fixed buffer of 1024 ended the run with 'End of record')
+    character(len=:), allocatable :: line
     real(wp) :: values(n_values)
+    integer :: extra
+    extra = 0
+    if (present(name)) extra = len(name)
+    allocate(character(len=32 * (n_values + 1) + extra) :: line)
     values = value
     if (present(name)) then
       write(line, format) value, name, values

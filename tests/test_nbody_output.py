@@ -167,7 +167,7 @@ NAMELIST = """&bodies m1 = 1.0, m2 = 2.0 /
 def test_namelist_bodies_out(tmp_path):
     """&run bodies_out = ... in a namelist limits the CLI's columns as --bodies-out does (the
     list ends where the next variable starts); a bad list is bad input naming the line; Python's
-    load_scene refuses it rather than drop it (its Scene has no bodies_out yet)."""
+    load_scene reads it as Scene.bodies_out and simulate writes the same columns."""
     import subprocess
     from tools import find_tool
     cli = find_tool("impact1d")
@@ -182,9 +182,45 @@ def test_namelist_bodies_out(tmp_path):
         scene.write_text(NAMELIST.format(bad))
         proc = subprocess.run([cli, scene, "--quiet", "-o", tmp_path / "bad.dat"], capture_output=True, text=True)
         assert proc.returncode == 1 and message in proc.stderr, (bad, proc.stderr)
-    scene.write_text(NAMELIST.format("bodies_out = 2"))
-    with pytest.raises(impact1d.InputError, match="bodies_out is read by the command line"):
-        impact1d.load_scene(scene)
+    # Python reads it as Scene.bodies_out (it used to refuse it) and runs it as the CLI does.
+    scene.write_text(NAMELIST.format("bodies_out = 2, dt_out = 0.01"))
+    loaded = impact1d.load_scene(scene)
+    assert loaded.bodies_out == [2]
+    res_py = impact1d.simulate(loaded)
+    assert res_py.columns == res.columns and res_py.bodies == (2,) and res_py.x1 is None
+    np.testing.assert_array_equal(res_py.samples, res.samples)
+
+
+def test_python_bodies_out():
+    """Scene(bodies_out=...) and simulate(scene, bodies_out=[...]): the x and v of those
+    bodies only, the same numbers as a run of every body, the ledger unchanged; a bad list
+    is InputError with the namelist's messages. The namelist's &run bodies_out of more than
+    two bodies comes back in load_scene's Scene."""
+    from pathlib import Path
+    root = Path(__file__).parent.parent
+    cradle = impact1d.load_scene(root / "input" / "newtons_cradle.nml")
+    full = impact1d.simulate(cradle)
+    some = impact1d.simulate(cradle, bodies_out=[1, 5])
+    assert some.bodies == (1, 5) and some.x.shape == (len(full.t), 2) and some.x2 is None and some.x3 is None
+    assert some.columns[:5] == ("t", "x1", "v1", "x5", "v5")
+    np.testing.assert_array_equal(some.x5, full.x5)
+    np.testing.assert_array_equal(some.v1, full.v1)
+    np.testing.assert_array_equal(some.ke, full.ke)
+    assert some.scene.bodies_out == [1, 5] and list(some.events["kind"]) == list(full.events["kind"])
+    two = impact1d.simulate(impact1d.Scene(m1=1.0, m2=2.0, x1=0.0, v1=1.0, x2=5.0, t_end=0.1, dt=1e-3,
+                                           bodies_out=[2]))
+    assert two.columns == ("t", "x2", "v2", "ke", "work", "friction_loss", "impact_loss", "residual")
+    for bad, message in (([3, 1], "increasing order"), ([7], "does not have"), ([0], "does not have"),
+                         ([1.5], "list of body numbers"), ("1", "list of body numbers"), ([], "names no body")):
+        with pytest.raises(impact1d.InputError, match=message):
+            impact1d.simulate(cradle, bodies_out=bad)
+    text = (root / "input" / "newtons_cradle.nml").read_text().replace("&run ", "&run bodies_out = 2, 4, ")
+    import tempfile
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "cradle.nml"
+        path.write_text(text)
+        loaded = impact1d.load_scene(path)
+    assert loaded.bodies_out == [2, 4] and impact1d.simulate(loaded).bodies == (2, 4)
 
 
 def test_flat_api_output_of_five_bodies_becomes_a_result():
@@ -227,3 +263,23 @@ def test_flat_api_output_of_five_bodies_becomes_a_result():
     assert list(events["kind"]) == ["stop3", "rest_link_2_5", "stick4"]
     assert list(events["a"]) == [0, 2, 4] and list(events["b"]) == [3, 5, 0]
     assert list(events["va_after"]) == [0.0, 3.0, 0.0] and list(events["vb_before"]) == [-2.0, 2.0, 0.0]
+
+
+def test_cli_writes_a_thousand_bodies(tmp_path):
+    """A row of 1000 bodies is 2008 values (50 kB): the CLI measured its sample line in a
+    buffer of 1024 characters and ended with a Fortran runtime error ('End of record',
+    status 2, a backtrace). Now it writes the file, which reads back whole."""
+    import subprocess
+    from tools import find_tool
+    n = 1000
+    scene = tmp_path / "chain.nml"
+    scene.write_text(f"&bodies m = {n}*1.0 /\n"
+                     f"&initial x = {', '.join(f'{0.25 * i:g}' for i in range(n))}, v = 1.0, {n - 1}*0.0 /\n"
+                     f"&link d_min = {n - 1}*0.1 /\n&run t_end = 0.2, dt = 0.01, dt_out = 0.1 /\n")
+    done = subprocess.run([find_tool("impact1d"), scene, "--quiet", "-o", tmp_path / "chain.dat"],
+                          capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    res = impact1d.read_output(tmp_path / "chain.dat")
+    assert res.x.shape == (3, n) and res.bodies == tuple(range(1, n + 1))
+    np.testing.assert_allclose(res.x1, [0.0, 0.1, 0.15], atol=1e-12)    # ball 1 meets ball 2 at 0.15 s
+    np.testing.assert_allclose(res.v[-1, :3], [0.0, 1.0, 0.0], atol=1e-12)

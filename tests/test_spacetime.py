@@ -127,8 +127,37 @@ def test_rows_of_todays_scene_and_of_records():
     scene = SimpleNamespace(contacts=[dict(a=3, b=0, d_min=-2.0, name="stop3"),
                                       dict(a=1, b=2, d_min=0.25, d_max=0.5, name="link1")])
     rows = plot._rows(SimpleNamespace(scene=scene), 3)
+    # (bodies 2 and 3 meet, as the engine has them: no record joins them)
     assert [(r.name, r.a, r.b, r.side, r.limit) for r in rows] == [
+        ("link2", 2, 3, "min", 0.0),
         ("stop3", 0, 3, "max", 2.0), ("link1_min", 1, 2, "min", 0.25), ("link1_max", 1, 2, "max", 0.5)]
+
+
+@pytest.mark.parametrize("name", ["newtons_cradle", "train", "ball_stack"])
+def test_rows_of_the_chain_shorthand_are_the_engines(name):
+    """The &link arrays of more than two bodies are contact rows (link<i>), named and ordered
+    as the engine names its rows (event_kinds), with their limits: the cradle's balls touch
+    at 0.0625 m, the train's couplers have 62.5 mm of slack. Before, the pictures knew no
+    link of a chain (the Result's scene had lost its arrays, and _rows read scalars only)."""
+    scene = impact1d.load_scene(ROOT / "input" / f"{name}.nml")
+    result = impact1d.simulate(scene, t_end=0.01)
+    rows = plot._rows(result, len(scene.m))
+    assert [r.name for r in rows] == list(impact1d.event_kinds(scene)[:len(rows)])
+    assert impact1d.event_kinds(scene)[len(rows)].startswith("rest_")
+    limits = {(r.name, r.side): r.limit for r in rows}
+    if name == "newtons_cradle":
+        assert limits == {(f"link{i}", "min"): 0.0625 for i in range(1, 5)}
+    elif name == "train":
+        assert limits[("link9_max", "max")] == 16.0625 and limits[("link1_min", "min")] == 16.0
+        assert len(rows) == 18
+
+
+def test_chain_springs_for_the_animation():
+    """The chain's spring arrays (k, x_rest per body; k_link, d_rest per link), then the
+    &spring records."""
+    scene = SimpleNamespace(k=[10.0, 0.0, 5.0], x_rest=[0.0, 1.0, 2.0], k_link=[0.0, 20.0],
+                            d_rest=[0.3, 0.4], springs=[dict(a=1, b=3, k=1.0, d_rest=0.5)])
+    assert plot._springs(SimpleNamespace(scene=scene), 3) == [(0, 1, 0.0), (0, 3, 2.0), (2, 3, 0.4), (1, 3, 0.5)]
 
 
 # ----------------------------------------------------------------------------
@@ -231,8 +260,11 @@ def test_many_bodies_get_a_map_of_velocity_over_body_and_time():
     np.testing.assert_allclose(dots.get_xdata(), hits)
     np.testing.assert_allclose(dots.get_ydata(), np.arange(1, 1000) + 0.5)
     assert "x1" not in gids(fig)
-    gap = artist(plot.spacetime(result, quantity="gap"), "map:gap").get_array()
+    gap_fig = plot.spacetime(result, quantity="gap")
+    gap = artist(gap_fig, "map:gap").get_array()
     assert gap.shape == (999, 2000)
+    # (an impact of balls k, k+1 on the row of their gap, k: it was drawn at k + 0.5, between rows)
+    np.testing.assert_allclose(artist(gap_fig, "impacts").get_ydata(), np.arange(1, 1000))
     np.testing.assert_allclose(gap[:, 0], 0.01)             # the initial gaps, d_min taken off
     few, _ = long_cradle(20, 200)
     fig = plot.spacetime(few)
@@ -240,6 +272,29 @@ def test_many_bodies_get_a_map_of_velocity_over_body_and_time():
     assert "map:v" in gids(plot.spacetime(few, mode="map"))
     with pytest.raises(ValueError, match="mode"):
         plot.spacetime(few, mode="bars")
+
+
+def test_map_scale_is_that_of_most_moving_bodies_and_crowded_impacts_are_faint():
+    """One body thrown off fast among many slow ones: the colour scale is the 99th
+    percentile of the moving bodies' speeds (the fast one saturates, the bar says so), not
+    the fastest (which left every other body white); thousands of impact dots are faint
+    (at full strength they hid the map: 1,000 random balls, 7,264 impacts)."""
+    result, hits = long_cradle(1000, 2000)
+    result.v = result.v.copy()
+    result.v[:, 0] *= 0.1                       # (ball 1 slower,)
+    result.v[-1, -1] = 50.0                     # (one sample of the last ball fast)
+    fig = plot.spacetime(result)
+    image = artist(fig, "map:v")
+    assert image.norm.vmax == pytest.approx(1.0) and image.norm.vmin == pytest.approx(-1.0)
+    assert image.colorbar.extend == "both"
+    assert artist(fig, "impacts").get_alpha() == pytest.approx(0.4)        # 999 impacts
+    crowded = SimpleNamespace(**vars(result))
+    crowded.events = np.concatenate([result.events] * 4)
+    assert artist(plot.spacetime(crowded), "impacts").get_alpha() == pytest.approx(0.4 * 1000 / (4 * 999))
+    crowded.events = np.concatenate([result.events] * 20)
+    assert artist(plot.spacetime(crowded), "impacts").get_alpha() == 0.08        # (its floor)
+    calm = artist(plot.spacetime(long_cradle(1000, 2000)[0]), "map:v")
+    assert calm.norm.vmax == pytest.approx(1.0) and calm.colorbar.extend == "neither"
 
 
 def test_figure_draws_the_spacetime_plot_for_three_bodies_or_more(cradle):
@@ -333,3 +388,72 @@ def test_cli_animates_a_run(tmp_path):
     done = subprocess.run([find_tool("impact1d-plot"), "--animate", "--separate", str(out)],
                           capture_output=True, text=True)
     assert done.returncode == 1 and "--animate writes one animation" in done.stderr
+
+
+# ----------------------------------------------------------------------------
+# the N-body scenes of input/ and outputs of some bodies (--bodies-out)
+
+
+def test_cradle_animation_balls_touch_and_train_couplers_show_their_state():
+    """The cradle's blocks are one diameter wide (its &link d_min: balls 2-5 touch; they
+    were 4 % of the span wide, apart, when the pictures knew no chain link). The train's
+    couplers are squares above the joints: at t = 0 every one blue (buffers touching), at
+    0.25 s (after the locomotive's take-up at 0.224 s, before the next at 0.355 s) link 9
+    red (taut), link 8 grey (in its slack), at 2 s all taut."""
+    figures, factory = recorded()
+    anim = plot.animate(run("newtons_cradle"), max_frames=3, figure_factory=factory)
+    anim._draw_was_started = True       # (not saved: matplotlib's warning is not for this)
+    assert artist(figures[0], "block3").get_width() == 0.0625
+    train = run("train", t_end=2.0)
+    ax = Figure().subplots()
+    stage = plot._Stage(ax, plot._Mechanism(train), plot._springs(train, 10))
+    couplers = artist(ax.figure, "couplers")
+    blue, grey, red = (matplotlib.colors.to_rgba(c) for c, _ in plot._Couplers.STATES)
+    for t, expected in ((0.0, [blue] * 9), (0.25, [blue] * 7 + [grey, red]), (2.0, [red] * 9)):
+        stage.show(int(np.argmin(np.abs(train.t - t))))
+        assert [tuple(c) for c in couplers.get_facecolors()] == expected, t
+        np.testing.assert_allclose(couplers.get_offsets()[:, 0], 0.5 * (train.x[:, :-1] + train.x[:, 1:])[
+            int(np.argmin(np.abs(train.t - t)))])
+
+
+def bodies_out(tmp_path, scene, bodies):
+    out = tmp_path / f"{scene}.dat"
+    done = subprocess.run([find_tool("impact1d"), str(ROOT / "input" / f"{scene}.nml"), "--quiet",
+                           "--bodies-out", bodies, "-o", str(out)], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    return out
+
+
+def test_plot_of_an_output_of_some_bodies(tmp_path):
+    """impact1d-plot on a --bodies-out output: case 3 with body 2 only used to fail ('x and y
+    must have same first dimension': the panels assumed x1); now it is the space-time picture
+    of body 2 with its impacts on it (the slot's, whose other end is not written, on x2), and
+    a cradle of balls 1 and 5 has x1 and x5 (not x1 and x2). The animation refuses them."""
+    out = bodies_out(tmp_path, "case3", "2")
+    done = subprocess.run([find_tool("impact1d-plot"), str(out)], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert (tmp_path / "case3.png").stat().st_size > 0
+    result = impact1d.read_output(out)
+    fig = plot.figure(result)
+    assert fig.axes[0].get_label() == "spacetime" and {"x2", "wall:left", "wall:right"} <= gids(fig)
+    assert "x1" not in gids(fig)
+    slot = artist(fig, "impact:slot_min")
+    times = slot.get_xdata()
+    assert times.size > 0 and np.all(np.isfinite(slot.get_ydata()))
+    np.testing.assert_allclose(slot.get_ydata(), np.interp(times, result.t, result.x2))
+    cradle = impact1d.read_output(bodies_out(tmp_path, "newtons_cradle", "1,5"))
+    fig = plot.spacetime(cradle)
+    assert {"x1", "x5"} <= gids(fig) and "x2" not in gids(fig)
+    # The paths are the samples and each ball's position at its impact (from the log's
+    # velocities): ball 1 reaches 0.1875 m at 0.375 s, where it meets ball 2, instead of
+    # cutting the corner between the samples at 0.37 and 0.38 s.
+    for body, where in ((1, 0.1875), (5, 0.4375)):
+        line = artist(fig, f"x{body}")
+        times, ys = line.get_xdata(), line.get_ydata()
+        assert times.size == cradle.t.size + 1 and np.all(np.diff(times) >= 0)
+        np.testing.assert_array_equal(np.delete(ys, np.flatnonzero(times == 0.375)[0]), getattr(cradle, f"x{body}"))
+        assert ys[times == 0.375][0] == pytest.approx(where, abs=1e-12)
+    with pytest.raises(ValueError, match="bodies 1, 5 of 5"):
+        plot.animate(cradle)
+    with pytest.raises(ValueError, match="every body"):
+        plot.spacetime(cradle, mode="map")

@@ -155,6 +155,7 @@ class Scene:
     contacts: Optional[Sequence[dict]] = None
     springs: Optional[Sequence[dict]] = None
     sines: Optional[Sequence[dict]] = None     # &sine records: {"body", "amp", "period", "phase"}
+    bodies_out: Optional[Sequence[int]] = None  # &run bodies_out: the bodies whose x, v a run keeps
 
 
 def decode(text) -> str:
@@ -172,7 +173,7 @@ def _words(text) -> tuple:
 
 # Every input field as the core numbers them (id k: the k-th name).
 INPUT_FIELDS = REAL_FIELDS + TEXT_FIELDS + ARRAY_FIELDS + ("r_meet",) + \
-    tuple(prefix + name for _, prefix, fields in _RECORD_GROUPS for name in fields)
+    tuple(prefix + name for _, prefix, fields in _RECORD_GROUPS for name in fields) + ("bodies_out",)
 
 
 def _check_field_order() -> None:
@@ -189,7 +190,9 @@ _SCENE_FIELDS = tuple(f.name for f in dataclasses.fields(Scene))
 # (the N-body fields after source: positional Scene(...) calls keep their meaning)
 _NBODY_FIELDS = tuple(name for name in ARRAY_FIELDS if name not in _SHARED_FIELDS) + \
     ("r_meet", "contacts", "springs", "sines")
-assert _SCENE_FIELDS == REAL_FIELDS + TEXT_FIELDS + ("source",) + _NBODY_FIELDS
+# (what a run writes, whatever the scene's form; it goes to the core with the records)
+_OUTPUT_FIELDS = ("bodies_out",)
+assert _SCENE_FIELDS == REAL_FIELDS + TEXT_FIELDS + ("source",) + _NBODY_FIELDS + _OUTPUT_FIELDS
 # Field ids: the scalars' and texts' by name, the arrays' apart (d_min is both).
 _ID = {name: k + 1 for k, name in reversed(list(enumerate(INPUT_FIELDS)))}
 _ARRAY_ID = {name: len(REAL_FIELDS + TEXT_FIELDS) + k + 1 for k, name in enumerate(ARRAY_FIELDS)}
@@ -314,6 +317,9 @@ def to_assignments(scene: Scene):
     for name, value in vars(scene).items():
         if value is None or name in ("source",) + _RECORD_NAMES:
             continue
+        if name in _OUTPUT_FIELDS:
+            numbers += _body_list(name, value)
+            continue
         if name in ARRAY_FIELDS and (_is_sequence(value) or name not in _SHARED_FIELDS):
             if not _is_sequence(value):
                 raise InputError(f"{name} must be a list (one value per body or link), got {value!r:.80}")
@@ -336,6 +342,17 @@ def to_assignments(scene: Scene):
                 else:
                     numbers.append((_ID[prefix + key], j, _number(f"{group}[{j - 1}].{key}", value)))
     return numbers, texts
+
+
+def _body_list(name, value):
+    """bodies_out = [1, 10, 20] as assignments (element i: a body number; the core checks
+    them against the scene, as the namelist's)."""
+    if not _is_sequence(value) or any(isinstance(item, bool) or float(_number(name, item)) != int(_number(name, item))
+                                      for item in value):
+        raise InputError(f"{name} must be a list of body numbers (bodies_out=[1, 10, 20]), got {value!r:.80}")
+    if len(value) == 0:
+        raise InputError(f"{name} names no body (None: every body)")      # (the core's words)
+    return [(_ID[name], i, float(item)) for i, item in enumerate(value, start=1)]
 
 
 def _packed(numbers, texts):
@@ -364,9 +381,10 @@ _NO_RECORDS = _packed([], [])
 
 
 def record_fields(scene: Scene) -> dict:
-    """The scene's record lists that are given ({"contacts": [...], ...}; {} for none)."""
+    """The scene's record lists that are given ({"contacts": [...], ...}; {} for none), and
+    its bodies_out (which goes to the core with them, whatever the scene's form)."""
     fields = vars(scene)
-    return {name: fields[name] for name in _RECORD_NAMES if fields[name] is not None}
+    return {name: fields[name] for name in _RECORD_NAMES + _OUTPUT_FIELDS if fields[name] is not None}
 
 
 def _settled(scene: Scene):
@@ -447,4 +465,4 @@ def _put(kwargs: dict, name: str, index: int, value) -> None:
     else:
         array = kwargs.setdefault(name, [])
         array.extend(None for _ in range(index - len(array)))
-        array[index - 1] = value
+        array[index - 1] = int(value) if name in _OUTPUT_FIELDS else value

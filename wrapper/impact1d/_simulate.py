@@ -412,9 +412,10 @@ def _make_form(scene: Scene, overrides: dict) -> CoreForm:
     form.flat = not is_nbody_form(scene)
     form.records = record_assignments(scene) if form.flat or not _more_than_two(scene) else \
         _packed(*to_assignments(scene))
-    if not form.flat:
-        # (written with arrays: the Result's scene is the one run, in the tutorial's names,
-        # with its records)
+    if not form.flat and not _more_than_two(scene):
+        # (one or two bodies written with arrays: the Result's scene is the one run, in the
+        # tutorial's names, with its records; more bodies keep their arrays, which the
+        # tutorial's names cannot hold and the N-body plots read: the links, the springs)
         scene = dataclasses.replace(from_core(*form.core, source=scene.source), **record_fields(scene))
     texts = form.core[2:]
     form.blob = b"".join(texts) or b" "           # (f2py refuses an empty string)

@@ -552,7 +552,7 @@ def _draw_energy(ax, result, name, label, color, ylabel):
 
 def _draw_kinetic_energy(ax, result, events):
     label = "KE = m1 v1\u00b2/2" + (" + m2 v2\u00b2/2" if result.v2 is not None else "")
-    if _bodies(result.result)[1].shape[1] > 2:
+    if _bodies(result.result)[1].shape[1] > 2 or not _every_body(result.result):
         label = "KE = \u03a3 m_i v_i\u00b2/2"
     _draw_energy(ax, result, "ke", label, "black", "kinetic energy (J)")
 
@@ -680,6 +680,7 @@ def _draw_residual(ax, result, events):
 _NOT_IMPACTS = ("rest_", "release_", "stick", "slip")
 _MAP_ABOVE = 50         # more bodies than this: a colour map over body index and time
 _LEGEND_UP_TO = 10      # bodies named in a legend (more: a colour bar of the body index)
+_DOTS_CLEAR = 1000      # impacts on a map drawn at full strength (more: fainter)
 
 
 def _is_impact(kind):
@@ -707,6 +708,31 @@ def _bodies(result):
     return t, X, np.asarray(v, dtype=float).reshape(t.size, -1)
 
 
+def _written(result, columns):
+    """(numbers, n): the body number of each of the `columns` columns of x (Result.bodies:
+    every body, or those of &run bodies_out; 1, 2, ... when the result does not say) and
+    the scene's number of bodies (its m's length, or 2 with m2, 1 with m1 alone; else the
+    highest body written)."""
+    numbers = tuple(int(b) for b in (getattr(result, "bodies", None) or ()))
+    if len(numbers) != columns:
+        numbers = tuple(range(1, columns + 1))
+    m = _scene_value(result, "m")
+    if isinstance(m, (list, tuple, np.ndarray)):
+        n = len(m)
+    elif _scene_value(result, "m2") is not None:
+        n = 2
+    else:
+        n = 1 if _scene_value(result, "m1") is not None else 0
+    return numbers, max([n, *numbers])
+
+
+def _every_body(result):
+    """Whether the result has the x and v of every body of its scene (not so for an output
+    of &run bodies_out)."""
+    numbers, n = _written(result, _bodies(result)[1].shape[1])
+    return numbers == tuple(range(1, n + 1))
+
+
 class _Row(NamedTuple):
     """One limit of a contact record: x_b - x_a >= limit ("min") or <= limit ("max")."""
     name: str           # the event kind of its impacts
@@ -717,11 +743,12 @@ class _Row(NamedTuple):
     record: int         # the record it comes from (a slot's two rows share one)
 
 
-def _tutorial_records(result, n, joined=False):
+def _tutorial_records(result, n, joined=()):
     """Today's walls and slot as contact records (docs/nbody-plan.md, 'Today's scene in
     records'): left (0, 1) lower, right (0, N) upper, the slot (1, 2) with its meeting
-    (none when a record joins the bodies, `joined`, and the scene gives no d_min: the
-    record replaces the meeting, as in the engine)."""
+    (none when a record joins the bodies, (1, 2) in `joined`, and the scene gives no d_min:
+    the record replaces the meeting, as in the engine); more than two bodies: link i of
+    the chain shorthand (_chain_links)."""
     value = {name: _float_or_none(_scene_value(result, name))
              for name in ("x_left", "x_right", "d_min", "d_max")}
     records = []
@@ -729,15 +756,36 @@ def _tutorial_records(result, n, joined=False):
         records.append(dict(a=0, b=1, d_min=value["x_left"], name="left"))
     if value["x_right"] is not None:
         records.append(dict(a=0, b=n, d_max=value["x_right"], name="right"))
+    if n > 2:
+        return records + _chain_links(result, n, joined)
     if n == 2:
         slot = dict(a=1, b=2, name="slot", name_min="slot_min", name_max="slot_max")
-        if value["d_min"] is not None or not joined:
+        if value["d_min"] is not None or (1, 2) not in joined:
             slot["d_min"] = value["d_min"] or 0.0
         if value["d_max"] is not None:
             slot["d_max"] = value["d_max"]
         if "d_min" in slot or "d_max" in slot:
             records.append(slot)
     return records
+
+
+def _chain_links(result, n, joined):
+    """Link i of more than two bodies (on x(i+1) - x(i), named link<i>), as the engine makes
+    it (impact1d_chain's link_records): its &link d_min (d_max) element, or the bodies'
+    meeting (d_min = 0) unless a &contact record joins the pair (in `joined`)."""
+    arrays = {name: _scene_value(result, name) for name in ("d_min", "d_max")}
+    links = []
+    for i in range(1, n):
+        link = dict(a=i, b=i + 1, name=f"link{i}")
+        for name, values in arrays.items():
+            if isinstance(values, (list, tuple, np.ndarray)) and i <= len(values) and \
+                    _float_or_none(values[i - 1]) is not None:
+                link[name] = float(values[i - 1])
+        if "d_min" not in link and (i, i + 1) not in joined:
+            link["d_min"] = 0.0
+        if len(link) > 3:
+            links.append(link)
+    return links
 
 
 def _record_rows(j, record):
@@ -774,8 +822,7 @@ def _scene_record_rows(result):
 def _rows(result, n):
     """The contact rows in the engine's order: today's walls and slot (a one- or two-body
     scene's), then the scene's records."""
-    joined = any(sorted((int(_field(r, "a", 0)), int(_field(r, "b", 0)))) == [1, 2]
-                 for r in _scene_records(result))
+    joined = {tuple(sorted((int(_field(r, "a", 0)), int(_field(r, "b", 0))))) for r in _scene_records(result)}
     tutorial = _tutorial_records(result, n, joined)
     return [row for record in tutorial for row in _record_rows(0, record)] + _scene_record_rows(result)
 
@@ -831,7 +878,10 @@ class _Mechanism:
 
     def __init__(self, result, t_from=None, t_to=None):
         t, X, V = _bodies(result)
-        self.result, self.n = result, X.shape[1]
+        # (an output of &run bodies_out has some bodies: numbers says which, n counts all)
+        self.numbers, self.n = _written(result, X.shape[1])
+        self.column = {body: k for k, body in enumerate(self.numbers)}
+        self.result = result
         self.run = (float(t[0]), float(t[-1])) if t.size else (0.0, 0.0)
         self.span = _span(self.run, t_from, t_to)
         inside = _samples_around(t, self.span)
@@ -844,13 +894,28 @@ class _Mechanism:
         self.events = [e for e in self.log if self.span[0] <= e.t <= self.span[1]]
         self.ends = {row.name: (row.a, row.b) for row in self.rows}
         self.ends.update((e.contact, e.ends) for e in self.log if e.contact and e.ends)
+        self._paths = {}            # body -> path(body)
         self.by_kind = {}           # kind -> [(index in the log, event)]
         for index, e in enumerate(self.log):
             self.by_kind.setdefault(e.kind, []).append((index, e))
 
     def position(self, body, times):
-        """Body `body`'s position at `times`, linear between samples."""
-        return np.interp(times, self.t, self.X[:, body - 1])
+        """Body `body`'s position at `times`, linear along its path (NaN: not written)."""
+        if body not in self.column:
+            return np.full(np.shape(times), np.nan)
+        return np.interp(times, *self.path(body))
+
+    def path(self, body):
+        """(times, positions) of a written body: its samples and, where the log gives the
+        velocities of its impacts (va_before ... of more than two bodies), its position at
+        each impact in the window, so that a line reaches the wall or the other body where
+        the marker is instead of cutting the corner between samples (_impact_positions)."""
+        if body not in self._paths:
+            k = self.column[body]
+            times, x = _impact_positions(self, body, self.X[:, k], self.V[:, k])
+            order = np.argsort(np.concatenate([self.t, times]), kind="stable")
+            self._paths[body] = (np.concatenate([self.t, times])[order], np.concatenate([self.X[:, k], x])[order])
+        return self._paths[body]
 
     def held(self, begin, end):
         """(start, end) of each interval from a `begin` event to an `end` one (or the run's
@@ -864,6 +929,41 @@ class _Mechanism:
                 if b >= lo and a <= hi]
 
 
+def _impact_positions(mech, body, x, v):
+    """(times, positions) of body `body` at its impacts in the window, from the log's
+    velocities (va_before, vb_before, va_after, vb_after: runs of more than two bodies):
+    from the point before (a sample, or the impact before with its velocity after),
+    x_e = x_p + (v_p + v_before) (t_e - t_p) / 2, exact under constant forces between the
+    two. None known (another log): no points."""
+    events = getattr(mech.result, "events", None)
+    names = getattr(getattr(events, "dtype", None), "names", None) or ()
+    if "va_before" not in names or len(events) == 0:
+        return np.empty(0), np.empty(0)
+    if not hasattr(mech, "_impacts"):
+        kinds = [_kind_str(k) for k in events["kind"]]
+        mech._impacts = np.array([_is_impact(k) for k in kinds], dtype=bool) & \
+            (events["t"] >= mech.t[0]) & (events["t"] <= mech.t[-1])
+    ends_a, ends_b = events["a"] == body, events["b"] == body
+    mine = np.flatnonzero(mech._impacts & (ends_a | ends_b))
+    times, positions = [], []
+    last = (None, None, None)             # the impact before: (t, x, v after)
+    for j in mine[np.argsort(events["t"][mine], kind="stable")]:
+        te = float(events["t"][j])
+        before, after = (("va_before", "va_after") if ends_a[j] else ("vb_before", "vb_after"))
+        k = int(np.searchsorted(mech.t, te, side="right")) - 1
+        if last[0] is not None and (k < 0 or last[0] >= mech.t[k]):
+            tp, xp, vp = last
+        elif k >= 0:
+            tp, xp, vp = mech.t[k], x[k], v[k]
+        else:
+            continue
+        xe = xp + 0.5 * (vp + float(events[before][j])) * (te - tp)
+        times.append(te)
+        positions.append(xe)
+        last = (te, xe, float(events[after][j]))
+    return np.array(times), np.array(positions)
+
+
 def _body_colors(n):
     """The default cycle for a few bodies (1 and 2 keep today's blue and orange), a
     sequential map over the body index for more."""
@@ -875,7 +975,8 @@ def _body_colors(n):
 def _impact_points(mech):
     """{contact: (times, positions, on the ground)} of the impacts in the window: at the
     wall's position for a contact with the ground (its limit, when the scene gives it),
-    midway between the ends' positions for two bodies (linear between samples)."""
+    midway between the ends' positions for two bodies (linear along their paths; at the one
+    end written, when an output of &run bodies_out has only one)."""
     walls = {row.name: row.limit for row in mech.rows if row.a == 0}
     lo, hi = mech.span
     points = {}
@@ -890,7 +991,9 @@ def _impact_points(mech):
         if a == 0:
             y = np.full(times.size, walls[contact]) if contact in walls else mech.position(b, times)
         else:
-            y = 0.5 * (mech.position(a, times) + mech.position(b, times))
+            # (one end not written, &run bodies_out: at the end that is)
+            y = np.nanmean([mech.position(a, times), mech.position(b, times)], axis=0) \
+                if a in mech.column or b in mech.column else np.full(times.size, np.nan)
         points[contact] = (times, y, a == 0)
     return points
 
@@ -986,9 +1089,9 @@ def _draw_paths(ax, mech):
     _draw_holds(ax, mech, colors)
     _draw_ground_rows(ax, mech, colors)
     width = 1.4 if mech.n <= _LEGEND_UP_TO else 0.8
-    for i in range(mech.n):
-        ax.plot(mech.t, mech.X[:, i], color=colors[i], linewidth=width, gid=f"x{i + 1}",
-                label=f"x{i + 1} (body {i + 1})" if mech.n <= _LEGEND_UP_TO else "_nolegend_")
+    for k, i in enumerate(mech.numbers):
+        ax.plot(*mech.path(i), color=colors[i - 1], linewidth=width, gid=f"x{i}",
+                label=f"x{i} (body {i})" if len(mech.numbers) <= _LEGEND_UP_TO else "_nolegend_")
     _draw_impact_marks(ax, mech)
     walls = [row.limit for row in mech.rows if row.a == 0]
     values = np.concatenate([mech.X.ravel(), walls]) if mech.X.size else np.array(walls or [0.0, 1.0])
@@ -1011,8 +1114,9 @@ def _index_bar(ax, colors):
     _inset_bar(ax, mappable, "body", ticks=MaxNLocator(6, integer=True).tick_values(1, n))
 
 
-def _inset_bar(ax, mappable, label, ticks=None):
-    bar = ax.figure.colorbar(mappable, cax=ax.inset_axes([1.01, 0.0, 0.015, 0.45]), label=label)
+def _inset_bar(ax, mappable, label, ticks=None, extend="neither"):
+    bar = ax.figure.colorbar(mappable, cax=ax.inset_axes([1.01, 0.0, 0.015, 0.45]), label=label,
+                             extend=extend)
     if ticks is not None:
         bar.set_ticks([v for v in ticks if 1 <= v <= mappable.norm.boundaries[-1]])
     bar.ax.set_label("colorbar")
@@ -1041,19 +1145,31 @@ def _draw_map(ax, mech, quantity):
         rows, label = (0.5, mech.n - 0.5), "gap to the next body (m)"
     else:
         data = mech.V[index].T
-        top = float(np.max(np.abs(data))) if data.size else 1.0
+        # The scale of most moving bodies' speeds (most bodies of a long chain are at rest):
+        # one light ball thrown off fast would leave every other one white.
+        speeds = np.abs(data[data != 0.0])
+        top = float(np.percentile(speeds, 99)) if speeds.size else 1.0
         style = dict(cmap="RdBu_r", vmin=-(top or 1.0), vmax=top or 1.0)
         rows, label = (0.5, mech.n + 0.5), "velocity (m/s)"
     # Antialiased: a row or a column narrower than a pixel (one body moving among 1,000)
     # stays visible, averaged, where nearest-neighbour sampling would drop it.
     image = ax.imshow(data, aspect="auto", origin="lower", extent=(*mech.span, *rows),
                       interpolation="antialiased", gid=f"map:{quantity}", **style)
-    _inset_bar(ax, image, label)
-    hits = [(e.t, 0.5 * (e.ends[0] + e.ends[1]) if e.ends[0] else e.ends[1])
-            for e in mech.events if _is_impact(e.kind) and e.ends]
+    clipped = bool(data.size) and (data.max() > style["vmax"] or data.min() < style["vmin"])
+    _inset_bar(ax, image, label, extend="both" if clipped else "neither")
+    # Velocity rows are bodies (a contact of two midway between them); gap rows are the
+    # gaps after body a (a neighbours' contact on its gap's row; the ground's below body b's).
+    if quantity == "gap":
+        hits = [(e.t, e.ends[0] if e.ends[0] else e.ends[1] - 0.5)
+                for e in mech.events if _is_impact(e.kind) and e.ends]
+    else:
+        hits = [(e.t, 0.5 * (e.ends[0] + e.ends[1]) if e.ends[0] else e.ends[1])
+                for e in mech.events if _is_impact(e.kind) and e.ends]
     if hits:
+        # Fainter as they crowd: thousands of dots at full strength hide the map under them.
         ax.plot(*np.array(hits).T, linestyle="none", marker=".", markersize=1.5, color="black",
-                alpha=0.4, gid="impacts", label="impact")
+                alpha=max(0.08, 0.4 * min(1.0, _DOTS_CLEAR / len(hits))), gid="impacts",
+                label="impact")
     ax.set_ylim(*rows)
     ax.yaxis.set_major_locator(MaxNLocator(integer=True))
     ax.set_ylabel("gap after body" if quantity == "gap" else "body")
@@ -1064,7 +1180,11 @@ def _draw_spacetime(ax, mech, mode="auto", quantity="v"):
         raise ValueError(f"mode must be 'auto', 'lines' or 'map', got {mode!r}")
     if quantity not in ("v", "gap"):
         raise ValueError(f"quantity must be 'v' or 'gap', got {quantity!r}")
-    if mode == "map" or (mode == "auto" and mech.n > _MAP_ABOVE):
+    if mode == "map" or (mode == "auto" and len(mech.numbers) > _MAP_ABOVE):
+        if len(mech.numbers) != mech.n:
+            raise ValueError(f"the colour map is over every body: this output has "
+                             f"{len(mech.numbers)} of the scene's {mech.n} (&run bodies_out); "
+                             "draw mode='lines'")
         _draw_map(ax, mech, quantity)
     else:
         _draw_paths(ax, mech)
@@ -1074,6 +1194,8 @@ def _draw_spacetime(ax, mech, mode="auto", quantity="v"):
         ax.grid(True, alpha=0.3)
     if ax.get_legend_handles_labels()[0]:
         _legend(ax)
+        for handle in ax.get_legend().legend_handles:
+            handle.set_alpha(1.0)       # (the map's faint impact dots: a dot that shows)
 
 
 def _draw_spacetime_panel(ax, window, events):
@@ -1091,7 +1213,8 @@ def spacetime(result, *, mode="auto", quantity="v", t_from=None, t_to=None, path
     sequential colour map with a colour bar of the body index above 10 bodies, a legend up
     to 10), each impact where it happens (``impact:<contact>``: a cross at the wall for a
     contact with the ground, a circle midway between the two bodies' positions for a
-    contact between bodies, positions linear between samples), walls and stops
+    contact between bodies, positions linear along the paths: the samples and, for more than
+    two bodies, each body's position at its impacts from the log's velocities), walls and stops
     (``wall:<name>``), and what holds: a grey band over a body stuck by friction
     (``stuck<i>``, stick<i> to slip<i>) and an orange one over a body held on a wall, or
     between two bodies held together (``rest:<contact>``). ``mode="map"``: a colour map
@@ -1179,7 +1302,7 @@ def _build(window, names, factory, label):
 def _panels(window, forces):
     """The panels this run has, in PANELS order (NBODY_PANELS for three bodies or more);
     sets window.forces when they are drawn."""
-    if _bodies(window.result)[1].shape[1] > 2:
+    if _bodies(window.result)[1].shape[1] > 2 or not _every_body(window.result):
         return [p for p in NBODY_PANELS if p != "potential_energy" or window.pe is not None]
     drawn = set(PANELS) - {"forces", "potential_energy"}
     if window.pe is not None:
@@ -1265,16 +1388,32 @@ def _write(fig, path, dpi=100):
 
 
 def _springs(result, n):
-    """The scene's springs as (a, b, rest): records (a, b, d_rest; DESIGN's &spring) or
-    today's k1/x1_rest (0, 1), k2/x2_rest (0, 2), k12/d_rest (1, 2)."""
+    """The scene's springs as (a, b, rest), in the engine's order: today's k1/x1_rest (0, 1),
+    k2/x2_rest (0, 2), k12/d_rest (1, 2), or for more than two bodies the chain's arrays (k,
+    x_rest: body i to the ground; k_link, d_rest: link i), then the &spring records (a, b,
+    d_rest)."""
     scene = getattr(result, "scene", None)
-    records = None if scene is None else _field(scene, "springs")
-    if records is not None:
-        return [(int(_field(r, "a", 0)), int(_field(r, "b", 0)), float(_field(r, "d_rest", 0.0)))
-                for r in records]
-    tutorial = (("k1", "x1_rest", 0, 1), ("k2", "x2_rest", 0, 2), ("k12", "d_rest", 1, 2))
-    return [(a, b, _float_or_none(_scene_value(result, rest)) or 0.0)
-            for k, rest, a, b in tutorial if b <= n and _float_or_none(_scene_value(result, k))]
+    records = (None if scene is None else _field(scene, "springs")) or []
+    if n > 2:
+        own = [(0, i + 1, rest) for i, rest in _elements(result, "k", "x_rest", n)]
+        own += [(i + 1, i + 2, rest) for i, rest in _elements(result, "k_link", "d_rest", n - 1)]
+    else:
+        tutorial = (("k1", "x1_rest", 0, 1), ("k2", "x2_rest", 0, 2), ("k12", "d_rest", 1, 2))
+        own = [(a, b, _float_or_none(_scene_value(result, rest)) or 0.0)
+               for k, rest, a, b in tutorial if b <= n and _float_or_none(_scene_value(result, k))]
+    return own + [(int(_field(r, "a", 0)), int(_field(r, "b", 0)), float(_field(r, "d_rest", 0.0)))
+                  for r in records]
+
+
+def _elements(result, stiffness, rest, count):
+    """(index, rest) of each element of the chain arrays `stiffness` (count long) that is
+    there and not 0, its rest from the array `rest` (0 when absent)."""
+    ks, rests = _scene_value(result, stiffness), _scene_value(result, rest)
+    if not isinstance(ks, (list, tuple, np.ndarray)):
+        return []
+    rests = rests if isinstance(rests, (list, tuple, np.ndarray)) else []
+    return [(i, (_float_or_none(rests[i]) if i < len(rests) else None) or 0.0)
+            for i in range(min(count, len(ks))) if _float_or_none(ks[i])]
 
 
 def _zigzag(x0, x1, y, height, turns=8):
@@ -1303,7 +1442,13 @@ class _Stage:
         self.w = min(gaps) if gaps else 0.04 * (span or 1.0)
         # A slot: (its upper row, its lower limit: 0 when the record has none).
         lows = {r.record: r.limit for r in mech.rows if r.side == "min"}
-        self.slots = [(r, lows.get(r.record, 0.0)) for r in mech.rows if r.a and r.side == "max"]
+        # Links of a chain of more than two bodies with an upper limit (couplers with slack)
+        # are drawn where the neighbours meet, coloured by their state (_Couplers); the
+        # others as slots above the blocks.
+        links = [r for r in mech.rows if r.a and r.side == "max" and mech.n > 2 and r.b == r.a + 1]
+        self.slots = [(r, lows.get(r.record, 0.0)) for r in mech.rows
+                      if r.a and r.side == "max" and r not in links]
+        self.couplers = _Couplers(ax, [(r, lows.get(r.record)) for r in links]) if links else None
         self.blocks = [ax.add_patch(Rectangle((0.0, 0.0), self.w, 1.0, facecolor=c, edgecolor="black",
                                               linewidth=0.8, gid=f"block{i + 1}"))
                        for i, c in enumerate(self.colors)]
@@ -1363,9 +1508,45 @@ class _Stage:
         for level, ((a, b, rest), art) in enumerate(zip(self.springs, self.spring_art)):
             start = rest if a == 0 else x[a - 1]
             art.set_data(*_zigzag(start, x[b - 1], -0.25 - 0.3 * level, 0.08))
+        if self.couplers is not None:
+            self.couplers.show(x)
         ke = "" if self.mech.ke is None else f"   KE = {self.mech.ke[k]:.4g} J"
         self.clock.set_text(f"t = {self.mech.t[k]:.3f} s{ke}")
         return self.blocks
+
+
+class _Couplers:
+    """The links of a chain with an upper limit (a train's couplers): a square above where
+    each pair of neighbours meets (above: the blocks' own colours are no state), red when the link is at its upper limit (taut), blue at its lower
+    one (buffers touching), grey in between (in its slack). A slack of 6 cm between wagons
+    16 m long is too small to see in the blocks' motion; its state is not."""
+
+    Y = 1.17        # (the blocks stand from 0 to 1)
+    STATES = (("tab:blue", "link at its lower limit"), ("0.6", "link in its slack"),
+              ("tab:red", "link at its upper limit (taut)"))
+
+    def __init__(self, ax, links):
+        from matplotlib.lines import Line2D
+
+        self.links = links          # (upper row, lower limit or None)
+        self.art = ax.scatter(np.zeros(len(links)), np.full(len(links), self.Y), s=60, marker="s",
+                              edgecolors="black", linewidths=0.6, zorder=4, gid="couplers")
+        ax.legend(handles=[Line2D([], [], linestyle="none", marker="s", markersize=7,
+                                  markeredgecolor="black", markeredgewidth=0.6, color=c, label=label)
+                           for c, label in self.STATES],
+                  loc="upper right", fontsize="x-small", frameon=False, ncol=3)
+
+    def show(self, x):
+        colours, where = [], []
+        for row, low in self.links:
+            gap, top = x[row.b - 1] - x[row.a - 1], row.limit
+            # (a link held at a limit sits on it to rounding: a millionth of its slack)
+            close = 1e-6 * abs(top - (low if low is not None else top - 1.0))
+            state = 2 if gap >= top - close else 0 if low is not None and gap <= low + close else 1
+            colours.append(self.STATES[state][0])
+            where.append((0.5 * (x[row.a - 1] + x[row.b - 1]), self.Y))
+        self.art.set_offsets(where)
+        self.art.set_facecolor(colours)
 
 
 def _frames(mech, max_frames):
@@ -1397,6 +1578,9 @@ def animate(result, path=None, *, fps=20, max_frames=300, t_from=None, t_to=None
 
     writer = None if path is None else _writer(path, fps)     # a bad name before any work
     mech = _Mechanism(result, t_from, t_to)
+    if len(mech.numbers) != mech.n:
+        raise ValueError(f"the animation shows every body: this output has x of bodies "
+                         f"{', '.join(map(str, mech.numbers))} of {mech.n} (&run bodies_out)")
     samples = _frames(mech, max_frames)
     fig = (figure_factory or Figure)(figsize=(9.0, 2.4 + 0.25 * mech.n ** 0.5), layout="constrained")
     fig.set_label("animation")
