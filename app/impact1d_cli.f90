@@ -293,7 +293,7 @@ contains
     line = ''
     ! Per row, impacts, rests, releases; then per body, sticks and slips.
     do c = class_impact, class_slip
-      do k = 1, merge(scene%n_rows, scene%n_bodies, c < class_stick)
+      do k = 1, merge(scene%n_rows + scene%n_stops, scene%n_bodies, c < class_stick)
         if (event_count(stats, c, k) > 0) line = line // ' ' // trim(event_name(scene%row_name, c, k)) // ' ' // &
           trim(fmt(event_count(stats, c, k)))
       end do

@@ -265,7 +265,7 @@ contains
     if (len(note) > 0) warnings = warnings // repeat(new_line('a'), min(len(warnings), 1)) // note
     n_samples = sink%n_samples
     n_events = sink%n_events
-    n_rows = scene%n_rows
+    n_rows = scene%n_rows + scene%n_stops
     info(2:5) = [n_samples, n_events, n_rows, int(min(stats%steps, int(huge(1_c_int), kind(stats%steps))), c_int)]
     energy_residual = stats%max_residual
     if (n_samples > max_samples .or. n_events > max_events .or. n_rows > max_rows .or. len(warnings) > text_room) then

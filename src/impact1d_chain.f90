@@ -15,7 +15,7 @@ module impact1d_chain
     record_input, a_m, a_mu, a_mus, a_x, a_f_amp, a_f_period, a_f_phase, a_k, a_x_rest, a_c, a_d_min, a_r_min, &
     a_d_max, a_r_max, a_k_link, a_d_rest, a_c_link, r_a, r_b, r_d_min, r_r_min, r_d_max, r_r_max, r_k, r_d_rest, &
     r_c, contact_fields, spring_fields, r_name, n_contact_fields, n_spring_fields, written_array, text_item, &
-    a_f_table, mechanism_records, n_sine_fields, sine_fields, r_body, r_amp, r_period, r_phase
+    a_f_table, mechanism_records, n_sine_fields, sine_fields, r_body, r_amp, r_period, r_phase, r_stop_k, r_stop_c
   implicit none
   private
   public :: settle_chain, validate_chain, input_records, mechanism_records, n_bodies_of, slot_of, alias_slot
@@ -412,7 +412,8 @@ contains
     do r = 1, size(records)
       associate (rec => records(r))
         call record_place(trim(merge('&contact', '&spring ', contact)), rec, r, where)
-        do f = 1, merge(size(contact_fields) - 1, size(spring_fields), contact)
+        do f = 1, merge(size(contact_fields), size(spring_fields), contact)
+          if (contact .and. f == r_name) cycle
           if (rec%given(f) .and. .not. ieee_is_finite(rec%value(f))) call raise(error, status_input, where // &
             trim(field_of(contact, f)) // ' = ' // trim(fmt(rec%value(f))) // ' is not a finite number')
         end do
@@ -530,6 +531,16 @@ contains
     end do
     call limits_in_order(where // 'd_min', 'd_max', rec%given(r_d_min), rec%value(r_d_min), &
       rec%given(r_d_max), rec%value(r_d_max), .false., error)
+    if (allocated(error)) return
+    ! A compliant stop (k, optionally c): a stiffness > 0, a damping >= 0 beside it.
+    if (rec%given(r_stop_c) .and. .not. rec%given(r_stop_k)) then
+      call raise(error, status_input, where // 'c is given but k is not: a compliant stop needs its ' // &
+        'stiffness k (a rigid contact has neither)')
+      return
+    end if
+    if (rec%given(r_stop_k)) call positive_value(where // 'k', rec%value(r_stop_k), error)
+    if (rec%given(r_stop_c) .and. .not. allocated(error)) call nonnegative_value(where // 'c', &
+      rec%value(r_stop_c), error)
   end subroutine contact_limits
 
   !> A spring has k or c (not negative); k and d_rest go together.
@@ -636,11 +647,13 @@ contains
     if (allocated(input%chain%contacts)) nc = nc + size(input%chain%contacts)
     if (allocated(input%chain%springs)) ne = ne + size(input%chain%springs)
     allocate(records%contact_body(2, nc), records%contact_has(2, nc), records%contact_limit(2, nc), &
-      records%contact_restitution(2, nc), records%contact_name(nc))
+      records%contact_restitution(2, nc), records%contact_name(nc), records%contact_k(nc), records%contact_c(nc))
     allocate(records%element_body(2, ne), records%element_k(ne), records%element_c(ne), records%element_rest(ne))
     records%contact_has = .false.
     records%contact_limit = 0.0_wp
     records%contact_restitution = 1.0_wp
+    records%contact_k = 0.0_wp
+    records%contact_c = 0.0_wp
     call wall_records(input, n, records)
     call link_records(input, n, records)
     call contact_records(input, records)
@@ -740,6 +753,8 @@ contains
         records%contact_has(:, k) = rec%given([r_d_min, r_d_max])
         records%contact_limit(:, k) = merge(rec%value([r_d_min, r_d_max]), 0.0_wp, rec%given([r_d_min, r_d_max]))
         records%contact_restitution(:, k) = merge(rec%value([r_r_min, r_r_max]), 1.0_wp, rec%given([r_r_min, r_r_max]))
+        if (rec%given(r_stop_k)) records%contact_k(k) = rec%value(r_stop_k)
+        if (rec%given(r_stop_c)) records%contact_c(k) = rec%value(r_stop_c)
         if (ends(2) == 0) then
           records%contact_body(:, k) = [0, ends(1)]
           records%contact_has(:, k) = records%contact_has([2, 1], k)
@@ -818,6 +833,8 @@ contains
       records%contact_limit = records%contact_limit(:, :nc)
       records%contact_restitution = records%contact_restitution(:, :nc)
       records%contact_name = records%contact_name(:nc)
+      records%contact_k = records%contact_k(:nc)
+      records%contact_c = records%contact_c(:nc)
       records%element_body = records%element_body(:, :ne)
       records%element_k = records%element_k(:ne)
       records%element_c = records%element_c(:ne)

@@ -1,7 +1,7 @@
 !> The contacts' geometry (METHOD.md 2): gaps exact to their own size, their rounding
 !> levels, and putting a closed contact exactly on its constraint.
 module impact1d_contacts
-  use impact1d_kinds, only: wp
+  use impact1d_kinds, only: wp, eps_wp
   use impact1d_scene, only: scene_type
   use impact1d_impacts, only: normal_velocity
   use impact1d_state, only: lane_state_type, add_compensated
@@ -12,6 +12,7 @@ module impact1d_contacts
   implicit none
   private
   public :: gap, gap_tolerance, gap_tolerance_along, displacement, snap, snap_row, rigid_pair, u_tolerance, u_tolerances
+  public :: stop_gap_band, stop_force_band
 
 contains
 
@@ -45,6 +46,27 @@ contains
     gap_tolerance = gap_rounding * (moved + dot_product(abs(scene%pair%normal(:, k)), abs(m%x_lo))) + &
       time_rounding * max(abs(m%t), scene%dt) * max(0.0_wp, -normal_velocity(scene, k, m%v))
   end function gap_tolerance
+
+  !> Within how much of its limit a compliant stop row k is at it: the gap's rounding and
+  !> what the rounding of the clock at an event moves it by, either way (a stop released at
+  !> its limit leaves it, 1e-17 m inside, at once: open, not engaged again).
+  pure real(wp) function stop_gap_band(scene, k, m) result(band)
+    type(scene_type), intent(in) :: scene
+    integer, intent(in) :: k
+    type(lane_state_type), intent(in) :: m
+    band = gap_tolerance(scene, k, m, 0.0_wp) + &
+      time_rounding * max(abs(m%t), scene%dt) * abs(normal_velocity(scene, k, m%v))
+  end function stop_gap_band
+
+  !> The rounding of a compliant stop row k's force -(k gap + c gap') in state m: what
+  !> counts as zero at its engagement and release.
+  pure real(wp) function stop_force_band(scene, k, m) result(band)
+    type(scene_type), intent(in) :: scene
+    integer, intent(in) :: k
+    type(lane_state_type), intent(in) :: m
+    band = 1.0e3_wp * eps_wp * (scene%row_k(k) * max(abs(gap(scene, k, m)), stop_gap_band(scene, k, m)) + &
+      scene%row_c(k) * abs(normal_velocity(scene, k, m%v))) + tiny(1.0_wp)
+  end function stop_force_band
 
   !> gap_tolerance along a step from state a with dense output c, as a polynomial in theta:
   !> what the step has moved the gap by at theta (each body's displacement), not by the
@@ -141,7 +163,7 @@ contains
     integer, intent(in) :: k
     real(wp), intent(in) :: entry_scale(max_lanes)
     real(wp) :: f(max_lanes), acc(max_lanes)
-    call state_force(scene, s, f)
+    call state_force(scene, s, f, mode%engaged)
     call mode%acceleration(f, acc)
     u_tolerance = velocity_rounding * dot_product(abs(scene%pair%normal(:, k)), &
       max(abs(s%v) + abs(acc) * scene%dt, entry_scale))
@@ -155,7 +177,7 @@ contains
     real(wp), intent(in) :: entry_scale(max_lanes)
     real(wp) :: tol(pair_rows), f(max_lanes), acc(max_lanes), speed(max_lanes)
     integer :: k
-    call state_force(scene, s, f)
+    call state_force(scene, s, f, mode%engaged)
     call mode%acceleration(f, acc)
     speed = max(abs(s%v) + abs(acc) * scene%dt, entry_scale)
     tol = 0.0_wp

@@ -12,13 +12,14 @@ module impact1d_event_point
   use impact1d_modes, only: mode_type, solve_mode, pair_rows
   use impact1d_impacts, only: normal_velocity, impulse, most_approaching, restitution_of, &
     kinetic_energy, joint_inelastic, inelastic_projection
-  use impact1d_output, only: sink_type, run_stats, class_impact, class_rest, class_stick, class_slip
+  use impact1d_output, only: sink_type, run_stats, class_impact, class_rest, class_release, class_stick, class_slip
   use impact1d_state, only: lane_state_type, add_compensated
   use impact1d_yardsticks, only: gap_rounding, velocity_rounding, time_rounding, energy_rounding, force_scale, &
     same_instant
-  use impact1d_contacts, only: gap, gap_tolerance, snap, rigid_pair, u_tolerance, u_tolerances
+  use impact1d_contacts, only: gap, gap_tolerance, snap, rigid_pair, u_tolerance, u_tolerances, stop_gap_band, &
+    stop_force_band
   use impact1d_stepping, only: rk4_type
-  use impact1d_location, only: watch_type, located_type, located_row, located_body
+  use impact1d_location, only: watch_type, located_type, located_row, located_body, located_stop
   use impact1d_loads, only: state_force, applied_rate
   use impact1d_event_log, only: event_log_type, log_event
   use impact1d_accumulation, only: join_cycle
@@ -53,8 +54,13 @@ contains
     real(wp) :: entry_scale(max_lanes)
     integer :: k, i, n_impulses
     type(mode_type) :: new_mode
+    logical :: switched
 
-    call state_force(scene, s, f)
+    if (scene%n_stops > 0) then
+      call switch_stops(scene, which, s, mode%engaged, sink, stats, switched)
+      if (switched .or. initial) call rk%set_springs(scene, mode%engaged)
+    end if
+    call state_force(scene, s, f, mode%engaged)
     call applied_rate(scene, s%t, s%v, df)
     closed = .false.
     do k = 1, scene%n_rows
@@ -169,7 +175,7 @@ contains
 
     ! Dampers pull with the velocities the impacts left.
     if (scene%springs%has_damper) then
-      call state_force(scene, s, f)
+      call state_force(scene, s, f, mode%engaged)
       call applied_rate(scene, s%t, s%v, df)
     end if
     call candidates(scene, mode, s, entry_scale, closed, candidate, resting, moving_sign)
@@ -181,6 +187,7 @@ contains
     end if
 
     call log_mode_change(scene, initial, f, df, candidate, new_mode, s, event_log, sink, stats)
+    new_mode%engaged = mode%engaged
     mode = new_mode
     call watch%forget_quiet_times()
     if (rk%constant_forcing) then
@@ -188,8 +195,58 @@ contains
       call watch%find_quiet_times(scene, mode, s, rk%constant_acceleration)
     end if
     watch%watching = mode%n_hold > 0 .or. any(.not. mode%active(:scene%n_rows)) .or. &
-      any(scene%pair%static_friction > 0.0_wp .and. mode%sgn /= 0.0_wp)
+      any(scene%pair%static_friction > 0.0_wp .and. mode%sgn /= 0.0_wp) .or. scene%n_stops > 0
   end subroutine event_point
+
+  !> The compliant stops at this instant (docs/method.md section 10): an open stop whose gap
+  !> has closed (located, or within its rounding) engages when its ends approach, logged as
+  !> an impact on its row (no velocity changes); an engaged one releases when its force
+  !> F = -(k gap + c gap') has fallen to zero (located, or within rounding), logged as
+  !> release_<row>; one released inside (gap < 0) engages again when F has risen to zero.
+  subroutine switch_stops(scene, which, s, engaged, sink, stats, switched)
+    type(scene_type), intent(in) :: scene
+    type(located_type), intent(in) :: which
+    type(lane_state_type), intent(in) :: s
+    integer, intent(inout) :: engaged   !< the stops engaged (bits)
+    class(sink_type), intent(inout) :: sink
+    type(run_stats), intent(inout) :: stats
+    logical, intent(out) :: switched    !< a stop engaged or released
+    real(wp) :: g, u, force, tol
+    integer :: j, r, engaged_before
+    logical :: located, engage
+    engaged_before = engaged
+    do j = 1, scene%n_stops
+      r = scene%n_rows + j
+      g = gap(scene, r, s)
+      u = normal_velocity(scene, r, s%v)
+      force = -(scene%row_k(r) * g + scene%row_c(r) * u)
+      tol = stop_force_band(scene, r, s)
+      located = (which%kind == located_row .or. which%kind == located_stop) .and. which%index == r
+      ! A located crossing switches where the force is zero within rounding (refine's
+      ! Newton may stop short of it: the next step finds it again); one the location missed
+      ! switches where the force is past zero.
+      if (btest(engaged, j - 1)) then
+        if (force < -tol .or. (located .and. force <= tol)) then
+          engaged = ibclr(engaged, j - 1)
+          call log_event(scene, sink, stats, s%t, class_release, r, s%v, s%v)
+        end if
+        cycle
+      end if
+      if (g > stop_gap_band(scene, r, s)) cycle
+      ! At the limit (gap within rounding) the stop engages when its ends approach; inside
+      ! it, when its force has risen to zero.
+      if (g >= -stop_gap_band(scene, r, s)) then
+        engage = u < -velocity_rounding * maxval(abs(s%v))
+      else
+        engage = force > tol .or. (located .and. force >= -tol)
+      end if
+      if (engage) then
+        engaged = ibset(engaged, j - 1)
+        call log_event(scene, sink, stats, s%t, class_impact, r, s%v, s%v)
+      end if
+    end do
+    switched = engaged /= engaged_before
+  end subroutine switch_stops
 
   !> An event point whose impulses hit the rows marked, recorded; when the last points make
   !> an accumulation over several contacts (impact1d_accumulation) whose rest is near, its

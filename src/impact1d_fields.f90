@@ -11,7 +11,7 @@ module impact1d_fields
   public :: a_m, a_mu, a_mus, a_x, a_v, a_f, a_f_amp, a_f_period, a_f_phase, a_k, a_x_rest, a_c
   public :: a_d_min, a_r_min, a_d_max, a_r_max, a_k_link, a_d_rest, a_c_link, a_f_table
   public :: n_contact_fields, contact_fields, n_spring_fields, spring_fields, n_sine_fields, sine_fields
-  public :: r_a, r_b, r_d_min, r_r_min, r_d_max, r_r_max, r_name, r_k, r_d_rest, r_c
+  public :: r_a, r_b, r_d_min, r_r_min, r_d_max, r_r_max, r_name, r_k, r_d_rest, r_c, r_stop_k, r_stop_c
   public :: r_body, r_amp, r_period, r_phase
   public :: name_len, text_item, written_array, record_input, chain_input, alias_name, mechanism_records, array_value
 
@@ -38,13 +38,15 @@ module impact1d_fields
   logical, parameter :: array_is_link(n_arrays) = [spread(.false., 1, 12), spread(.true., 1, 7), .false.]
   logical, parameter :: array_is_text(n_arrays) = [spread(.false., 1, 19), .true.]
 
-  !> The fields of a &contact record (on x_b - x_a; a, b body numbers, 0 the ground) and of
+  !> The fields of a &contact record (on x_b - x_a; a, b body numbers, 0 the ground; k and
+  !> c make it a compliant stop: past a limit it pushes back with max(0, k p + c p')) and of
   !> a &spring record (tension k ((x_b - x_a) - d_rest) + c (v_b - v_a)).
-  integer, parameter :: n_contact_fields = 7, n_spring_fields = 5
-  integer, parameter :: r_a = 1, r_b = 2, r_d_min = 3, r_r_min = 4, r_d_max = 5, r_r_max = 6, r_name = 7
+  integer, parameter :: n_contact_fields = 9, n_spring_fields = 5
+  integer, parameter :: r_a = 1, r_b = 2, r_d_min = 3, r_r_min = 4, r_d_max = 5, r_r_max = 6, r_name = 7, &
+    r_stop_k = 8, r_stop_c = 9
   integer, parameter :: r_k = 3, r_d_rest = 4, r_c = 5
   character(len=*), parameter :: contact_fields(n_contact_fields) = [character(len=5) :: &
-    'a', 'b', 'd_min', 'r_min', 'd_max', 'r_max', 'name']
+    'a', 'b', 'd_min', 'r_min', 'd_max', 'r_max', 'name', 'k', 'c']
   character(len=*), parameter :: spring_fields(n_spring_fields) = [character(len=6) :: &
     'a', 'b', 'k', 'd_rest', 'c']
   !> The fields of a &sine record: amp sin(2 pi t / period + phase) on body `body`'s force
@@ -99,6 +101,8 @@ module impact1d_fields
     real(wp), allocatable :: contact_limit(:, :)         !< (2, nc) d_min, d_max on x_b - x_a (walls: positions)
     real(wp), allocatable :: contact_restitution(:, :)   !< (2, nc) r at the lower, upper limit
     character(len=name_len), allocatable :: contact_name(:)   !< (nc) 'left' 'right' 'slot' 'link3' ...
+    !> (nc) a compliant stop's stiffness (N/m) and damping (N s/m); k = 0: a rigid contact
+    real(wp), allocatable :: contact_k(:), contact_c(:)
     integer :: n_elements = 0
     integer, allocatable :: element_body(:, :)           !< (2, ne) ends; elongation (x_b - x_a) - rest
     real(wp), allocatable :: element_k(:), element_c(:), element_rest(:)   !< (ne)

@@ -10,17 +10,19 @@ module impact1d_location
   use impact1d_state, only: lane_state_type
   use impact1d_lanes, only: max_lanes
   use impact1d_yardsticks, only: velocity_rounding, force_scale
-  use impact1d_contacts, only: gap, gap_tolerance, gap_tolerance_along, displacement
+  use impact1d_contacts, only: gap, gap_tolerance, gap_tolerance_along, displacement, stop_gap_band, stop_force_band
   use impact1d_stepping, only: rk4_type, dense_output
-  use impact1d_loads, only: applied_force, applied_rate, state_force
+  use impact1d_loads, only: applied_force, applied_rate, state_force, add_stop_force
   implicit none
   private
   public :: watch_type, hold_crossing, refine, constraints_hold, first_negative
-  public :: located_type, located_none, located_row, located_body, located_hold
+  public :: located_type, located_none, located_row, located_body, located_hold, located_stop
 
-  !> What a location found: a row's gap closing, a sliding body stopping, a mode condition
-  !> failing (located_hold, no index), or nothing.
-  integer, parameter :: located_none = 0, located_row = 1, located_body = 2, located_hold = 3
+  !> What a location found: a row's gap closing (a compliant stop's too: its engagement), a
+  !> sliding body stopping, a mode condition failing (located_hold, no index), a compliant
+  !> stop's force k p + c p' crossing zero (located_stop: its release, or its engagement
+  !> again while still inside), or nothing.
+  integer, parameter :: located_none = 0, located_row = 1, located_body = 2, located_hold = 3, located_stop = 4
   type :: located_type
     integer :: kind = located_none
     integer :: index = 0      !< the row or the body
@@ -89,7 +91,7 @@ contains
       if (p(0) - step * (abs(p(1)) + step * (abs(p(2)) + step * abs(p(3)))) > 0.0_wp) cycle
       ! Only a gap that may close needs the forces' rounding (a sine costs two evaluations).
       if (.not. have_acc_rounding) then
-        call state_force(scene, a, f)
+        call state_force(scene, a, f, mode%engaged)
         call applied_rate(scene, a%t, a%v, df)
         acc_rounding = 1.0e3_wp * eps_wp * force_scale(scene, f, df) / scene%pair%mass
         if (.not. polynomial_forcing) then
@@ -129,7 +131,7 @@ contains
       ! again and again. The dip the cubic cannot resolve does not count.
       if (.not. polynomial_forcing) then
         if (.not. have_acc0) then
-          call state_force(scene, a, f)
+          call state_force(scene, a, f, mode%engaged)
           call mode%acceleration(f, acc0)
         end if
         have_acc0 = .true.
@@ -141,6 +143,11 @@ contains
         which = located_type(located_body, i)
       end if
     end do
+    if (scene%n_stops > 0) then
+      if (.not. have_dense) call dense_output(a, b, step, c)
+      have_dense = .true.
+      call locate_stops(scene, mode, a, c, step, theta, which)
+    end if
     ! Under constant forces the mode's conditions are constant: they held when it began.
     if (mode%n_hold > 0 .and. .not. constant_forcing) then
       if (scene%springs%present .and. .not. have_dense) call dense_output(a, b, step, c)
@@ -151,6 +158,63 @@ contains
       end if
     end if
   end subroutine locate
+
+  !> The compliant stops' events on the step's dense output c from a (docs/method.md section
+  !> 10), if earlier than theta: an open stop's gap closing (its engagement: located_row),
+  !> an engaged stop's force F = -(k gap + c gap') falling through zero (its release:
+  !> located_stop), and a stop released inside (gap < 0) whose F rises through zero (engaged
+  !> again: located_stop). On the cubic gap(theta) F is a cubic too; its tolerance is the
+  !> gap's (gap_tolerance_along, with the cubic's own error when the motion is not one)
+  !> carried through the same combination.
+  subroutine locate_stops(scene, mode, a, c, step, theta, which)
+    type(scene_type), intent(in) :: scene
+    type(mode_type), intent(in) :: mode
+    type(lane_state_type), intent(in) :: a
+    real(wp), intent(in) :: c(3, max_lanes), step
+    real(wp), intent(inout) :: theta
+    type(located_type), intent(inout) :: which
+    real(wp) :: g(0:3), q(0:3), force(0:3), tol(0:3), f(max_lanes), df(max_lanes), acc0(max_lanes)
+    real(wp) :: acc_rounding(max_lanes)
+    integer :: r
+    logical :: engaged
+    call state_force(scene, a, f, mode%engaged)
+    call applied_rate(scene, a%t, a%v, df)
+    acc_rounding = 1.0e3_wp * eps_wp * force_scale(scene, f, df) / scene%pair%mass
+    call mode%acceleration(f, acc0)
+    do r = scene%n_rows + 1, scene%n_rows + scene%n_stops
+      engaged = btest(mode%engaged, r - scene%n_rows - 1)
+      g(0) = gap(scene, r, a)
+      g(1:3) = scene%pair%normal(1, r) * c(:, 1) + scene%pair%normal(2, r) * c(:, 2)
+      q = gap_tolerance_along(scene, r, a, c, acc_rounding)
+      q(2) = q(2) + abs(g(2) - 0.5_wp * dot_product(scene%pair%normal(:, r), acc0))
+      ! Released at the limit (c = 0: at gap = 0), within its rounding, the stop is open.
+      if (.not. engaged .and. g(0) >= -stop_gap_band(scene, r, a)) then
+        call take_earlier(earliest_crossing(g, step, [max(q(0), stop_gap_band(scene, r, a)), q(1:3)]), &
+          located_type(located_row, r), theta, which)
+        cycle
+      end if
+      associate (k => scene%row_k(r), d => scene%row_c(r))
+        force = -[k * g(0) + d * g(1), k * g(1) + 2.0_wp * d * g(2), k * g(2) + 3.0_wp * d * g(3), k * g(3)]
+        tol = k * q + d * [q(1), 2.0_wp * q(2), 3.0_wp * q(3), 0.0_wp]
+      end associate
+      tol(0) = max(tol(0), stop_force_band(scene, r, a))
+      ! Engaged: F >= 0 until it falls through zero. Released inside: F < 0 until it rises.
+      if (.not. engaged) force = -force
+      call take_earlier(earliest_crossing(force, step, tol), located_type(located_stop, r), theta, which)
+    end do
+  end subroutine locate_stops
+
+  !> theta, which := candidate, found when the candidate is earlier.
+  pure subroutine take_earlier(candidate, found, theta, which)
+    real(wp), intent(in) :: candidate
+    type(located_type), intent(in) :: found
+    real(wp), intent(inout) :: theta
+    type(located_type), intent(inout) :: which
+    if (candidate < theta) then
+      theta = candidate
+      which = found
+    end if
+  end subroutine take_earlier
 
   !> Earliest time in [0, step] at which a condition of the mode (a contact force, a static
   !> friction margin) has turned negative, for the step from state a with dense output c.
@@ -167,7 +231,7 @@ contains
     real(wp), parameter :: two_pi = 2.0_wp * acos(-1.0_wp)
     theta = huge(1.0_wp)
     t0 = a%t
-    tol = hold_tolerance(scene, a)
+    tol = hold_tolerance(scene, mode, a)
     n_sub = 1
     ! (the fastest sine's count is the largest of the sines' counts: rounding is monotone)
     if (scene%forcing%fastest > 0.0_wp) n_sub = max(n_sub, ceiling(16.0_wp * step * scene%forcing%fastest / two_pi))
@@ -207,6 +271,7 @@ contains
       dx = a%x_lo + theta * (c(1, :) + theta * (c(2, :) + theta * c(3, :)))
       v = c(1, :) + theta * (2.0_wp * c(2, :) + 3.0_wp * theta * c(3, :))
       call applied_force(scene, a%t + theta, a%x, dx, v, f)
+      if (mode%engaged /= 0) call add_stop_force(scene, mode%engaged, a%x, dx, v, f)
     else
       call scene%forcing%force(a%t + theta, f)
     end if
@@ -214,11 +279,12 @@ contains
     worst_hold = minval(values(1:mode%n_hold))
   end function worst_hold
 
-  real(wp) function hold_tolerance(scene, a)
+  real(wp) function hold_tolerance(scene, mode, a)
     type(scene_type), intent(in) :: scene
+    type(mode_type), intent(in) :: mode
     type(lane_state_type), intent(in) :: a
     real(wp) :: f(max_lanes), df(max_lanes)
-    call state_force(scene, a, f)
+    call state_force(scene, a, f, mode%engaged)
     call applied_rate(scene, a%t, a%v, df)
     hold_tolerance = 1.0e3_wp * eps_wp * force_scale(scene, f, df) + tiny(1.0_wp)
   end function hold_tolerance
@@ -238,12 +304,20 @@ contains
     integer :: iteration
     located_step = step
     call rk%step(scene, mode, a, step, b)
-    if (which%kind /= located_row .and. which%kind /= located_body) return
+    if (which%kind /= located_row .and. which%kind /= located_body .and. which%kind /= located_stop) return
     do iteration = 1, 8
       associate (i => which%index, k => which%index)
-        if (which%kind == located_body) then
+        if (which%kind == located_stop) then
+          ! A stop's force F = -(k gap + c gap'), its rate -(k gap' + c gap'').
+          call state_force(scene, b, f, mode%engaged)
+          call mode%acceleration(f, acc)
+          slope = normal_velocity(scene, k, b%v)
+          value = -(scene%row_k(k) * gap(scene, k, b) + scene%row_c(k) * slope)
+          tol = stop_force_band(scene, k, b)
+          slope = -(scene%row_k(k) * slope + scene%row_c(k) * dot_product(scene%pair%normal(:, k), acc))
+        else if (which%kind == located_body) then
           value = b%v(i)
-          call state_force(scene, b, f)
+          call state_force(scene, b, f, mode%engaged)
           call mode%acceleration(f, acc)
           slope = acc(i)
           tol = velocity_rounding * max(abs(a%v(i)), abs(value))

@@ -41,6 +41,9 @@ module impact1d_modes
     integer :: n_hold = 0
     real(wp) :: hold_w(2, max_holds) = 0.0_wp !< hold_j = hold_w(:,j) . (f + f_slide) + hold_c(j) >= 0
     real(wp) :: hold_c(max_holds) = 0.0_wp
+    !> The compliant stops engaged (bit j - 1: the scene's stop row n_rows + j), switched at
+    !> event points (impact1d_event_point's switch_stops) and kept through the mode's solve.
+    integer :: engaged = 0
   contains
     procedure :: acceleration
     procedure :: holds

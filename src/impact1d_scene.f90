@@ -8,7 +8,8 @@ module impact1d_scene
   use impact1d_forcing, only: forcing_type, table_type, angular_frequency
   use impact1d_springs, only: springs_type, pair_elements, assemble, rate_bound
   use impact1d_modes, only: pair_type, pair_rows
-  use impact1d_fields, only: chain_input, mechanism_records, r_k, r_c, array_value, a_m, a_mu, a_mus, a_x, a_v, &
+  use impact1d_fields, only: chain_input, mechanism_records, r_k, r_c, r_stop_k, r_stop_c, array_value, a_m, &
+    a_mu, a_mus, a_x, a_v, &
     a_f, a_f_amp, a_f_period, a_f_phase, a_f_table
   use impact1d_stability, only: linear_modes, stable_step, mode_error, coarse_rate
   implicit none
@@ -155,11 +156,18 @@ module impact1d_scene
     real(wp), allocatable :: contact_limit(:, :)        !< (2, nc) d_min, d_max on x_b - x_a (walls: positions)
     real(wp), allocatable :: contact_restitution(:, :)  !< (2, nc) Newton's r at the lower, upper limit
     character(len=name_len), allocatable :: contact_name(:)  !< (nc) 'left', 'right', 'slot', ...
+    !> (nc) a compliant stop's stiffness (N/m) and damping (N s/m); k = 0: a rigid contact
+    real(wp), allocatable :: contact_k(:), contact_c(:)
     ! rows: one unilateral constraint per present limit, what the engine loops over, made
     ! from the records by set_rows in record order, lower limit first (docs/nbody-plan.md
     ! B4: left, right, slot_min, slot_max); gap_r = row_normal(:, r) . x(row_body(:, r))
     ! + row_offset(r) >= 0.
+    ! The rigid rows come first (1..n_rows: what the impacts, the modes and the location of
+    ! closing gaps loop over), then the compliant stops' rows (n_rows + 1 .. n_rows +
+    ! n_stops: a force k p + c p' while engaged, docs/method.md section 10); nr is their sum.
     integer :: n_rows = 0
+    integer :: n_stops = 0                              !< rows of compliant stops (after the rigid ones)
+    real(wp), allocatable :: row_k(:), row_c(:)         !< (nr) a stop row's stiffness and damping (0: rigid)
     integer, allocatable :: row_contact(:)              !< (nr) the record it comes from
     integer, allocatable :: row_body(:, :)              !< (2, nr) ends a, b (a = 0: ground)
     real(wp), allocatable :: row_normal(:, :)           !< (2, nr) on x_a, x_b: lower (-1, 1), upper (1, -1);
@@ -652,6 +660,9 @@ contains
         call raise(error, status_input, nbody_refusal)
         return
       end if
+      call refuse_stops(records, 'are not supported for more than two bodies yet (N = ' // &
+        trim(fmt(input%chain%n_bodies)) // '): the N-body engine has rigid contacts only', error)
+      if (allocated(error)) return
       call set_chain_bodies(input, tables, scene)
     else
       call set_bodies(input, tables, scene)
@@ -659,6 +670,9 @@ contains
     if (records%n_sines > 0) call scene%forcing%set_sines(records%sine_body, records%sine_amp, &
       records%sine_period, records%sine_phase)
     call scene%forcing%set_varies()
+    if (scene%method == 'vissim') call refuse_stops(records, 'need method = ''event'' (the vissim ' // &
+      'method is the tutorial''s scheme, with rigid contacts only)', error)
+    if (allocated(error)) return
     call set_records(input, records, scene)
     call set_rows(scene, error)
     if (allocated(error)) return
@@ -686,6 +700,22 @@ contains
     ! (validate keeps the count within max_rows, a default integer)
     scene%n_samples = int(row_count(scene%t_end, scene%dt_out))
   end subroutine build_scene
+
+  !> A scene whose engine has no compliant stops: the first &contact record with k named
+  !> in the message (why: what the engine lacks).
+  subroutine refuse_stops(records, why, error)
+    type(mechanism_records), intent(in) :: records
+    character(len=*), intent(in) :: why
+    type(error_type), allocatable, intent(inout) :: error
+    integer :: j
+    do j = 1, records%n_contacts
+      if (records%contact_k(j) > 0.0_wp) then
+        call raise(error, status_input, 'the &contact ''' // trim(records%contact_name(j)) // ''' has k = ' // &
+          trim(fmt(records%contact_k(j))) // ': compliant stops ' // why)
+        return
+      end if
+    end do
+  end subroutine refuse_stops
 
   !> The bodies (N: 2 with m2, else 1), their forces but the &sine records' (build_scene's),
   !> and the kernels' view of them (pair).
@@ -797,6 +827,8 @@ contains
     scene%contact_limit = records%contact_limit + 0.0_wp
     scene%contact_restitution = records%contact_restitution
     scene%contact_name = records%contact_name
+    scene%contact_k = records%contact_k
+    scene%contact_c = records%contact_c
     scene%n_elements = records%n_elements
     scene%element_body = records%element_body
     scene%element_k = records%element_k
@@ -808,12 +840,18 @@ contains
   end subroutine set_records
 
   !> Whether the scene names a stiffness, and a damping: the tutorial's k1, k2, k12 (c1, c2,
-  !> c12) or a &spring record's k (c). They decide the pe and damping_loss columns.
+  !> c12), a &spring record's k (c) or a compliant &contact's k (c). They decide the pe and damping_loss columns.
   pure function springs_named(input) result(named)
     type(scene_input), intent(in) :: input
     logical :: named(2)
     integer :: r
     named = [any(input%given(spring_index)), any(input%given(spring_index + 2))]
+    ! A compliant stop's k stores energy (pe), its c dissipates (damping_loss).
+    if (allocated(input%chain%contacts)) then
+      do r = 1, size(input%chain%contacts)
+        named = named .or. input%chain%contacts(r)%given([r_stop_k, r_stop_c])
+      end do
+    end if
     if (.not. allocated(input%chain%springs)) return
     do r = 1, size(input%chain%springs)
       named = named .or. input%chain%springs(r)%given([r_k, r_c])
@@ -825,7 +863,7 @@ contains
   subroutine set_springs(scene, error)
     type(scene_type), intent(inout) :: scene
     type(error_type), allocatable, intent(inout) :: error
-    integer :: ne
+    integer :: ne, j
     ne = scene%n_elements
     if (scene%n_bodies > 2) then
       ! The N-body engine reads the element records themselves (impact1d_elements).
@@ -848,6 +886,21 @@ contains
     scene%springs%present = ne > 0
     ! The lightest body's mass (the scene's own: not the kernels' one-body phantom).
     call scene%springs%set_frequency(minval(scene%body_mass))
+    if (scene%n_stops == 0) return
+    if (ne + scene%n_stops > pair_elements) then
+      call raise(error, status_input, 'the scene has ' // trim(fmt(ne)) // ' springs and dampers and ' // &
+        trim(fmt(scene%n_stops)) // ' compliant stop limits: a scene of one or two bodies has at most ' // &
+        trim(fmt(pair_elements)) // ' of them together (the two-body kernels'' elements)')
+      return
+    end if
+    ! Compliant stops are state-dependent forces too (springs' stepping and sampling; the pe
+    ! and damping_loss columns from springs_named); the sampling rate bounds them as if
+    ! engaged (sqrt(a + b) <= sqrt(a) + sqrt(b)).
+    associate (stops => [(j, j = scene%n_rows + 1, scene%n_rows + scene%n_stops)])
+      scene%springs%omega = scene%springs%omega + rate_bound(scene%row_body(:, stops), scene%row_k(stops), &
+        scene%row_c(stops), minval(scene%body_mass))
+    end associate
+    scene%springs%present = .true.
   end subroutine set_springs
 
   !> Room for nc contact records, none of their limits present yet.
@@ -856,12 +909,14 @@ contains
     integer, intent(in) :: nc
     scene%n_contacts = nc
     allocate(scene%contact_body(2, nc), scene%contact_has(2, nc), scene%contact_limit(2, nc), &
-      scene%contact_restitution(2, nc), scene%contact_name(nc))
+      scene%contact_restitution(2, nc), scene%contact_name(nc), scene%contact_k(nc), scene%contact_c(nc))
     scene%contact_body = 0
     scene%contact_has = .false.
     scene%contact_limit = 0.0_wp
     scene%contact_restitution = 1.0_wp
     scene%contact_name = ''
+    scene%contact_k = 0.0_wp
+    scene%contact_c = 0.0_wp
   end subroutine allocate_contacts
 
   !> The rows from the contact records: one per present limit, in record order, the lower
@@ -871,7 +926,7 @@ contains
   subroutine set_rows(scene, error)
     type(scene_type), intent(inout) :: scene
     type(error_type), allocatable, intent(inout) :: error
-    integer :: j, e, r, nr
+    integer :: j, e, r, nr, pass
     real(wp) :: sgn
     logical :: suffix
     nr = count(scene%contact_has)
@@ -880,36 +935,44 @@ contains
         'two bodies has at most ' // trim(fmt(pair_rows)) // ' (the two-body kernels'' rows)')
       return
     end if
-    scene%n_rows = nr
+    scene%n_stops = count(scene%contact_has .and. spread(scene%contact_k > 0.0_wp, 1, 2))
+    scene%n_rows = nr - scene%n_stops
     allocate(scene%row_contact(nr), scene%row_body(2, nr), scene%row_normal(2, nr), scene%row_offset(nr), &
-      scene%row_restitution(nr), scene%row_partner(nr), scene%row_name(nr))
+      scene%row_restitution(nr), scene%row_partner(nr), scene%row_name(nr), scene%row_k(nr), scene%row_c(nr))
     scene%row_partner = 0
     r = 0
-    do j = 1, scene%n_contacts
-      suffix = all(scene%contact_has(:, j)) .or. scene%contact_name(j) == 'slot'
-      do e = 1, 2
-        if (.not. scene%contact_has(e, j)) cycle
-        r = r + 1
-        sgn = merge(1.0_wp, -1.0_wp, e == 1)
-        scene%row_contact(r) = j
-        scene%row_body(:, r) = scene%contact_body(:, j)
-        scene%row_normal(:, r) = merge([-sgn, sgn], [0.0_wp, 0.0_wp], scene%contact_body(:, j) /= 0)
-        scene%row_offset(r) = -sgn * scene%contact_limit(e, j)
-        scene%row_restitution(r) = scene%contact_restitution(e, j)
-        scene%row_name(r) = scene%contact_name(j)
-        if (suffix) scene%row_name(r) = trim(scene%contact_name(j)) // trim(merge('_min', '_max', e == 1))
-      end do
-      if (all(scene%contact_has(:, j))) then
-        if (scene%contact_limit(1, j) == scene%contact_limit(2, j)) then
-          scene%row_partner(r - 1) = r
-          scene%row_partner(r) = r - 1
+    ! The rigid records' rows, then the compliant stops' (pass 2), each in record order.
+    do pass = 1, 2
+      do j = 1, scene%n_contacts
+        if ((scene%contact_k(j) > 0.0_wp) .neqv. (pass == 2)) cycle
+        suffix = all(scene%contact_has(:, j)) .or. scene%contact_name(j) == 'slot'
+        do e = 1, 2
+          if (.not. scene%contact_has(e, j)) cycle
+          r = r + 1
+          sgn = merge(1.0_wp, -1.0_wp, e == 1)
+          scene%row_contact(r) = j
+          scene%row_body(:, r) = scene%contact_body(:, j)
+          scene%row_normal(:, r) = merge([-sgn, sgn], [0.0_wp, 0.0_wp], scene%contact_body(:, j) /= 0)
+          scene%row_offset(r) = -sgn * scene%contact_limit(e, j)
+          scene%row_restitution(r) = scene%contact_restitution(e, j)
+          scene%row_k(r) = scene%contact_k(j)
+          scene%row_c(r) = scene%contact_c(j)
+          scene%row_name(r) = scene%contact_name(j)
+          if (suffix) scene%row_name(r) = trim(scene%contact_name(j)) // trim(merge('_min', '_max', e == 1))
+        end do
+        if (all(scene%contact_has(:, j)) .and. pass == 1) then
+          if (scene%contact_limit(1, j) == scene%contact_limit(2, j)) then
+            scene%row_partner(r - 1) = r
+            scene%row_partner(r) = r - 1
+          end if
         end if
-      end if
+      end do
     end do
     ! The two-body kernels' view: each row's coefficients on the pair's lanes (body i in
-    ! lane i). The N-body engine reads the rows themselves.
+    ! lane i). The N-body engine reads the rows themselves. The mode solve sees the rigid
+    ! rows only.
     if (scene%n_bodies > 2) return
-    scene%pair%n_rows = nr
+    scene%pair%n_rows = scene%n_rows
     scene%pair%normal = 0.0_wp
     do r = 1, nr
       do e = 1, 2
@@ -936,8 +999,18 @@ contains
     logical :: ok
     integer :: j
 
-    call assemble(scene%element_body, scene%element_k, k)
-    call assemble(scene%element_body, scene%element_c, c)
+    if (scene%n_stops > 0) then
+      ! The compliant stops as if engaged (springs and dampers between their rows' ends).
+      associate (stops => [(j, j = scene%n_rows + 1, scene%n_rows + scene%n_stops)])
+        call assemble(reshape([scene%element_body, scene%row_body(:, stops)], [2, scene%n_elements + &
+          scene%n_stops]), [scene%element_k, scene%row_k(stops)], k)
+        call assemble(reshape([scene%element_body, scene%row_body(:, stops)], [2, scene%n_elements + &
+          scene%n_stops]), [scene%element_c, scene%row_c(stops)], c)
+      end associate
+    else
+      call assemble(scene%element_body, scene%element_k, k)
+      call assemble(scene%element_body, scene%element_c, c)
+    end if
     call linear_modes(scene%body_mass, c, k, lambda, ok)
     if (.not. ok) then
       call raise(error, status_input, 'the modes of the springs and dampers could not be found ' // &
@@ -1000,18 +1073,32 @@ contains
   !> it: k<b> or c<b> to the ground, k<a><b> or c<a><b> between bodies.
   pure function fastest_element(scene) result(text)
     type(scene_type), intent(in) :: scene
-    character(len=fmt_width + 24) :: text     ! blank padded: callers trim
-    real(wp) :: mass(scene%n_elements), rate(2 * scene%n_elements)
+    character(len=fmt_width + name_len + 24) :: text     ! blank padded: callers trim
+    real(wp) :: rate(2 * scene%n_elements), stop_rate(2 * scene%n_stops), mass
     character(len=8) :: ends
-    integer :: j, ne
+    integer :: j, ne, ns, r
     ne = scene%n_elements
+    ns = scene%n_stops
     do j = 1, ne
-      associate (m => scene%body_mass, a => scene%element_body(1, j), b => scene%element_body(2, j))
-        mass(j) = m(b)
-        if (a > 0) mass(j) = 1.0_wp / (1.0_wp / m(a) + 1.0_wp / m(b))
-      end associate
+      mass = ends_mass(scene, scene%element_body(:, j))
+      rate([j, ne + j]) = [sqrt(scene%element_k(j) / mass), scene%element_c(j) / mass]
     end do
-    rate = [sqrt(scene%element_k / mass), scene%element_c / mass]
+    do j = 1, ns
+      r = scene%n_rows + j
+      mass = ends_mass(scene, scene%row_body(:, r))
+      stop_rate([j, ns + j]) = [sqrt(scene%row_k(r) / mass), scene%row_c(r) / mass]
+    end do
+    ! A compliant stop sets it when it is faster than every element (as if engaged).
+    if (ns > 0) then
+      if (ne == 0 .or. maxval(stop_rate) > maxval(rate)) then
+        j = maxloc(stop_rate, 1)
+        if (j > ns) j = j - ns
+        r = scene%n_rows + j
+        text = 'the stop ''' // trim(scene%row_name(r)) // ''' (k = ' // trim(fmt(scene%row_k(r))) // &
+          ', c = ' // trim(fmt(scene%row_c(r))) // ')'
+        return
+      end if
+    end if
     j = maxloc(rate, 1)
     if (j > ne) j = j - ne
     write(ends, '(i0)') scene%element_body(2, j)
@@ -1022,6 +1109,17 @@ contains
       text = 'c' // trim(ends) // ' = ' // trim(fmt(scene%element_c(j)))
     end if
   end function fastest_element
+
+  !> The mass an element or stop between ends (a, b) moves: the body's on the ground, the
+  !> reduced mass between two bodies.
+  pure real(wp) function ends_mass(scene, ends) result(mass)
+    type(scene_type), intent(in) :: scene
+    integer, intent(in) :: ends(2)
+    associate (m => scene%body_mass, a => ends(1), b => ends(2))
+      mass = m(b)
+      if (a > 0) mass = 1.0_wp / (1.0_wp / m(a) + 1.0_wp / m(b))
+    end associate
+  end function ends_mass
 
   !> The step toward a stop with `remaining` time to it: dt, or what is left when that is
   !> less. No sliver steps: a step that would end just short of the stop goes to it.

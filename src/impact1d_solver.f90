@@ -24,6 +24,7 @@ module impact1d_solver
   use impact1d_event_log, only: event_log_type
   use impact1d_event_point, only: event_point
   use impact1d_nbody_solver, only: run_nbody
+  use impact1d_loads, only: stop_potential
   implicit none
   private
   public :: run, run_stats
@@ -73,7 +74,7 @@ contains
     end if
     ! What the sink calls the events on each row; nothing counted yet.
     sink%row_names = scene%row_name
-    call start_counts(stats, scene%n_rows, scene%n_bodies)
+    call start_counts(stats, scene%n_rows + scene%n_stops, scene%n_bodies)
     ! The stepping kernels here take the bodies in lanes (impact1d_lanes); more bodies run
     ! on the N-body engine.
     if (scene%n_bodies > max_lanes) then
@@ -88,10 +89,11 @@ contains
     rk%polynomial_forcing = scene%forcing%is_polynomial() .and. .not. scene%springs%present
     rk%bulk_steps => constant_steps
     rk%constant_forcing = .not. (scene%forcing%varies .or. scene%springs%present)
+    call rk%set_springs(scene, 0)
     ! Every array of the run, once: nothing allocates per step.
     call new_state(scene%n_bodies, s0)
     allocate(watch%quiet_body(scene%n_bodies))
-    call event_log%allocate_log(scene%n_rows, scene%n_bodies)
+    call event_log%allocate_log(scene%n_rows + scene%n_stops, scene%n_bodies)
     s0%x(:) = scene%body_x0
     s0%v(:) = scene%body_v0
     ke0 = kinetic_energy(scene, s0%v)
@@ -180,6 +182,7 @@ contains
     real(wp) :: pe
     pe = 0.0_wp
     if (scene%springs%present) pe = scene%springs%potential(s%x, s%x_lo)
+    if (scene%n_stops > 0) pe = pe + stop_potential(scene, s%x, s%x_lo)
     call emit_sample(sink, stats, s%t, s%x, s%v, scene%pair%mass, ke0, s%work, s%friction_loss, &
       s%impact_loss, scene%springs%present, [pe, pe0, s%damping_loss], error)
     j_sample = j_sample + 1

@@ -7,6 +7,8 @@ module impact1d_stepping
   use impact1d_events, only: hermite
   use impact1d_lanes, only: max_lanes
   use impact1d_state, only: lane_state_type, add_compensated, constant_step, constant_steps
+  use impact1d_loads, only: stop_release_loss
+  use impact1d_springs, only: springs_type
   implicit none
   private
   public :: rk4_type, book_constant_ledger, books_ledger, dense_output
@@ -25,6 +27,12 @@ module impact1d_stepping
     !> With springs the force depends on the state too: the state it was evaluated in.
     real(wp), dimension(max_lanes) :: end_x = 0.0_wp, end_x_lo = 0.0_wp, end_v = 0.0_wp, end_v_lo = 0.0_wp
     real(wp) :: end_external(max_lanes) = 0.0_wp   !< and its external (time-only) part
+    !> The springs and dampers the state-dependent step applies: the scene's, then the
+    !> compliant stops engaged as elements of their own (set_springs, at the run's start
+    !> and whenever a stop switches), so a scene without stops steps exactly as before.
+    !> Allocatable (once a run): a component of its size default-initialised in run made
+    !> run too large for the compiler to inline advance (+50 instructions a spring step).
+    type(springs_type), allocatable :: springs
     !> impact1d_state's constant_steps, called through this pointer (set by run) so that the
     !> compiler does not inline it: compiled on its own its loop keeps every value in
     !> registers, two bodies a register (2.6 ns a step); inlined, it takes the registers its
@@ -32,6 +40,7 @@ module impact1d_stepping
     procedure(constant_steps), pointer, nopass :: bulk_steps => null()
   contains
     procedure :: step => rk4_step
+    procedure :: set_springs
   end type rk4_type
 
 contains
@@ -138,7 +147,7 @@ contains
     else
       call scene%forcing%force(a%t, f0)
       f = f0
-      call scene%springs%add_force(a%x, a%x_lo, v0, f)
+      call self%springs%add_force(a%x, a%x_lo, v0, f)
     end if
     call scene%forcing%force(a%t + half, fm)
     call scene%forcing%force(a%t + step, f1)
@@ -149,17 +158,17 @@ contains
     kx2 = v0 + half * kv1
     dx = a%x_lo + half * kx1
     load = fm
-    call scene%springs%add_force(a%x, dx, kx2, load)
+    call self%springs%add_force(a%x, dx, kx2, load)
     call mode%acceleration(load, kv2)
     kx3 = v0 + half * kv2
     dx = a%x_lo + half * kx2
     load = fm
-    call scene%springs%add_force(a%x, dx, kx3, load)
+    call self%springs%add_force(a%x, dx, kx3, load)
     call mode%acceleration(load, kv3)
     kx4 = v0 + step * kv3
     dx = a%x_lo + step * kx3
     load = f1
-    call scene%springs%add_force(a%x, dx, kx4, load)
+    call self%springs%add_force(a%x, dx, kx4, load)
     call mode%acceleration(load, kv4)
     b = a
     call add_compensated(b%t, b%t_lo, step)
@@ -168,7 +177,7 @@ contains
     ! The end force is the next step's start force.
     v1 = b%v + b%v_lo
     f = f1
-    call scene%springs%add_force(b%x, b%x_lo, v1, f)
+    call self%springs%add_force(b%x, b%x_lo, v1, f)
     self%end_external = f1
     self%end_force = f
     self%end_force_t = b%t
@@ -182,10 +191,39 @@ contains
       4.0_wp * dot_product(fm, vm) + dot_product(f1, v1)))
     if (any(mode%f_slide /= 0.0_wp)) call add_compensated(b%friction_loss, b%friction_lo, step / 6.0_wp * &
       dot_product(-mode%f_slide, v0 + 4.0_wp * vm + v1))
-    if (scene%springs%has_damper) call add_compensated(b%damping_loss, b%damping_lo, step / 6.0_wp * &
-      (scene%springs%damping_power(v0) + 4.0_wp * scene%springs%damping_power(vm) + &
-      scene%springs%damping_power(v1)))
+    if (self%springs%has_damper) call add_compensated(b%damping_loss, b%damping_lo, step / 6.0_wp * &
+      (self%springs%damping_power(v0) + 4.0_wp * self%springs%damping_power(vm) + &
+      self%springs%damping_power(v1)))
+    ! The stops released inside lose their stored energy exactly (the engaged ones are
+    ! dampers of self%springs above).
+    if (scene%n_stops > 0 .and. self%springs%has_damper) call add_compensated(b%damping_loss, b%damping_lo, &
+      stop_release_loss(scene, mode%engaged, a%x, a%x_lo, b%x, b%x_lo))
   end subroutine state_dependent_step
+
+  !> The springs the state-dependent step applies: the scene's, and each compliant stop
+  !> engaged (bits of engaged) as a spring and damper along its row's normal with its rest
+  !> at the limit (tension k gap + c gap', pulling the ends together: the stop's push F =
+  !> -(k gap + c gap')). The step's cached end force is forgotten (the forces changed).
+  pure subroutine set_springs(self, scene, engaged)
+    class(rk4_type), intent(inout) :: self
+    type(scene_type), intent(in) :: scene
+    integer, intent(in) :: engaged
+    integer :: j, r, n
+    self%springs = scene%springs
+    self%end_force_t = -huge(1.0_wp)
+    n = self%springs%n
+    do j = 1, scene%n_stops
+      if (.not. btest(engaged, j - 1)) cycle
+      r = scene%n_rows + j
+      n = n + 1
+      self%springs%body(:, n) = scene%row_body(:, r)
+      self%springs%normal(:, n) = scene%pair%normal(:, r)
+      self%springs%k(n) = scene%row_k(r)
+      self%springs%c(n) = scene%row_c(r)
+      self%springs%rest(n) = -scene%row_offset(r)
+    end do
+    self%springs%n = n
+  end subroutine set_springs
 
   !> The step's dense output: Hermite coefficients of each body's displacement (lanes).
   pure subroutine dense_output(a, b, step, c)

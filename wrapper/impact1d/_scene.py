@@ -55,7 +55,7 @@ TEXT_FIELDS = ("title", "f1_table", "f2_table", "method", "substeps", "events")
 # the &contact, &spring and &sine records. Checked against _api.input_field_names() at import.
 ARRAY_FIELDS = ("m", "mu", "mus", "x", "v", "f", "f_amp", "f_period", "f_phase", "k", "x_rest", "c",
                 "d_min", "r_min", "d_max", "r_max", "k_link", "d_rest", "c_link", "f_table")
-CONTACT_FIELDS = ("a", "b", "d_min", "r_min", "d_max", "r_max", "name")
+CONTACT_FIELDS = ("a", "b", "d_min", "r_min", "d_max", "r_max", "name", "k", "c")
 SPRING_FIELDS = ("a", "b", "k", "d_rest", "c")
 SINE_FIELDS = ("body", "amp", "period", "phase")
 # The record groups: Scene field, the core's prefix of its fields, the fields.
