@@ -132,41 +132,70 @@ contains
     do k = 1, scene%n_rows
       if (scene%row_partner(k) > 0) closed(k) = closed(k) .or. closed(scene%row_partner(k))
     end do
-    do k = 1, scene%n_rows
-      if (closed(k)) call snap(scene, k, closed, s)
-    end do
+    call snap_closed(scene, closed, s)
   end subroutine close_rows
 
-  !> Put closed row k exactly on its constraint: a ground row puts its body at -offset / n_b;
-  !> a row between bodies puts x_b - x_a on its limit by moving the end that no closed ground
-  !> row holds (b if neither is).
-  pure subroutine snap(scene, k, closed, s)
+  !> Put every closed row exactly on its constraint, the bodies placed outward from what
+  !> holds them: the bodies on closed ground rows first (at -offset / n_b), then across
+  !> closed rows from a placed end to the other, so that a chain held at either end (bodies
+  !> pressed between a wall and a row, in any record order) is put on all its constraints at
+  !> once; snapping row by row, a later row moved a body an earlier one had placed, leaving
+  !> that row's gap at a rounding-level negative value that the location found again at once,
+  !> event point after event point. A group on no closed ground row starts from the a end of
+  !> its first closed row. Rows whose ends are both placed already (a closed loop, a rigid
+  !> link's second limit) move nothing. Passes alternate in direction: a chain takes two.
+  pure subroutine snap_closed(scene, closed, s)
     type(scene_type), intent(in) :: scene
-    integer, intent(in) :: k
     logical, intent(in) :: closed(:)
     type(state_type), intent(inout) :: s
+    logical :: placed(0:scene%n_bodies), grew
     real(wp) :: limit
-    integer :: j
-    associate (a => scene%row_body(1, k), b => scene%row_body(2, k))
-      limit = -scene%row_offset(k) / scene%row_normal(2, k)
-      if (a == 0) then
-        s%x(b) = limit
+    integer :: k, j, first, last, step
+    placed = .false.
+    do k = 1, scene%n_rows
+      if (.not. closed(k) .or. scene%row_body(1, k) /= 0) cycle
+      associate (b => scene%row_body(2, k))
+        s%x(b) = -scene%row_offset(k) / scene%row_normal(2, k)
         s%x_lo(b) = 0.0_wp
-        return
-      end if
-      do j = 1, scene%n_rows
-        if (closed(j) .and. scene%row_body(1, j) == 0 .and. scene%row_body(2, j) == b) then
-          s%x(a) = s%x(b)
-          s%x_lo(a) = s%x_lo(b)
-          call add_compensated(s%x(a), s%x_lo(a), -limit)
-          return
-        end if
+        placed(b) = .true.
+      end associate
+    end do
+    step = -1
+    do
+      grew = .false.
+      step = -step
+      first = merge(1, scene%n_rows, step > 0)
+      last = merge(scene%n_rows, 1, step > 0)
+      do k = first, last, step
+        if (.not. closed(k) .or. scene%row_body(1, k) == 0) cycle
+        associate (ea => scene%row_body(1, k), eb => scene%row_body(2, k))
+          if (placed(ea) .eqv. placed(eb)) cycle
+          limit = -scene%row_offset(k) / scene%row_normal(2, k)
+          if (placed(ea)) then
+            s%x(eb) = s%x(ea)
+            s%x_lo(eb) = s%x_lo(ea)
+            call add_compensated(s%x(eb), s%x_lo(eb), limit)
+          else
+            s%x(ea) = s%x(eb)
+            s%x_lo(ea) = s%x_lo(eb)
+            call add_compensated(s%x(ea), s%x_lo(ea), -limit)
+          end if
+          placed(scene%row_body(:, k)) = .true.
+          grew = .true.
+        end associate
       end do
-      s%x(b) = s%x(a)
-      s%x_lo(b) = s%x_lo(a)
-      call add_compensated(s%x(b), s%x_lo(b), limit)
-    end associate
-  end subroutine snap
+      if (grew) cycle
+      ! A group that no placed body reaches: its first row's a end stays where it is.
+      do j = 1, scene%n_rows
+        if (.not. closed(j) .or. scene%row_body(1, j) == 0) cycle
+        if (.not. (placed(scene%row_body(1, j)) .or. placed(scene%row_body(2, j)))) exit
+      end do
+      if (j > scene%n_rows) exit
+      placed(scene%row_body(1, j)) = .true.
+      step = -1
+    end do
+
+  end subroutine snap_closed
 
   !> Bodies joined by rigid links whose two rows are closed (d_min = d_max) are one body: the
   !> groups (work%rigid, 0 the ground for a link to it) and their masses; each group moves
@@ -347,9 +376,7 @@ contains
     if (.not. found) return
     call event_log%cycles%forget()
     closed = closed .or. rows
-    do k = 1, scene%n_rows
-      if (rows(k)) call snap(scene, k, closed, s)
-    end do
+    call snap_closed(scene, closed, s)
     v = s%v
     call join_cycle(scene%row_body, rows, scene%body_mass, v)
     call apply(scene, s, v)
