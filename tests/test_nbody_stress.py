@@ -8,6 +8,8 @@ Each check here once failed (the commit that added it says what it found):
   by one, a later row moving a body an earlier one had placed; that row's gap was left at a
   rounding-level negative value which the location found again at once, event point after
   event point, into the `max_step_events` error;
+- a body with static but no sliding friction (mu = 0 < mus, random_scene seed 49) had no
+  sliding direction, so its stop was not watched and static friction never held it;
 """
 
 from __future__ import annotations
@@ -62,7 +64,7 @@ def assert_matches_reference(res, sol):
 
 
 # (seed, n): random_scene's own N (None) or a given one; each reference solve < 2 s.
-RANDOM_SEEDS = ((0, None), (3, None), (20, None), (54, None), (2, None), (13, None),
+RANDOM_SEEDS = ((0, None), (3, None), (49, None), (20, None), (54, None), (2, None), (13, None),
                 (19, None), (22, None), (28, None), (31, None), (46, None), (57, None))
 
 
@@ -93,3 +95,18 @@ def test_chain_pressed_on_a_wall_keeps_its_gaps_closed():
         sol = nb.solve(scene)
         for dt in (te.DT, COARSE_DT):
             assert_matches_reference(impact1d.simulate(te.engine_scene(scene, dt=dt)), sol)
+
+
+# --- closed forms ------------------------------------------------------------------------------
+
+def test_body_with_static_but_no_sliding_friction_stops_and_sticks():
+    """mu = 0 < mus: body 2 slides freely against the force -F until it stops at
+    t = m v0 / F, and static friction (mus m g > F) holds it there: x = x0 + m v0^2 / (2 F)."""
+    m, v0, push, g = 2.0, 1.5, -3.0, 10.0
+    scene = impact1d.Scene(m=[1.0, m, 1.0], x=[-100.0, 0.0, 100.0], v=[0.0, v0, 0.0], mu=[0.0, 0.0, 0.0],
+                           mus=[0.0, 0.25, 0.0], f=[0.0, push, 0.0], g=g, t_end=2.0, dt=te.DT, dt_out=0.5)
+    for dt in (te.DT, COARSE_DT):
+        res = impact1d.simulate(scene, dt=dt, dt_out=0.5)
+        assert [(kind, round(t, 12)) for t, kind in te.engine_events(res)] == [("stick2", m * v0 / -push)]
+        assert res.x[-1][1] == pytest.approx(m * v0 ** 2 / (2 * -push), abs=1e-12)
+        assert res.v[-1][1] == 0.0
