@@ -82,7 +82,7 @@ contains
       if ((found == found_body .and. index == i) .or. abs(s%v(i)) <= velocity_rounding * abs(acc(i)) * scene%dt) &
         call zero_velocity(scene, s, i)
     end do
-    call lock_rigid(scene, closed, s, work)
+    call lock_rigid(scene, closed, s, work, sink, stats)
     call impacts(scene, closed, entry_scale, acc, s, work, hit, sink, stats, error)
     if (allocated(error)) return
     if (any(hit)) call cut_cycle(scene, hit, closed, s, event_log, sink, stats)
@@ -200,13 +200,16 @@ contains
   !> Bodies joined by rigid links whose two rows are closed (d_min = d_max) are one body: the
   !> groups (work%rigid, 0 the ground for a link to it) and their masses; each group moves
   !> with its centre of mass (a relative velocity the link cannot have is absorbed, as by a
-  !> plastic impact, and booked as impact loss).
-  subroutine lock_rigid(scene, closed, s, work)
+  !> plastic impact, booked as impact loss and logged as an impact of the link's row that
+  !> approached, as the two-body engine and tests/exact_nbody.py log it).
+  subroutine lock_rigid(scene, closed, s, work, sink, stats)
     type(scene_type), intent(in) :: scene
     logical, intent(in) :: closed(:)
     type(state_type), intent(inout) :: s
     type(point_work_type), intent(inout) :: work
-    real(wp) :: momentum(0:scene%n_bodies), v_new(scene%n_bodies)
+    class(sink_type), intent(inout) :: sink
+    type(run_stats), intent(inout) :: stats
+    real(wp) :: momentum(0:scene%n_bodies), v_new(scene%n_bodies), v_before(scene%n_bodies)
     integer :: i, k, r
     logical :: joined
     work%rigid = [(i, i = 0, scene%n_bodies)]
@@ -231,7 +234,15 @@ contains
         v_new(i) = momentum(r) / work%rigid_mass(r)
       end if
     end do
-    if (any(v_new /= s%v)) call apply(scene, s, v_new)
+    if (all(v_new == s%v)) return
+    v_before = s%v
+    call apply(scene, s, v_new)
+    do k = 1, scene%n_rows
+      if (scene%row_partner(k) == 0) cycle
+      if (.not. (closed(k) .and. closed(scene%row_partner(k)))) cycle
+      if (row_velocity(scene, k, v_before) < -u_tolerance(scene, k, v_before, spread(0.0_wp, 1, scene%n_bodies), &
+          spread(0.0_wp, 1, scene%n_bodies))) call log_event(scene, sink, stats, s%t, class_impact, k, v_before, s%v)
+    end do
   end subroutine lock_rigid
 
   !> Rounding level of row k's normal velocity: from the speeds of its ends and what a step

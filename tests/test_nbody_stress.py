@@ -10,10 +10,13 @@ Each check here once failed (the commit that added it says what it found):
   event point, into the `max_step_events` error;
 - a body with static but no sliding friction (mu = 0 < mus, random_scene seed 49) had no
   sliding direction, so its stop was not watched and static friction never held it;
+- a rigid link whose bodies start with different velocities was locked silently: no impact
+  logged (the two-body engine and exact_nbody log the approaching limit's impact).
 """
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 import impact1d
@@ -24,6 +27,7 @@ from mpmath import mp  # noqa: E402
 import exact_nbody as nb  # noqa: E402
 import nbody_scenes as ns  # noqa: E402
 import test_nbody_engine as te  # noqa: E402
+import test_reference as tr  # noqa: E402
 
 COARSE_DT = 1.0 / 32
 
@@ -110,3 +114,63 @@ def test_body_with_static_but_no_sliding_friction_stops_and_sticks():
         assert [(kind, round(t, 12)) for t, kind in te.engine_events(res)] == [("stick2", m * v0 / -push)]
         assert res.x[-1][1] == pytest.approx(m * v0 ** 2 / (2 * -push), abs=1e-12)
         assert res.v[-1][1] == 0.0
+
+
+# --- the two-body engine's scenes as three bodies ----------------------------------------------
+
+def as_three(scene: impact1d.Scene) -> impact1d.Scene:
+    """A tutorial two-body Scene as the same physics on three bodies: its walls and slot as
+    &contact records (names kept), a third body 1e6 m away, free and at rest, whose meeting
+    with body 2 lies 1e9 m below: it never interacts."""
+    def given(name, default=None):
+        value = getattr(scene, name)
+        return default if value is None else value
+
+    contacts = []
+    if scene.x_left is not None:
+        contacts.append(dict(a=0, b=1, d_min=scene.x_left, r_min=given("r_left", 1.0), name="left"))
+    if scene.x_right is not None:
+        contacts.append(dict(a=0, b=2, d_max=scene.x_right, r_max=given("r_right", 1.0), name="right"))
+    slot = dict(a=1, b=2, d_min=given("d_min", 0.0), r_min=given("r_min", 1.0))
+    if scene.d_max is not None:
+        slot.update(d_max=scene.d_max, r_max=given("r_max", 1.0))
+    contacts.append(dict(slot, name="slot" if "d_max" in slot else "slot_min"))
+    contacts.append(dict(a=2, b=3, d_min=-1.0e9, name="far"))
+    mu = [given("mu1", 0.0), given("mu2", 0.0), 0.0]
+    tables = [given("f1_table"), given("f2_table"), None]
+    return impact1d.Scene(m=[scene.m1, scene.m2, 1.0], x=[scene.x1, scene.x2, 1.0e6],
+                          v=[given("v1", 0.0), given("v2", 0.0), 0.0], mu=mu,
+                          mus=[given("mus1", mu[0]), given("mus2", mu[1]), 0.0],
+                          f=[given("f1", 0.0), given("f2", 0.0), 0.0], g=given("g", 9.80665),
+                          f_table=tables if any(tables) else None, contacts=contacts,
+                          t_end=scene.t_end, dt=scene.dt, dt_out=scene.dt_out)
+
+
+# test_reference's generated scenes 0-59 (all six families) but those that still differ:
+# 0, 35, 40, 45, 50, 57, 59 end in `max_step_events` on three bodies (a break-away located
+# a rounding-level force before its bound: the cluster's LCP calls it a tie, the sliding
+# direction then comes from an acceleration of the wrong sign, and the stop found at once
+# repeats; issue 19 item 1's report), and 58 logs a rigid pair stopped at a wall as a joint
+# impact of the wall and the link's row, as tests/exact_nbody.py does, where the two-body
+# engine logs the wall alone (a convention of the log: the velocities agree).
+THREE_BODY_STILL_DIFFER = (0, 35, 40, 45, 50, 57, 58, 59)
+THREE_BODY_INDICES = tuple(i for i in range(60) if i not in THREE_BODY_STILL_DIFFER)
+
+
+@pytest.fixture(scope="module")
+def table_folder(tmp_path_factory):
+    return str(tmp_path_factory.mktemp("three_body_tables"))
+
+
+@pytest.mark.parametrize("index", THREE_BODY_INDICES)
+def test_two_body_scene_as_three_bodies(index, table_folder):
+    scene, _ = tr.generate(index, table_folder)
+    scene.dt, scene.dt_out = 1e-2, scene.t_end / 100
+    two, three = impact1d.simulate(scene), impact1d.simulate(as_three(scene))
+    a, b = te.engine_events(two), te.engine_events(three)
+    assert [kind for _, kind in a] == [kind for _, kind in b], (a, b)
+    if a:
+        assert max(abs(s - t) for (s, _), (t, _) in zip(a, b)) < 1e-10
+    x, v = np.asarray(three.x)[:, :2], np.asarray(three.v)[:, :2]
+    assert np.max(np.abs(x - np.stack([two.x1, two.x2], 1))) < 1e-9
+    assert np.max(np.abs(v - np.stack([two.v1, two.v2], 1))) < 1e-9
