@@ -134,6 +134,74 @@ def test_frictionless_body_resting_on_a_stuck_one_is_held():
             assert_matches_reference(impact1d.simulate(te.engine_scene(scene, dt=dt)), sol)
 
 
+@pytest.mark.parametrize("push", (10.0, 40.0), ids=("holds", "slides"))
+def test_friction_chain_under_a_constant_push(push):
+    """nbody_scenes.friction_chain: eight touching blocks, static above sliding friction,
+    pushed on block 1 by a constant force: below the sum of the static bounds the load front
+    holds (rest_ of the contacts it reaches at t = 0), above it the chain slides as one."""
+    scene = ns.friction_chain(push=push)
+    with mp.workdps(nb.DPS):
+        answer = ns.friction_chain_answer(scene)
+        want = [(float(t), kind) for t, kind, _, _ in answer["events"]]
+        for dt in (te.DT, COARSE_DT):
+            res = impact1d.simulate(te.engine_scene(scene, dt=dt))
+            assert te.instants(te.engine_events(res)) == te.instants(want)
+            te.assert_final_matches(res, *answer["final"])
+
+
+def test_rigid_pair_bounces_off_a_wall_as_one_body():
+    """Bodies 1 and 2 joined by a rigid link (d_min = d_max) move at 1 m/s onto a wall on
+    body 2 (r = 0.5) 0.75 m away: at t = 0.75 both leave at -0.5 m/s, one impact logged."""
+    scene = impact1d.Scene(m=[1.0, 3.0, 1.0], x=[0.0, 0.5, 100.0], v=[1.0, 1.0, 0.0],
+                           contacts=[dict(a=1, b=2, d_min=0.5, d_max=0.5, name="rod"),
+                                     dict(a=0, b=2, d_max=1.25, r_max=0.5, name="wall"),
+                                     dict(a=2, b=3, d_min=-1.0e9, name="far")], t_end=2.0, dt=te.DT, dt_out=0.5)
+    for dt in (te.DT, COARSE_DT):
+        res = impact1d.simulate(scene, dt=dt, dt_out=0.5)
+        assert te.engine_events(res) == [(0.0, "rest_rod_min"), (0.75, "wall")]
+        assert list(res.x[-1]) == [0.125, 0.625, 100.0] and list(res.v[-1]) == [-0.5, -0.5, 0.0]
+
+
+def fourth_order(errors):
+    """Halving the step divides the error by about 16 (RK4), each time."""
+    return all(12.0 < a / b < 20.0 for a, b in zip(errors, errors[1:]))
+
+
+@pytest.mark.parametrize("mode", (1, 2, 3))
+def test_spring_chain_normal_mode(mode):
+    """Three equal masses between walls, four equal springs (&spring records; the wall ends
+    as ground springs): started at rest in normal mode j (shape sin(i j pi / 4)), each body
+    moves as cos(w_j t), w_j = 2 sqrt(k/m) sin(j pi / 8); the error falls as dt^4."""
+    n, k, amplitude, t_end = 3, 40.0, 0.05, 2.0
+    rest = np.arange(1, n + 1, dtype=float)
+    springs = [dict(a=0, b=1, k=k, d_rest=1.0)] + [dict(a=i, b=i + 1, k=k, d_rest=1.0) for i in range(1, n)] + \
+        [dict(a=0, b=n, k=k, d_rest=float(rest[-1]))]
+    shape = np.sin(np.arange(1, n + 1) * mode * np.pi / (n + 1))
+    omega = 2.0 * np.sqrt(k) * np.sin(mode * np.pi / (2 * (n + 1)))
+    errors = []
+    for dt in (1e-2, 5e-3, 2.5e-3):
+        scene = impact1d.Scene(m=[1.0] * n, x=list(rest + amplitude * shape), springs=springs, d_min=[-1.0e6] * (n - 1),
+                               t_end=t_end, dt=dt, dt_out=t_end)
+        res = impact1d.simulate(scene)
+        errors.append(np.max(np.abs(res.x[-1] - (rest + amplitude * shape * np.cos(omega * t_end)))))
+    assert errors[-1] < 1e-8 and fourth_order(errors), errors
+
+
+def test_sines_on_three_bodies():
+    """A &sine record per body (amp A_i, period P_i, phase 0) on free bodies at rest:
+    x_i(t) = x_i(0) + A_i P_i / (2 pi m) (t - P_i / (2 pi) sin(2 pi t / P_i)), to order 4."""
+    sines = [dict(body=i, amp=2.0 * i, period=0.5 * i, phase=0.0) for i in (1, 2, 3)]
+    t = 1.3
+    exact = [10.0 * (i - 1) + a["amp"] * a["period"] / (2 * np.pi) * (t - a["period"] / (2 * np.pi) *
+             np.sin(2 * np.pi * t / a["period"])) for i, a in zip((1, 2, 3), sines)]
+    errors = []
+    for dt in (1e-2, 5e-3, 2.5e-3):
+        scene = impact1d.Scene(m=[1.0] * 3, x=[0.0, 10.0, 20.0], sines=sines, d_min=[-1.0e6] * 2, t_end=t, dt=dt,
+                               dt_out=t)
+        errors.append(np.max(np.abs(impact1d.simulate(scene).x[-1] - exact)))
+    assert errors[-1] < 1e-9 and fourth_order(errors), errors
+
+
 # --- the two-body engine's scenes as three bodies ----------------------------------------------
 
 def as_three(scene: impact1d.Scene) -> impact1d.Scene:
