@@ -260,12 +260,10 @@ contains
 
   !> Among the force distributions of a cluster with stuck bodies (statically indeterminate:
   !> a block pressed onto a wall that its static friction can hold), the one that leaves a
-  !> held row without load when friction alone keeps the same motion: each held row between
-  !> two stuck bodies or a stuck body and the ground in turn is let go, and stays so when the
-  !> cluster then moves as before without closing into it (the choice of impact1d_modes,
-  !> "more bodies stuck, then more contacts held", and of tests/exact_nbody.py, the least
-  !> contact force). A row with a free end (a frictionless body resting on a stuck one) is
-  !> held as the module header says: friction does not carry it.
+  !> held row without load when friction alone keeps the same motion: each held row in turn
+  !> is let go, and stays so when the cluster then moves as before without closing into it
+  !> (the choice of impact1d_modes, "more bodies stuck, then more contacts held", and of
+  !> tests/exact_nbody.py, the least contact force).
   subroutine prefer_friction(work, nb, nr, status)
     type(mode_work_type), intent(inout) :: work
     integer, intent(in) :: nb, nr
@@ -277,7 +275,6 @@ contains
     if (.not. any(work%stuck(1:nb))) return
     do j = 1, nr
       if (.not. work%active(j)) cycle
-      if (.not. all(work%row_body(:, j) == 0 .or. stuck_end(work%row_body(:, j)))) cycle
       acc = work%acc(1:nb)
       sgn = work%sgn(1:nb)
       active = work%active(1:nr)
@@ -295,15 +292,6 @@ contains
       call solve_gathered(work, nb, nr, status)
       if (status /= cluster_solved) return
     end do
-
-  contains
-
-    !> Whether each of a row's ends (local numbers, 0 the ground) is a stuck body.
-    pure elemental logical function stuck_end(e)
-      integer, intent(in) :: e
-      stuck_end = .false.
-      if (e > 0) stuck_end = work%stuck(e)
-    end function stuck_end
   end subroutine prefer_friction
 
   !> Room for a cluster of nb bodies and nr rows (grown, never shrunk).
