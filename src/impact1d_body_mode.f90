@@ -146,6 +146,13 @@ contains
       call solve_cluster(scene, work, c, f, df, v, mode, status)
       if (status /= mode_solved) return
     end do
+    ! A moving body with static friction but no sliding friction (mu = 0 < mus) has a
+    ! direction too, as in the two-body engine (impact1d_event_point's moving_sign): its stop
+    ! is watched, where static friction may hold it (its sliding force -0 sgn stays 0).
+    do i = 1, scene%n_bodies
+      if (mode%sgn(i) == 0.0_wp .and. v(i) /= 0.0_wp .and. scene%body_static(i) > 0.0_wp) &
+        mode%sgn(i) = sign(1.0_wp, v(i))
+    end do
     call set_groups(scene, mode, work%root)
   end subroutine solve_body_mode
 

@@ -15,7 +15,6 @@ module impact1d_nbody_event
   use impact1d_event_point, only: bounce_series_time
   use impact1d_clusters, only: uf_join, uf_find
   use impact1d_accumulation, only: join_cycle
-  use impact1d_contacts, only: snap_row
   use impact1d_cluster_impact, only: impact_work_type, impact_reserve, cluster_projection
   use impact1d_lcp, only: lcp_solved, lcp_too_large
   use impact1d_body_mode, only: body_mode_type, mode_work_type, solve_body_mode, mode_solved, max_dense_unknowns
@@ -83,7 +82,7 @@ contains
       if ((found == found_body .and. index == i) .or. abs(s%v(i)) <= velocity_rounding * abs(acc(i)) * scene%dt) &
         call zero_velocity(scene, s, i)
     end do
-    call lock_rigid(scene, closed, s, work)
+    call lock_rigid(scene, closed, s, work, sink, stats)
     call impacts(scene, closed, entry_scale, acc, s, work, hit, sink, stats, error)
     if (allocated(error)) return
     if (any(hit)) call cut_cycle(scene, hit, closed, s, event_log, sink, stats)
@@ -139,21 +138,84 @@ contains
     do k = 1, scene%n_rows
       if (scene%row_partner(k) > 0) closed(k) = closed(k) .or. closed(scene%row_partner(k))
     end do
-    do k = 1, scene%n_rows
-      if (closed(k)) call snap_row(scene, k, closed, s%x, s%x_lo)
-    end do
+    call snap_closed(scene, closed, s)
   end subroutine close_rows
+
+  !> Put every closed row exactly on its constraint, the bodies placed outward from what
+  !> holds them: the bodies on closed ground rows first (at -offset / n_b), then across
+  !> closed rows from a placed end to the other, so that a chain held at either end (bodies
+  !> pressed between a wall and a row, in any record order) is put on all its constraints at
+  !> once; snapping row by row, a later row moved a body an earlier one had placed, leaving
+  !> that row's gap at a rounding-level negative value that the location found again at once,
+  !> event point after event point. A group on no closed ground row starts from the a end of
+  !> its first closed row. Rows whose ends are both placed already (a closed loop, a rigid
+  !> link's second limit) move nothing. Passes alternate in direction: a chain takes two.
+  pure subroutine snap_closed(scene, closed, s)
+    type(scene_type), intent(in) :: scene
+    logical, intent(in) :: closed(:)
+    type(state_type), intent(inout) :: s
+    logical :: placed(0:scene%n_bodies), grew
+    real(wp) :: limit
+    integer :: k, j, first, last, step
+    placed = .false.
+    do k = 1, scene%n_rows
+      if (.not. closed(k) .or. scene%row_body(1, k) /= 0) cycle
+      associate (b => scene%row_body(2, k))
+        s%x(b) = -scene%row_offset(k) / scene%row_normal(2, k)
+        s%x_lo(b) = 0.0_wp
+        placed(b) = .true.
+      end associate
+    end do
+    step = -1
+    do
+      grew = .false.
+      step = -step
+      first = merge(1, scene%n_rows, step > 0)
+      last = merge(scene%n_rows, 1, step > 0)
+      do k = first, last, step
+        if (.not. closed(k) .or. scene%row_body(1, k) == 0) cycle
+        associate (ea => scene%row_body(1, k), eb => scene%row_body(2, k))
+          if (placed(ea) .eqv. placed(eb)) cycle
+          limit = -scene%row_offset(k) / scene%row_normal(2, k)
+          if (placed(ea)) then
+            s%x(eb) = s%x(ea)
+            s%x_lo(eb) = s%x_lo(ea)
+            call add_compensated(s%x(eb), s%x_lo(eb), limit)
+          else
+            s%x(ea) = s%x(eb)
+            s%x_lo(ea) = s%x_lo(eb)
+            call add_compensated(s%x(ea), s%x_lo(ea), -limit)
+          end if
+          placed(scene%row_body(:, k)) = .true.
+          grew = .true.
+        end associate
+      end do
+      if (grew) cycle
+      ! A group that no placed body reaches: its first row's a end stays where it is.
+      do j = 1, scene%n_rows
+        if (.not. closed(j) .or. scene%row_body(1, j) == 0) cycle
+        if (.not. (placed(scene%row_body(1, j)) .or. placed(scene%row_body(2, j)))) exit
+      end do
+      if (j > scene%n_rows) exit
+      placed(scene%row_body(1, j)) = .true.
+      step = -1
+    end do
+
+  end subroutine snap_closed
 
   !> Bodies joined by rigid links whose two rows are closed (d_min = d_max) are one body: the
   !> groups (work%rigid, 0 the ground for a link to it) and their masses; each group moves
   !> with its centre of mass (a relative velocity the link cannot have is absorbed, as by a
-  !> plastic impact, and booked as impact loss).
-  subroutine lock_rigid(scene, closed, s, work)
+  !> plastic impact, booked as impact loss and logged as an impact of the link's row that
+  !> approached, as the two-body engine and tests/exact_nbody.py log it).
+  subroutine lock_rigid(scene, closed, s, work, sink, stats)
     type(scene_type), intent(in) :: scene
     logical, intent(in) :: closed(:)
     type(state_type), intent(inout) :: s
     type(point_work_type), intent(inout) :: work
-    real(wp) :: momentum(0:scene%n_bodies), v_new(scene%n_bodies)
+    class(sink_type), intent(inout) :: sink
+    type(run_stats), intent(inout) :: stats
+    real(wp) :: momentum(0:scene%n_bodies), v_new(scene%n_bodies), v_before(scene%n_bodies)
     integer :: i, k, r
     logical :: joined
     work%rigid = [(i, i = 0, scene%n_bodies)]
@@ -178,7 +240,15 @@ contains
         v_new(i) = momentum(r) / work%rigid_mass(r)
       end if
     end do
-    if (any(v_new /= s%v)) call apply(scene, s, v_new)
+    if (all(v_new == s%v)) return
+    v_before = s%v
+    call apply(scene, s, v_new)
+    do k = 1, scene%n_rows
+      if (scene%row_partner(k) == 0) cycle
+      if (.not. (closed(k) .and. closed(scene%row_partner(k)))) cycle
+      if (row_velocity(scene, k, v_before) < -u_tolerance(scene, k, v_before, spread(0.0_wp, 1, scene%n_bodies), &
+          spread(0.0_wp, 1, scene%n_bodies))) call log_event(scene, sink, stats, s%t, class_impact, k, v_before, s%v)
+    end do
   end subroutine lock_rigid
 
   !> Rounding level of row k's normal velocity: from the speeds of its ends and what a step
@@ -328,9 +398,7 @@ contains
     if (.not. found) return
     call event_log%cycles%forget()
     closed = closed .or. rows
-    do k = 1, scene%n_rows
-      if (rows(k)) call snap_row(scene, k, closed, s%x, s%x_lo)
-    end do
+    call snap_closed(scene, closed, s)
     v = s%v
     call join_cycle(scene%row_body, rows, scene%body_mass, v)
     call apply(scene, s, v)
