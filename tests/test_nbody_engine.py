@@ -39,6 +39,7 @@ from mpmath import mp, mpf  # noqa: E402
 
 import exact_nbody as nb  # noqa: E402
 import nbody_scenes as ns  # noqa: E402
+from tools import wall_records  # noqa: E402
 
 INPUT = Path(__file__).resolve().parent.parent / "input"
 
@@ -99,11 +100,7 @@ def reference_scene(scene: impact1d.Scene) -> dict:
         value = getattr(scene, name)
         return default if value is None else value
 
-    contacts = []
-    if scene.x_left is not None:
-        contacts.append(dict(a=0, b=1, d_min=scene.x_left, r_min=given("r_left", 1.0), name="left"))
-    if scene.x_right is not None:
-        contacts.append(dict(a=0, b=n, d_max=scene.x_right, r_max=given("r_right", 1.0), name="right"))
+    contacts = wall_records(scene, n)
     records = scene.contacts or []
     joined = {tuple(sorted((rec["a"], rec["b"]))) for rec in records}
     for i in range(1, n):

@@ -28,6 +28,7 @@ import exact_nbody as nb  # noqa: E402
 import nbody_scenes as ns  # noqa: E402
 import test_nbody_engine as te  # noqa: E402
 import test_reference as tr  # noqa: E402
+from tools import wall_records  # noqa: E402
 
 COARSE_DT = 1.0 / 32
 
@@ -194,11 +195,7 @@ def as_three(scene: impact1d.Scene) -> impact1d.Scene:
         value = getattr(scene, name)
         return default if value is None else value
 
-    contacts = []
-    if scene.x_left is not None:
-        contacts.append(dict(a=0, b=1, d_min=scene.x_left, r_min=given("r_left", 1.0), name="left"))
-    if scene.x_right is not None:
-        contacts.append(dict(a=0, b=2, d_max=scene.x_right, r_max=given("r_right", 1.0), name="right"))
+    contacts = wall_records(scene, 2)
     slot = dict(a=1, b=2, d_min=given("d_min", 0.0), r_min=given("r_min", 1.0))
     if scene.d_max is not None:
         slot.update(d_max=scene.d_max, r_max=given("r_max", 1.0))

@@ -57,3 +57,18 @@ def mounted_tmpfs(folder: Path, options: str):
         yield folder
     finally:
         subprocess.run(["umount", str(folder)], check=True)
+
+
+def wall_records(scene, right_body: int) -> list:
+    """A tutorial Scene's walls as &contact records: the left wall on body 1, the right wall
+    on body `right_body`, named as the engine names them (restitution 1 when not given)."""
+    def given(name, default):
+        value = getattr(scene, name)
+        return default if value is None else value
+
+    contacts = []
+    if scene.x_left is not None:
+        contacts.append(dict(a=0, b=1, d_min=scene.x_left, r_min=given("r_left", 1.0), name="left"))
+    if scene.x_right is not None:
+        contacts.append(dict(a=0, b=right_body, d_max=scene.x_right, r_max=given("r_right", 1.0), name="right"))
+    return contacts
