@@ -5,7 +5,7 @@ module impact1d_output
   use, intrinsic :: iso_fortran_env, only: error_unit, output_unit, int64
   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
   use impact1d_kinds, only: wp
-  use impact1d_error, only: error_type, raise, status_input, status_simulation, status_interrupted, fmt
+  use impact1d_error, only: error_type, raise, status_input, status_simulation, status_interrupted, fmt, fmt_width
   use impact1d_interrupt, only: interrupt_count
   use impact1d_scene, only: scene_input, real_names, n_real, i_title, i_method, i_g, i_dt_out, &
     events_all, events_impacts, events_none, events_kept, name_len, &
@@ -850,15 +850,28 @@ contains
     class(file_sink), intent(inout) :: self
     type(scene_input), intent(in) :: input
     character(len=:), allocatable :: line
-    integer :: a, i
+    character(len=fmt_width) :: text
+    integer :: a, i, used, width
+    ! The line is filled in place (appending value by value copied it whole each time), and a
+    ! value equal to the one before (to the bit: m = 10000*1.0) is not formatted again.
     do a = 1, n_arrays
       associate (array => input%chain%array(a))
         if (array%n == 0 .or. array_is_text(a)) cycle
-        line = '# ' // trim(array_names(a)) // ' ='
+        deallocate(line, stat=i)
+        allocate(character(len=len_trim(array_names(a)) + 4 + array%n * (fmt_width + 1)) :: line)
+        used = len_trim(array_names(a)) + 4
+        line(:used) = '# ' // trim(array_names(a)) // ' ='
         do i = 1, array%n
-          line = line // ' ' // trim(fmt(array%v(i)))
+          if (i == 1) then
+            text = fmt(array%v(i))
+          else if (transfer(array%v(i), 0_int64) /= transfer(array%v(i - 1), 0_int64)) then
+            text = fmt(array%v(i))
+          end if
+          width = len_trim(text)
+          line(used + 1:used + 1 + width) = ' ' // text(:width)
+          used = used + 1 + width
         end do
-        call self%put_line(self%unit, line)
+        call self%put_line(self%unit, line(:used))
       end associate
     end do
   end subroutine put_arrays
