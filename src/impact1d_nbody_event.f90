@@ -10,7 +10,8 @@ module impact1d_nbody_event
   use impact1d_scene, only: scene_type
   use impact1d_state, only: state_type, add_compensated
   use impact1d_output, only: sink_type, run_stats, class_impact, class_rest, class_stick, class_slip
-  use impact1d_yardsticks, only: gap_rounding, velocity_rounding, time_rounding, energy_rounding, same_instant
+  use impact1d_yardsticks, only: gap_rounding, velocity_rounding, time_rounding, energy_rounding, same_instant, &
+    force_scale
   use impact1d_event_log, only: event_log_type, log_event
   use impact1d_event_point, only: bounce_series_time
   use impact1d_clusters, only: uf_join, uf_find
@@ -18,7 +19,7 @@ module impact1d_nbody_event
   use impact1d_cluster_impact, only: impact_work_type, impact_reserve, cluster_projection
   use impact1d_lcp, only: lcp_solved, lcp_too_large
   use impact1d_body_mode, only: body_mode_type, mode_work_type, solve_body_mode, mode_solved, max_dense_unknowns
-  use impact1d_nbody_step, only: nbody_force, nbody_rate, row_gap, row_velocity, row_gap_tolerance, force_size, &
+  use impact1d_nbody_step, only: nbody_force, nbody_rate, row_gap, row_velocity, row_gap_tolerance, &
     found_row, found_body
   implicit none
   private
@@ -34,7 +35,6 @@ module impact1d_nbody_event
     real(wp), allocatable :: scale(:)
     integer, allocatable :: rigid(:)          !< (0:N) bodies locked by rigid links (union-find)
     real(wp), allocatable :: rigid_mass(:)    !< (0:N) mass of each rigid group, by root
-    integer, allocatable :: local(:)          !< (N) a body's index in a gathered impact
   end type point_work_type
 
 contains
@@ -43,7 +43,7 @@ contains
   subroutine new_point_work(n, work)
     integer, intent(in) :: n
     type(point_work_type), intent(inout) :: work
-    allocate(work%scale(n), work%rigid(0:n), work%rigid_mass(0:n), work%local(n))
+    allocate(work%scale(n), work%rigid(0:n), work%rigid_mass(0:n))
     work%scale = 0.0_wp
   end subroutine new_point_work
 
@@ -693,7 +693,7 @@ contains
 
     call new%acceleration(f, acc)
     call new%rate_response(df, acc_rate)
-    tol_a = 1.0e3_wp * eps_wp * force_size(scene, f, df) / scene%body_mass
+    tol_a = 1.0e3_wp * eps_wp * force_scale(scene, f, df) / scene%body_mass
     rate_tol = 1.0e3_wp * eps_wp * sum(abs(df))
     do k = 1, scene%n_rows
       if (new%active(k) .and. .not. event_log%in_contact(k)) then

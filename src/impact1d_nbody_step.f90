@@ -14,7 +14,7 @@ module impact1d_nbody_step
   implicit none
   private
   public :: nbody_force, nbody_rate, nbody_step, row_gap, row_velocity, row_gap_tolerance, locate_nbody, &
-    refine_nbody, gaps_hold, force_size
+    refine_nbody, gaps_hold
   public :: found_none, found_row, found_body, found_hold
 
   !> What a location found: a row's gap closing, a sliding body stopping, the mode failing.
@@ -39,14 +39,6 @@ contains
     call scene%forcing%rate(t, df)
     if (scene%springs%present) call add_element_rates(scene, v, df)
   end subroutine nbody_rate
-
-  !> Size of the forces around an instant (the yardstick of a force's rounding): as
-  !> impact1d_yardsticks' force_scale.
-  pure real(wp) function force_size(scene, f, df)
-    type(scene_type), intent(in) :: scene
-    real(wp), intent(in) :: f(:), df(:)
-    force_size = sum(abs(f)) + 2.0_wp * sum(scene%body_static) + sum(abs(df)) * scene%dt
-  end function force_size
 
   !> One classical RK4 step of the mode's equations from a to b (the four stages in full: the
   !> forces may depend on the state); the ledger by Simpson's rule on the step's Hermite
