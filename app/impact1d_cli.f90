@@ -270,6 +270,44 @@ contains
       ': max_events)'
   end function event_log_text
 
+  !> The summary's events line: each row's impacts, rests, releases, then each body's sticks
+  !> and slips, by name; past max_named names (a long chain has thousands) each kind's total
+  !> and on how many rows or bodies, which a line can hold (the event log has the rest).
+  subroutine events_line(line)
+    character(len=:), allocatable, intent(out) :: line
+    integer, parameter :: max_named = 16
+    character(len=*), parameter :: kinds(class_impact:class_slip) = &
+      [character(len=8) :: 'impacts', 'rests', 'releases', 'sticks', 'slips']
+    integer :: c, k, named, total, on
+    named = 0
+    do c = class_impact, class_slip
+      do k = 1, entries(c)
+        if (event_count(stats, c, k) > 0) named = named + 1
+      end do
+    end do
+    line = ''
+    do c = class_impact, class_slip
+      total = 0
+      on = 0
+      do k = 1, entries(c)
+        if (event_count(stats, c, k) == 0) cycle
+        if (named <= max_named) line = line // ' ' // trim(event_name(scene%row_name, c, k)) // ' ' // &
+          trim(fmt(event_count(stats, c, k)))
+        total = total + event_count(stats, c, k)
+        on = on + 1
+      end do
+      if (named > max_named .and. on > 0) line = line // ' ' // trim(kinds(c)) // ' ' // trim(fmt(total)) // &
+        ' on ' // trim(fmt(on)) // trim(merge(' rows  ', ' bodies', c < class_stick))
+    end do
+    if (len(line) == 0) line = ' none'
+  end subroutine events_line
+
+  !> How many rows (impacts, rests, releases) or bodies (sticks, slips) an event class counts on.
+  integer function entries(class)
+    integer, intent(in) :: class
+    entries = merge(scene%n_rows + scene%n_stops, scene%n_bodies, class < class_stick)
+  end function entries
+
   !> The summary on stdout. Every number in ES with a three-digit exponent (7.73913E+157
   !> lost its E in ES12.5).
   subroutine summary()
@@ -290,15 +328,7 @@ contains
     if (stream) where = 'standard output'
     text = text // '  output    ' // where // ' (' // trim(fmt(scene%n_samples)) // ' rows every ' // &
       trim(fmt(scene%dt_out)) // ' s) and ' // trim(event_log_text()) // nl
-    line = ''
-    ! Per row, impacts, rests, releases; then per body, sticks and slips.
-    do c = class_impact, class_slip
-      do k = 1, merge(scene%n_rows + scene%n_stops, scene%n_bodies, c < class_stick)
-        if (event_count(stats, c, k) > 0) line = line // ' ' // trim(event_name(scene%row_name, c, k)) // ' ' // &
-          trim(fmt(event_count(stats, c, k)))
-      end do
-    end do
-    if (len(line) == 0) line = ' none'
+    call events_line(line)
     text = text // '  events   ' // line // nl
     call final_state(text)
     text = text // nl // '  energy    KE =' // es(final(l + 1))
