@@ -1,6 +1,7 @@
 """Parameter sweeps (issue 11): a table with a row per run, equal to single runs, on threads
 and on a real Dask LocalCluster with worker processes; a failing run is a row."""
 
+import dataclasses
 import math
 import subprocess
 from pathlib import Path
@@ -311,6 +312,18 @@ def test_steady_state_columns_only_when_asked_and_equal_to_the_results():
         assert row.x1_p2p == x.max() - x.min() and row.x1_rms == np.sqrt(np.mean((x - x.mean()) ** 2))
         hits = np.count_nonzero((result.events["kind"] == "left") & (result.events["t"] >= 12.0))
         assert hits > 0 and row.impacts_per_period == hits * 2.4 / (20.0 - 12.0)
+
+
+def test_impacts_per_period_of_a_sine_given_as_a_record():
+    """The impact oscillator's drive written as a &sine record (f1_amp = 0) is the same
+    run; impacts_per_period counted per that record's period (it read only f1/f2_period
+    and gave NaN), the same number as with f1_amp."""
+    scene = impact1d.load_scene(INPUT / "impact_oscillator.nml")
+    as_record = dataclasses.replace(scene, f1_amp=0.0, sines=[dict(body=1, amp=10.0, period=2.4, phase=0.0)])
+    plain = impact1d.sweep(scene, {"r_left": [0.8]}, workers=1, settle=12.0)
+    record = impact1d.sweep(as_record, {"r_left": [0.8]}, workers=1, settle=12.0)
+    assert plain["impacts_per_period"][0] > 0
+    assert record["impacts_per_period"][0] == plain["impacts_per_period"][0]
 
 
 @pytest.mark.parametrize("settle, message", [(-1.0, "must be a time of 0 s or more"),

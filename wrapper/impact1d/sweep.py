@@ -115,8 +115,9 @@ def steady_state(result, settle: float) -> dict:
       oscillation's, not its offset's: a spring's rest position or a wall does not enter).
     - impacts_per_period: impacts (on any contact) in the window times the forcing period
       over the window's length; the period is f1_period when f1_amp is given and non-zero,
-      else f2_period likewise; NaN for a scene without either (&sine records are not
-      read: several sines have no one period in general).
+      else f2_period likewise, else the period of the first &sine record (Scene.sines) with
+      a non-zero amplitude; NaN for a scene without a sine. (Several sines have no one
+      period in general: the first one named is the period the count is per.)
 
     Sampling error, for x = A cos(w t + phi) sampled every h (dt_out) over a window of
     length L = N h (N samples), w h <= pi/2: the sums of exp(i w t_k) and exp(2 i w t_k)
@@ -139,8 +140,9 @@ def steady_state(result, settle: float) -> dict:
         row[f"{name}_p2p"] = float(part.max() - part.min())
         row[f"{name}_rms"] = float(np.sqrt(np.mean((part - part.mean()) ** 2)))
     scene = result.scene
-    period = next((getattr(scene, f"f{i}_period") for i in (1, 2)
-                   if getattr(scene, f"f{i}_amp") and getattr(scene, f"f{i}_period")), None)
+    periods = [(getattr(scene, f"f{i}_amp"), getattr(scene, f"f{i}_period")) for i in (1, 2)]
+    periods += [(record.get("amp"), record.get("period")) for record in scene.sines or ()]
+    period = next((period for amp, period in periods if amp and period), None)
     if period is not None:
         events = result.events
         impacts = np.count_nonzero(np.isin(events["kind"], _IMPACT_KINDS) & (events["t"] >= settle))
