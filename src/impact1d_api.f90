@@ -7,7 +7,7 @@ module impact1d_api
   use, intrinsic :: iso_c_binding, only: c_double, c_int
   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
   use impact1d_kinds, only: wp
-  use impact1d_error, only: error_type, status_ok, status_input, status_interrupted, raise
+  use impact1d_error, only: error_type, status_ok, status_input, status_interrupted, raise, fmt
   use impact1d_interrupt, only: catch_interrupts, interrupt_count
   use impact1d_scene, only: scene_input, scene_type, validate, n_real, n_text, real_names, text_names, &
     i_title, i_f1_table, i_f2_table, i_method, i_substeps, i_events, set_text
@@ -336,7 +336,7 @@ contains
       call put_codes(message, message_codes(:, 1))
       return
     end if
-    if (n_summary /= size(summary_names) .or. any(over_index < 1 .or. over_index > n)) then
+    if (n_summary < size(summary_names) .or. any(over_index < 1 .or. over_index > n)) then
       message = 'internal: bad summary size or override index'
       call put_codes(message, message_codes(:, 1))
       return
@@ -355,6 +355,10 @@ contains
       input%value(over_index) = real(over_values(:, j), wp)
       input%given(over_index) = .true.
       call prepare_scene(input, scene, error)
+      ! Past two bodies, x3_end v3_end .. xN_end vN_end follow the named columns.
+      if (.not. allocated(error) .and. n_summary /= size(summary_names) + 2 * max(0, scene%n_bodies - 2)) &
+        call raise(error, status_input, 'internal: the summary has room for ' // trim(fmt(n_summary)) // &
+          ' columns, not the named ones and two per body past the second')
       if (.not. allocated(error)) then
         sink = summary_sink(n_bodies=scene%n_bodies)
         call run(scene, sink, stats, error, int(interrupt_epoch))
@@ -378,6 +382,7 @@ contains
         stats%max_residual, real(stats%steps, wp), final([l + 2, l + 6])]
       ! A one-body scene has no x2_end, v2_end.
       if (scene%n_bodies == 1) summary(3:4, j) = ieee_value(1.0_c_double, ieee_quiet_nan)
+      summary(size(summary_names) + 1:, j) = final(6:2 * scene%n_bodies + 1)
     end do
   end subroutine simulate_summaries
 

@@ -613,3 +613,34 @@ def test_sweep_of_an_n_body_scene_agrees_with_its_runs():
             res = impact1d.simulate(scene, t_end=t_end)
             assert row.x1_end == res.x1[-1] and row.v2_end == res.v2[-1]
             assert row.n_impacts == sum(not str(k).startswith(RESERVED) for k in res.events["kind"])
+
+
+def test_sweep_of_an_n_body_scene_has_every_bodys_columns():
+    """A sweep of N > 2 bodies adds x3_end v3_end .. xN_end vN_end (and with settle
+    x3_p2p x3_rms v3_p2p v3_rms ..): the core's batch and the per-run path (keep='results',
+    which raised on the N-body event log's missing v1_after) give the same table, each
+    body's end its run's last sample; t_rest from the samples alone (three blocks sliding
+    to a stop: the first sample from which no body moves)."""
+    cradle = load("newtons_cradle.nml")
+    table = impact1d.sweep(cradle, {"t_end": [0.5, 1.0]})
+    kept, results = impact1d.sweep(cradle, {"t_end": [0.5, 1.0]}, keep="results")
+    n = len(cradle.m)
+    columns = [f"{q}{i}_end" for i in range(3, n + 1) for q in "xv"]
+    assert list(table.columns[-1 - len(columns):-1]) == columns
+    __import__("pandas").testing.assert_frame_equal(table, kept)
+    for row, res in zip(table.to_dict("records"), results):
+        assert [row[f"x{i}_end"] for i in range(1, n + 1)] == list(res.x[-1])
+        assert [row[f"v{i}_end"] for i in range(1, n + 1)] == list(res.v[-1])
+    steady = impact1d.sweep(cradle, {"t_end": [2.0]}, settle=1.0)
+    assert steady["x5_p2p"][0] == pytest.approx(0.5) and steady["v5_rms"][0] == 0.0
+    assert steady["x4_p2p"][0] == 0.0
+    blocks = impact1d.Scene(m=[1.0, 2.0, 1.0], x=[0.0, 1.0, 2.0], v=[1.0, 0.5, -0.5], mu=[0.5] * 3,
+                            t_end=1.0, dt=0.01)
+    rest = impact1d.simulate(blocks)
+    moving = np.any(rest.v != 0.0, axis=1)
+    assert not moving[-1] and moving[0]
+    expected = rest.t[np.flatnonzero(moving)[-1] + 1]     # the first sample after the last stop
+    assert 0.2 < expected < 0.22
+    table = impact1d.sweep(blocks, {"t_end": [1.0]})
+    kept, _ = impact1d.sweep(blocks, {"t_end": [1.0]}, keep="results")
+    assert table["t_rest"][0] == kept["t_rest"][0] == expected

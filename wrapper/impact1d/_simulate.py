@@ -114,18 +114,21 @@ def interrupt_epoch_now() -> int:
     return int(_api.interrupt_epoch_now())
 
 
-def run_summaries(scene: Scene, overrides: list, interrupt_epoch: Optional[int] = None):
+def run_summaries(scene: Scene, overrides: list, body_columns: tuple = (), interrupt_epoch: Optional[int] = None):
     """Run `scene` once per override dict in one core call, keeping each run's summary only
     (no samples: O(1) memory per run). The dicts must override the same real fields with
     numbers. Returns ({column: float64 array}, [error message or '' per run]).
-    interrupt_epoch: the caller's (interrupt_epoch_now); None: taken now."""
+    body_columns: the names of x3_end v3_end .. xN_end vN_end for a scene of N > 2 bodies
+    (the core writes them after its named columns). interrupt_epoch: the caller's
+    (interrupt_epoch_now); None: taken now."""
     epoch = interrupt_epoch_now() if interrupt_epoch is None else interrupt_epoch
     names = list(overrides[0]) if overrides else []
     index = np.array([REAL_FIELDS.index(name) + 1 for name in names], dtype=np.int32)
     matrix = np.array([[run[name] for name in names] for run in overrides],
                       dtype=np.float64).reshape(len(overrides), len(names)).T
     form = core_form(scene, {}, _make_form)
-    summary, status, codes = _api.simulate_summaries(*form.core, *form.records, index, matrix, len(_summary_names()),
+    columns = _summary_names() + tuple(body_columns)
+    summary, status, codes = _api.simulate_summaries(*form.core, *form.records, index, matrix, len(columns),
                                                      interrupt_epoch=epoch)
     errors = [""] * len(overrides)
     for j in np.flatnonzero(status):
@@ -134,7 +137,7 @@ def run_summaries(scene: Scene, overrides: list, interrupt_epoch: Optional[int] 
             raise KeyboardInterrupt(errors[j])     # Ctrl-C ended the batch
         if codes[-1, j] != ord(" "):               # filled its room: maybe cut, run it alone
             errors[j] = _whole_message(scene, overrides[j]) or errors[j]
-    return dict(zip(_summary_names(), summary)), errors
+    return dict(zip(columns, summary)), errors
 
 
 def _whole_message(scene: Scene, overrides: dict) -> str:
@@ -213,6 +216,13 @@ def _tutorial_event_kinds() -> tuple:
 # and the words their names start with.
 _ROW_PREFIXES = ("", "rest_", "release_")
 _BODY_PREFIXES = ("stick", "slip")
+# A kind is an impact unless it starts so (DESIGN: no contact name may start so).
+_NOT_IMPACTS = tuple(p for p in _ROW_PREFIXES if p) + _BODY_PREFIXES
+
+
+def is_impact_kind(kind) -> bool:
+    """Whether an event kind is an impact (not a rest_, release_, stick or slip)."""
+    return not str(kind).startswith(_NOT_IMPACTS)
 
 
 @lru_cache(maxsize=64)

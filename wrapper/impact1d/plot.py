@@ -54,6 +54,7 @@ from matplotlib import colormaps
 from matplotlib.ticker import MaxNLocator, ScalarFormatter
 
 from ._files import check_input, write_whole
+from ._simulate import is_impact_kind
 
 __all__ = ["figure", "save", "sweep", "applied_forces", "spacetime", "animate", "PANELS",
            "NBODY_PANELS", "CONTACTS"]
@@ -228,7 +229,7 @@ def _subtitle(window, events):
     dt = _float_or_none(_scene_value(window, "dt"))
     if dt is not None:
         parts.append(f"dt = {dt:g} s")
-    n_impacts = sum(1 for _, k in events if _is_impact(k))
+    n_impacts = sum(1 for _, k in events if is_impact_kind(k))
     where = f" in t = {window.span[0]:g} to {window.span[1]:g} s" if window.span != window.run else ""
     parts.append(f"{n_impacts} impact{'s' if n_impacts != 1 else ''}{where}")
     residual = np.asarray(window.result.residual, dtype=float)
@@ -676,15 +677,9 @@ def _draw_residual(ax, result, events):
 # kind and, for N > 2, the contact's ends a, b (0 = ground); the scene's contact records
 # (a, b, d_min, d_max, name, name_min, name_max; or today's walls and slot) and springs.
 
-# A kind is an impact unless it starts so (DESIGN: no contact name may start so).
-_NOT_IMPACTS = ("rest_", "release_", "stick", "slip")
 _MAP_ABOVE = 50         # more bodies than this: a colour map over body index and time
 _LEGEND_UP_TO = 10      # bodies named in a legend (more: a colour bar of the body index)
 _DOTS_CLEAR = 1000      # impacts on a map drawn at full strength (more: fainter)
-
-
-def _is_impact(kind):
-    return not kind.startswith(_NOT_IMPACTS)
 
 
 def _field(record, name, default=None):
@@ -941,7 +936,7 @@ def _impact_positions(mech, body, x, v):
         return np.empty(0), np.empty(0)
     if not hasattr(mech, "_impacts"):
         kinds = [_kind_str(k) for k in events["kind"]]
-        mech._impacts = np.array([_is_impact(k) for k in kinds], dtype=bool) & \
+        mech._impacts = np.array([is_impact_kind(k) for k in kinds], dtype=bool) & \
             (events["t"] >= mech.t[0]) & (events["t"] <= mech.t[-1])
     ends_a, ends_b = events["a"] == body, events["b"] == body
     mine = np.flatnonzero(mech._impacts & (ends_a | ends_b))
@@ -982,7 +977,7 @@ def _impact_points(mech):
     points = {}
     for contact, events in mech.by_kind.items():
         ends = mech.ends.get(contact)
-        if not _is_impact(contact) or ends is None:
+        if not is_impact_kind(contact) or ends is None:
             continue
         times = np.array([e.t for _, e in events if lo <= e.t <= hi])
         if times.size == 0:
@@ -1161,10 +1156,10 @@ def _draw_map(ax, mech, quantity):
     # gaps after body a (a neighbours' contact on its gap's row; the ground's below body b's).
     if quantity == "gap":
         hits = [(e.t, e.ends[0] if e.ends[0] else e.ends[1] - 0.5)
-                for e in mech.events if _is_impact(e.kind) and e.ends]
+                for e in mech.events if is_impact_kind(e.kind) and e.ends]
     else:
         hits = [(e.t, 0.5 * (e.ends[0] + e.ends[1]) if e.ends[0] else e.ends[1])
-                for e in mech.events if _is_impact(e.kind) and e.ends]
+                for e in mech.events if is_impact_kind(e.kind) and e.ends]
     if hits:
         # Fainter as they crowd: thousands of dots at full strength hide the map under them.
         ax.plot(*np.array(hits).T, linestyle="none", marker=".", markersize=1.5, color="black",
@@ -1236,7 +1231,7 @@ def spacetime(result, *, mode="auto", quantity="v", t_from=None, t_to=None, path
     _draw_spacetime(ax, mech, mode, quantity)
     ax.set_xlabel("time t (s)")
     fig.suptitle(_title(result), fontsize="large", fontweight="bold")
-    n_impacts = sum(1 for e in mech.events if _is_impact(e.kind))
+    n_impacts = sum(1 for e in mech.events if is_impact_kind(e.kind))
     ax.set_title(f"{mech.n} bodies  \u00b7  {n_impacts} impacts", fontsize="small", loc="left",
                  color="0.3")
     if path is not None:

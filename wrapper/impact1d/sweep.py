@@ -2,7 +2,8 @@
 
     table = impact1d.sweep(scene, {"r_left": np.linspace(0, 1, 21), "r_right": [0.5, 1.0]})
 
-A row holds the varied fields, then the run's summary (SUMMARY_COLUMNS), then `error`: empty
+A row holds the varied fields, then the run's summary (SUMMARY_COLUMNS; past two bodies each
+further body's end state, body_columns), then `error`: empty
 when the run succeeded, else the message of its InputError or SimulationError (a failing run
 is a row, never the end of the sweep). Runs go in chunks to threads of this machine (the
 Fortran run releases the GIL) or to the workers of a dask.distributed Client.
@@ -21,7 +22,7 @@ from typing import Optional
 import numpy as np
 
 from ._scene import REAL_FIELDS, InputError, Scene, SimulationError
-from ._simulate import _OVERRIDABLE, interrupt_epoch_now, run_summaries, simulate
+from ._simulate import _OVERRIDABLE, interrupt_epoch_now, is_impact_kind, run_summaries, simulate
 
 __all__ = ["sweep", "SUMMARY_COLUMNS", "STEADY_COLUMNS", "summarize", "steady_state", "run_chunk"]
 
@@ -43,6 +44,30 @@ _PARALLEL_FROM = 200
 _CHUNK_MIN, _CHUNK_MAX = 16, 512
 
 
+def _bodies(scene: Scene) -> int:
+    """How many bodies a scene has: the length of its mass array, else one or two by the
+    tutorial's m2."""
+    masses = vars(scene).get("m")
+    if masses is not None and not isinstance(masses, (int, float)):
+        return len(masses)
+    return 2 if scene.m2 is not None else 1
+
+
+def body_columns(n_bodies: int, words=("end",)) -> tuple:
+    """The per-body columns past the second body's: x3_end v3_end .. xN_end vN_end (and
+    with words ("p2p", "rms"): x3_p2p x3_rms v3_p2p v3_rms ..), after SUMMARY_COLUMNS
+    (STEADY_COLUMNS), which name bodies 1 and 2."""
+    return tuple(f"{q}{i}_{word}" for i in range(3, n_bodies + 1) for q in ("x", "v") for word in words)
+
+
+def summary_columns(scene: Scene, settle: Optional[float] = None) -> tuple:
+    """A sweep's measured columns for `scene`: SUMMARY_COLUMNS, each body's end state past
+    the second, then with settle STEADY_COLUMNS and each body's past the second."""
+    n = _bodies(scene)
+    names = SUMMARY_COLUMNS + body_columns(n)
+    return names + (STEADY_COLUMNS + body_columns(n, ("p2p", "rms")) if settle is not None else ())
+
+
 def _chunk_size(n_runs: int, workers: int) -> int:
     return max(_CHUNK_MIN, min(_CHUNK_MAX, n_runs // (8 * workers)))
 
@@ -58,32 +83,71 @@ def summarize(result) -> dict:
     events = result.events
     kinds = events["kind"]
     counts = {kind: int(np.count_nonzero(kinds == kind)) for kind in _IMPACT_KINDS}
+    impacts = sum(1 for kind in kinds if is_impact_kind(kind))
     two_bodies = result.v2 is not None
-    moving = (result.v1 != 0.0) | ((result.v2 != 0.0) if two_bodies else False)
-    if moving[-1]:
-        t_rest = math.nan
-    else:
-        # The core's order: events at a sample's time come before that sample, and events
-        # at one instant in the order logged.
-        t_sample_moved = result.t[np.flatnonzero(moving)[-1]] if moving.any() else -math.inf
-        leaves_moving = (events["v1_after"] != 0.0) | (
-            (events["v2_after"] != 0.0) if two_bodies else False)
-        after = np.arange(len(events)) > (np.flatnonzero(leaves_moving)[-1] if leaves_moving.any() else -1)
-        t_event_moved = events["t"][~after].max() if (~after).any() and leaves_moving.any() else -math.inf
-        still = events["t"][after & (events["t"] > t_sample_moved)]
-        at_rest = result.t[(result.t > t_sample_moved) & (result.t >= t_event_moved)]
-        t_rest = float(min(still.min() if len(still) else math.inf, at_rest.min()))
-    row = {"x1_end": result.x1[-1], "v1_end": result.v1[-1],
+    t_rest = _rest_time(result) if _bodies(result.scene) <= 2 else _rest_sample(result, np.any(result.v != 0.0, axis=1))
+    row = {"x1_end": result.x1[-1], "v1_end": result.v1[-1], **_body_values(result, ("end",)),
            "x2_end": result.x2[-1] if two_bodies else math.nan,
            "v2_end": result.v2[-1] if two_bodies else math.nan, "ke_end": result.ke[-1],
-           "n_impacts": sum(counts.values()), **{f"n_{k}": counts[k] for k in _IMPACT_KINDS},
+           "n_impacts": impacts, **{f"n_{k}": counts[k] for k in _IMPACT_KINDS},
            "t_rest": t_rest, "impact_loss": result.impact_loss[-1],
            "friction_loss": result.friction_loss[-1],
            "energy_residual": result.energy_residual, "steps": result.steps,
            # The springs' energy and the dampers' loss at t_end: 0 without them.
            "pe_end": result.pe[-1] if result.pe is not None else 0.0,
            "damping_loss": result.damping_loss[-1] if result.damping_loss is not None else 0.0}
-    return {name: row[name] for name in SUMMARY_COLUMNS}
+    return {name: row[name] for name in SUMMARY_COLUMNS + body_columns(_bodies(result.scene))}
+
+
+def _rest_time(result) -> float:
+    """summarize's t_rest of a one- or two-body run: its events carry both velocities."""
+    events = result.events
+    two_bodies = result.v2 is not None
+    moving = (result.v1 != 0.0) | ((result.v2 != 0.0) if two_bodies else False)
+    if moving[-1]:
+        return math.nan
+    # The core's order: events at a sample's time come before that sample, and events
+    # at one instant in the order logged.
+    t_sample_moved = result.t[np.flatnonzero(moving)[-1]] if moving.any() else -math.inf
+    leaves_moving = (events["v1_after"] != 0.0) | (
+        (events["v2_after"] != 0.0) if two_bodies else False)
+    after = np.arange(len(events)) > (np.flatnonzero(leaves_moving)[-1] if leaves_moving.any() else -1)
+    t_event_moved = events["t"][~after].max() if (~after).any() and leaves_moving.any() else -math.inf
+    still = events["t"][after & (events["t"] > t_sample_moved)]
+    at_rest = result.t[(result.t > t_sample_moved) & (result.t >= t_event_moved)]
+    return float(min(still.min() if len(still) else math.inf, at_rest.min()))
+
+
+def _rest_sample(result, moving) -> float:
+    """summarize's t_rest of a run of more than two bodies (its events name only the pair
+    they concern: the core's summary decides by the samples alone): the first sample from
+    which no body moves, NaN if one moves at the last."""
+    if moving[-1]:
+        return math.nan
+    return float(result.t[np.flatnonzero(moving)[-1] + 1] if moving.any() else result.t[0])
+
+
+def _body_values(result, words, window=slice(None)) -> dict:
+    """Each body's measures past the second (body_columns) from result.x and result.v:
+    'end' the last sample, 'p2p' and 'rms' over the samples in window (NaN for a body the
+    output does not have, &run bodies_out)."""
+    row = {}
+    bodies = result.bodies or ()
+    for i in range(3, _bodies(result.scene) + 1):
+        for q in ("x", "v"):
+            values = getattr(result, q)[window, bodies.index(i)] if i in bodies else None
+            for word in words:
+                row[f"{q}{i}_{word}"] = math.nan if values is None else _measure(values, word)
+    return row
+
+
+def _measure(values, word) -> float:
+    """One column's measure: its last value, peak-to-peak, or RMS about its mean."""
+    if word == "end":
+        return float(values[-1])
+    if word == "p2p":
+        return float(values.max() - values.min())
+    return float(np.sqrt(np.mean((values - values.mean()) ** 2)))
 
 
 # The core's default &run max_events, and its largest (a summary reads the whole log).
@@ -129,23 +193,23 @@ def steady_state(result, settle: float) -> dict:
     v with A w for A."""
     t = result.t
     window = t >= settle
-    row = dict.fromkeys(STEADY_COLUMNS, math.nan)
+    scene = result.scene
+    row = dict.fromkeys(STEADY_COLUMNS + body_columns(_bodies(scene), ("p2p", "rms")), math.nan)
     if np.count_nonzero(window) < 2:
         return row
     for name in ("x1", "v1", "x2", "v2"):
         values = getattr(result, name)
         if values is None:
             continue
-        part = values[window]
-        row[f"{name}_p2p"] = float(part.max() - part.min())
-        row[f"{name}_rms"] = float(np.sqrt(np.mean((part - part.mean()) ** 2)))
-    scene = result.scene
+        for word in ("p2p", "rms"):
+            row[f"{name}_{word}"] = _measure(values[window], word)
+    row.update(_body_values(result, ("p2p", "rms"), window))
     periods = [(getattr(scene, f"f{i}_amp"), getattr(scene, f"f{i}_period")) for i in (1, 2)]
     periods += [(record.get("amp"), record.get("period")) for record in scene.sines or ()]
     period = next((period for amp, period in periods if amp and period), None)
     if period is not None:
         events = result.events
-        impacts = np.count_nonzero(np.isin(events["kind"], _IMPACT_KINDS) & (events["t"] >= settle))
+        impacts = sum(1 for kind in events["kind"][events["t"] >= settle] if is_impact_kind(kind))
         row["impacts_per_period"] = impacts * float(period) / float(t[-1] - settle)
     return row
 
@@ -181,10 +245,10 @@ def run_chunk(scene: Scene, overrides: list, keep_results: bool = False, settle:
     interrupt_epoch: the interrupt count the sweep started with, in this process (its
     runs end at their first checkpoint when an interrupt came after it); None: each run's
     start."""
-    names = SUMMARY_COLUMNS + (STEADY_COLUMNS if settle is not None else ())
+    names = summary_columns(scene, settle)
     if not keep_results and settle is None and _batchable(overrides):
-        columns, errors = run_summaries(scene, overrides, interrupt_epoch)
-        return {name: np.asarray(columns[name], dtype=np.float64) for name in SUMMARY_COLUMNS}, errors
+        columns, errors = run_summaries(scene, overrides, body_columns(_bodies(scene)), interrupt_epoch)
+        return {name: np.asarray(columns[name], dtype=np.float64) for name in names}, errors
     rows, errors, results = [], [], []
     for changes in overrides:
         # The summary reads the whole event log (its counts and t_rest are exact whatever
@@ -202,7 +266,8 @@ def run_chunk(scene: Scene, overrides: list, keep_results: bool = False, settle:
         rows.append({**summarize(result), **(steady_state(result, settle) if settle is not None else {})})
         errors.append("")
         if keep_results and events is not None and str(events).lower() != "all":
-            keep = np.isin(result.events["kind"], _IMPACT_KINDS if str(events).lower() == "impacts" else ())
+            impacts_only = str(events).lower() == "impacts"
+            keep = np.array([impacts_only and is_impact_kind(kind) for kind in result.events["kind"]], dtype=bool)
             result = dataclasses.replace(result, events=result.events[keep])
         if keep_results:
             result = _cut_log(result, _DEFAULT_MAX_EVENTS if cap is None else int(cap))
@@ -351,7 +416,7 @@ def sweep(scene: Scene, params, *, workers: Optional[int] = None, client=None,
 
     errors = [error for output in outputs for error in output[1]]
     table = pd.DataFrame({name: [run.get(name) for run in runs] for name in names})
-    measured = SUMMARY_COLUMNS + (STEADY_COLUMNS if settle is not None else ())
+    measured = summary_columns(scene, settle)
     summary = pd.DataFrame({name: (np.concatenate([output[0][name] for output in outputs])
                                    if outputs else np.empty(0)) for name in measured})
     table = pd.concat([table, summary], axis=1)
