@@ -5,10 +5,10 @@
 module impact1d_chain
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_value, ieee_quiet_nan
   use impact1d_kinds, only: wp, eps_wp
-  use impact1d_error, only: error_type, raise, status_input, fmt
+  use impact1d_error, only: error_type, raise, status_input, fmt, fmt_width
   use impact1d_scene, only: scene_input, real_names, text_names, n_real, n_text, set_text, name_of, value_or, &
-    positive_value, nonnegative_value, unit_interval, resolvable, i_m1, i_m2, i_x_left, i_r_left, i_x_right, i_r_right, &
-    i_r_min, i_d_min, i_g, default_gravity, i_mu1, i_mu2, i_mus1, i_mus2, i_x1, i_x2, i_v1, i_v2, i_f1, i_f2, &
+    positive_value, nonnegative_value, unit_interval, resolvable, unresolved, i_m1, i_m2, i_x_left, i_r_left, i_x_right, &
+    i_r_right, i_r_min, i_d_min, i_g, default_gravity, i_mu1, i_mu2, i_mus1, i_mus2, i_x1, i_x2, i_v1, i_v2, i_f1, i_f2, &
     i_f1_amp, i_f2_amp, i_f1_period, i_f2_period, i_f1_phase, i_f2_phase, i_k1, i_k2, i_x1_rest, i_x2_rest, &
     i_c1, i_c2, i_d_max, i_r_max, i_k12, i_d_rest, i_c12, i_f1_table, i_f2_table
   use impact1d_fields, only: array_value, n_arrays, array_names, array_is_link, array_is_text, alias_name, name_len, &
@@ -570,7 +570,8 @@ contains
     do k = 1, records%n_contacts
       associate (name => records%contact_name(k))
         do j = 1, size(reserved)
-          if (index(name, trim(reserved(j))) == 1) then
+          ! (len_trim and substrings: no temporary string per name and word)
+          if (name(:len_trim(reserved(j))) == reserved(j)(:len_trim(reserved(j)))) then
             call raise(error, status_input, 'the contact name ''' // trim(name) // ''' starts with ''' // &
               trim(reserved(j)) // ''', as event kinds do (rest_, release_, stick, slip): choose another')
             return
@@ -585,6 +586,14 @@ contains
     end do
   end subroutine check_names
 
+  !> 'x<b> - x<a>' (or 'x<b>' against the ground), for messages (blank padded: callers trim).
+  pure function difference_name(a, b) result(text)
+    integer, intent(in) :: a, b
+    character(len=2 * fmt_width + 8) :: text
+    text = 'x' // trim(fmt(b))
+    if (a > 0) text = trim(text) // ' - x' // trim(fmt(a))
+  end function difference_name
+
   !> The initial positions satisfy every contact's limits (within the rounding of the
   !> numbers the gap is made of, as for the tutorial's contacts), and every limit, width
   !> and initial gap is resolvable (impact1d_scene's resolvable, as the tutorial's are).
@@ -592,9 +601,9 @@ contains
     type(scene_input), intent(in) :: input
     type(mechanism_records), intent(in) :: records
     type(error_type), allocatable, intent(inout) :: error
-    real(wp) :: x(0:n_bodies_of(input)), d, limit, scale, gap
+    real(wp) :: x(0:n_bodies_of(input)), d, limit, scale, gap, width
     integer :: k, side
-    character(len=:), allocatable :: what
+    ! (a message is made only for a contact that fails: a scene's set-up builds no strings)
     x(0) = 0.0_wp
     do k = 1, size(x) - 1
       x(k) = element_or(input, a_x, k, 0.0_wp)
@@ -602,8 +611,6 @@ contains
     do k = 1, records%n_contacts
       associate (a => records%contact_body(1, k), b => records%contact_body(2, k))
         d = x(b) - x(a)
-        what = 'x' // trim(fmt(b))
-        if (a > 0) what = what // ' - x' // trim(fmt(a))
         do side = 1, 2
           if (.not. records%contact_has(side, k)) cycle
           limit = records%contact_limit(side, k)
@@ -611,20 +618,21 @@ contains
           gap = merge(d - limit, limit - d, side == 1)
           if (gap < -16.0_wp * eps_wp * scale) then
             call raise(error, status_input, 'the initial state violates the contact ''' // &
-              trim(records%contact_name(k)) // ''': ' // what // ' = ' // trim(fmt(d)) // ' is ' // &
-              trim(merge('below', 'above', side == 1)) // ' its ' // trim(merge('lower', 'upper', side == 1)) // &
-              ' limit ' // trim(fmt(limit)))
+              trim(records%contact_name(k)) // ''': ' // trim(difference_name(a, b)) // ' = ' // trim(fmt(d)) // &
+              ' is ' // trim(merge('below', 'above', side == 1)) // ' its ' // &
+              trim(merge('lower', 'upper', side == 1)) // ' limit ' // trim(fmt(limit)))
             return
           end if
           ! (within the rounding of its numbers a gap is contact, as in validate_bodies)
-          if (gap > 16.0_wp * eps_wp * scale) call resolvable('the initial gap of the contact ''' // &
-            trim(records%contact_name(k)) // ''' (' // what // ')', gap, scale, error)
-          if (a > 0) call resolvable('the contact ''' // trim(records%contact_name(k)) // '''s ' // &
-            trim(merge('d_min', 'd_max', side == 1)), limit, scale, error)
+          if (gap > 16.0_wp * eps_wp * scale .and. unresolved(gap, scale)) call resolvable('the initial gap ' // &
+            'of the contact ''' // trim(records%contact_name(k)) // ''' (' // trim(difference_name(a, b)) // ')', &
+            gap, scale, error)
+          if (a > 0 .and. unresolved(limit, scale)) call resolvable('the contact ''' // &
+            trim(records%contact_name(k)) // '''s ' // trim(merge('d_min', 'd_max', side == 1)), limit, scale, error)
         end do
-        if (all(records%contact_has(:, k))) call resolvable('the contact ''' // &
-          trim(records%contact_name(k)) // '''s width d_max - d_min', &
-          records%contact_limit(2, k) - records%contact_limit(1, k), scale, error)
+        width = records%contact_limit(2, k) - records%contact_limit(1, k)
+        if (all(records%contact_has(:, k)) .and. unresolved(width, scale)) call resolvable('the contact ''' // &
+          trim(records%contact_name(k)) // '''s width d_max - d_min', width, scale, error)
         if (allocated(error)) return
       end associate
     end do

@@ -21,7 +21,7 @@ module impact1d_scene
     i_f1_phase, i_f2_amp, i_f2_period, i_f2_phase, i_t_end, i_dt, i_dt_out, i_mus1, i_mus2, &
     i_k1, i_x1_rest, i_c1, i_k2, i_x2_rest, i_c2, i_k12, i_d_rest, i_c12, i_max_events
   public :: sample_time, step_length, set_text, events_kept, name_of, is_nbody, value_or, nbody_refusal
-  public :: positive_value, nonnegative_value, unit_interval, resolvable
+  public :: positive_value, nonnegative_value, unit_interval, resolvable, unresolved
   public :: i_title, i_f1_table, i_f2_table, i_method, i_substeps, i_events, default_gravity
   public :: events_all, events_impacts, events_none
   public :: name_len, set_rows, allocate_contacts, set_springs, springs_named
@@ -596,6 +596,13 @@ contains
     end if
   end subroutine sine_terms
 
+  !> A positive length below min_resolved_ulps units of rounding of scale: resolvable's
+  !> test, for callers that make its message only when it fails.
+  pure logical function unresolved(length, scale)
+    real(wp), intent(in) :: length, scale
+    unresolved = length > 0.0_wp .and. length < min_resolved_ulps * eps_wp * scale
+  end function unresolved
+
   !> A length the scene relies on: zero (contact, a rigid link), or at least
   !> min_resolved_ulps units of rounding of the coordinates it is measured against.
   subroutine resolvable(what, length, scale, error)
@@ -603,7 +610,7 @@ contains
     character(len=*), intent(in) :: what
     real(wp), intent(in) :: length, scale
     if (allocated(error)) return
-    if (length <= 0.0_wp .or. length >= min_resolved_ulps * eps_wp * scale) return
+    if (.not. unresolved(length, scale)) return
     call raise(error, status_input, what // ' = ' // trim(fmt(length)) // ' is below the resolution of ' // &
       'the scene''s coordinates (|x| up to ' // trim(fmt(scale)) // ' m resolves ' // &
       trim(fmt(min_resolved_ulps * eps_wp * scale)) // ' m): move the scene nearer the origin')
