@@ -513,7 +513,8 @@ contains
     type(scene_input), intent(in) :: input
     type(error_type), allocatable, intent(inout) :: error
     integer, intent(in) :: i
-    call positive_value(trim(name_of(input, i)), input%value(i), error)
+    ! (the name's text only for a value that fails: a set-up builds no strings)
+    if (input%value(i) <= 0.0_wp) call positive_value(trim(name_of(input, i)), input%value(i), error)
   end subroutine positive
 
   !> 'name = value must be positive' unless value > 0 (or an earlier check failed).
@@ -541,7 +542,9 @@ contains
     type(scene_input), intent(in) :: input
     type(error_type), allocatable, intent(inout) :: error
     integer, intent(in) :: i
-    if (input%given(i)) call nonnegative_value(trim(name_of(input, i)), input%value(i), error)
+    if (input%given(i)) then
+      if (input%value(i) < 0.0_wp) call nonnegative_value(trim(name_of(input, i)), input%value(i), error)
+    end if
   end subroutine nonnegative
 
   !> 'name = value must not be negative' unless value >= 0 (or an earlier check failed).
@@ -569,8 +572,10 @@ contains
     type(error_type), allocatable, intent(inout) :: error
     integer, intent(in) :: i, owner
     if (allocated(error) .or. .not. input%given(i)) return
-    call unit_interval(trim(name_of(input, i)), input%value(i), error)
-    if (allocated(error)) return
+    if (input%value(i) < 0.0_wp .or. input%value(i) > 1.0_wp) then
+      call unit_interval(trim(name_of(input, i)), input%value(i), error)
+      return
+    end if
     if (.not. input%given(owner) .and. i /= i_r_min) then
       ! (r_min alone is the restitution of the bodies meeting: d_min = 0 by default.)
       call raise(error, status_input, trim(name_of(input, i)) // ' is given but ' // &
