@@ -1,5 +1,5 @@
-"""`make bench`: run the convergence, work-precision and performance studies, the Siconos and
-CVODE peer comparisons and the sweep study in one process on one machine, then write
+"""`make bench`: run the convergence, work-precision and performance studies, the N-body
+accuracy study, the Siconos and CVODE peer comparisons and the sweep study in one process on one machine, then write
 docs/accuracy.md and docs/performance.md from the measured numbers (figures:
 docs/convergence.png, docs/work_precision.png, docs/performance.png).
 
@@ -16,6 +16,7 @@ import call_profile
 import common
 import convergence
 import cvode_peer
+import nbody_accuracy
 import siconos_peer
 import sweep_study
 
@@ -400,6 +401,8 @@ def main(argv):
         work_precision.run()
         print("performance study ...", flush=True)
         performance.run()
+        print("N-body accuracy study ...", flush=True)
+        nbody_accuracy.run()
         print("Siconos peer comparison ...", flush=True)
         siconos_peer.run()
         print("CVODE peer comparison ...", flush=True)
@@ -416,8 +419,10 @@ def main(argv):
     sweeps = common.load_json("sweep") if (common.RESULTS / "sweep.json").exists() else None
     cvode = common.load_json("cvode") if (common.RESULTS / "cvode.json").exists() else None
     calls = common.load_json("call_profile") if (common.RESULTS / "call_profile.json").exists() else None
+    nbody = common.load_json("nbody_accuracy") if (common.RESULTS / "nbody_accuracy.json").exists() else None
     (common.DOCS / "accuracy.md").write_text(
-        accuracy_md(conv, wp, perf, info).rstrip() + "\n\n" + siconos_peer.accuracy_section(peer)
+        accuracy_md(conv, wp, perf, info).rstrip() + "\n\n" + nbody_accuracy.accuracy_section(nbody).rstrip()
+        + "\n\n" + siconos_peer.accuracy_section(peer)
         .rstrip() + "\n\n" + cvode_peer.accuracy_section(cvode))
     (common.DOCS / "performance.md").write_text(
         performance_md(perf, info, cvode, peer).rstrip() + "\n\n"

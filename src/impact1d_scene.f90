@@ -20,7 +20,7 @@ module impact1d_scene
     i_r_min, i_d_max, i_r_max, i_x1, i_v1, i_x2, i_v2, i_f1, i_f2, i_f1_amp, i_f1_period, &
     i_f1_phase, i_f2_amp, i_f2_period, i_f2_phase, i_t_end, i_dt, i_dt_out, i_mus1, i_mus2, &
     i_k1, i_x1_rest, i_c1, i_k2, i_x2_rest, i_c2, i_k12, i_d_rest, i_c12, i_max_events
-  public :: sample_time, step_length, set_text, events_kept, name_of, is_nbody, value_or, nbody_refusal
+  public :: sample_time, step_length, set_text, events_kept, name_of, is_nbody, value_or
   public :: positive_value, nonnegative_value, unit_interval, resolvable, unresolved
   public :: i_title, i_f1_table, i_f2_table, i_method, i_substeps, i_events, default_gravity
   public :: events_all, events_impacts, events_none
@@ -74,9 +74,6 @@ module impact1d_scene
   integer, parameter :: name_len = 32
 
   real(wp), parameter :: default_gravity = 9.80665_wp
-  !> What a scene of more than two bodies gets with the vissim method (is_nbody).
-  character(len=*), parameter :: nbody_refusal = "method = 'vissim' is the tutorial's two-body scheme: " // &
-    "a scene of more than two bodies runs with method = 'event'"
   !> Bodies up to which build_scene checks dt against the springs' modes (a dense eigenproblem).
   integer, parameter :: max_modal_bodies = 400
   !> The tutorial's zero-velocity threshold, used by the vissim method only.
@@ -666,12 +663,9 @@ contains
     scene%method = 'event'
     if (len_trim(input%text(i_method)%s) > 0) scene%method = trim(input%text(i_method)%s)
     ! Up to two bodies the two-body kernels run any records (set_rows counts their rows);
-    ! more run on the N-body engine (impact1d_nbody_solver), which has no vissim method.
+    ! more run on the N-body engine (impact1d_nbody_solver), or, with the vissim method, on
+    ! the N-body form of the tutorial's scheme (impact1d_vissim).
     if (is_nbody(input)) then
-      if (scene%method == 'vissim') then
-        call raise(error, status_input, nbody_refusal)
-        return
-      end if
       call refuse_stops(records, 'are not supported for more than two bodies yet (N = ' // &
         trim(fmt(input%chain%n_bodies)) // '): the N-body engine has rigid contacts only', error)
       if (allocated(error)) return

@@ -26,6 +26,10 @@ Builders (each with its `<name>_answer(scene)`):
     friction_chain     eight touching blocks with static > sliding friction pushed on
                        block 1 by a constant force or a ramp: the load front and the
                        break-away
+    bouncing_chain     five unequal bodies between two walls, free of forces, with gaps
+                       and restitutions 1, 0.75, 0.5 (no closed form: exact_nbody's
+                       events, nine impacts in four seconds; tests/test_vissim_nbody.py
+                       and bench/nbody_accuracy.py measure vissim's order on it)
     random_scene       N = 3..12 bodies, friction, walls, gaps, restitutions 0..1 (no
                        answer: tests/test_exact_nbody.py checks the invariants that hold
                        exactly on any scene)
@@ -400,6 +404,22 @@ def friction_chain_answer(scene):
 
 
 # --- random N-body scenes -----------------------------------------------------------------------------
+
+# --- a chain of impacts ---------------------------------------------------------------------------
+
+def bouncing_chain(t_end=4.0):
+    """Five bodies (masses 1, 2, 0.5, 1.5, 1) a metre apart, diameter 0.25 (contacts n<i><i+1>,
+    restitutions 1, 0.5, 0.75, 1), a wall `left` at x1 >= -1 (r = 1) and `right` at x5 <= 5
+    (r = 0.5), no friction, no forces: a sequence of isolated impacts (two at once, on
+    separate pairs, at t = 0.375), none of them pressed shut, so a fixed-step scheme that
+    sees each impact a step late converges on it."""
+    m = [1.0, 2.0, 0.5, 1.5, 1.0]
+    r = [1.0, 0.5, 0.75, 1.0]
+    contacts = [dict(a=i, b=i + 1, d_min=0.25, r_min=r[i - 1], name=f"n{i}{i + 1}") for i in range(1, 5)]
+    contacts += [dict(a=0, b=1, d_min=-1.0, r_min=1.0, name="left"),
+                 dict(a=0, b=5, d_max=5.0, r_max=0.5, name="right")]
+    return _scene(m, [0.0, 1.0, 2.0, 3.0, 4.0], [2.0, 0.0, -1.0, 0.5, -1.5], contacts, t_end)
+
 
 RESTITUTIONS = (0.0, 0.3, 0.7, 1.0)
 

@@ -240,13 +240,17 @@ def test_records_events_are_named_by_their_rows():
     assert list(res.events["kind"][:2]) == ["stop1", "rest_stop1"]
 
 
-def test_more_than_two_bodies_run_but_not_by_vissim():
+def test_more_than_two_bodies_run_by_both_methods():
     scene = impact1d.Scene(m=[1.0] * 3, x=[0.0, 1.0, 2.0], v=[1.0, 0.0, 0.0], t_end=2.5, dt=1e-3)
     assert [str(k) for k in impact1d.simulate(scene).events["kind"] if not str(k).startswith("rest")] == \
         ["link1", "link2"]
     assert list(impact1d.simulate(scene).events["t"][:2]) == [1.0, 2.0]
-    with pytest.raises(impact1d.InputError, match=r"method = 'vissim' is the tutorial's two-body scheme"):
-        impact1d.simulate(scene, method="vissim")
+    # vissim sees each impact at a step end past it (a gap closed exactly on the grid is seen
+    # a step later; the second body starts a step late): within two steps of the instant.
+    res = impact1d.simulate(scene, method="vissim")
+    assert [str(k) for k in res.events["kind"]] == ["link1", "link2"]
+    late = res.events["t"] - [1.0, 2.0]
+    assert np.all(late > 0) and np.all(late < 2e-3 + 1e-12)
 
 
 def test_more_rows_than_the_kernels_hold_are_refused():

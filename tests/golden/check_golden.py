@@ -6,7 +6,7 @@ the event log (t, kind, velocities before/after) with tests/golden/hashes.json.
     python tests/golden/check_golden.py --update   # store the current engine's hashes
 
 The scenes: the seed cases input/case*.nml at their own dt, at dt = 0.1 and under
-method='vissim'; the other input/*.nml scenes (springs, dampers, static friction, one
+method='vissim' (and VISSIM_NBODY's N-body scenes under it); the other input/*.nml scenes (springs, dampers, static friction, one
 body, contact records, more than two bodies); the bench
 scenes bench/scenes/*.nml; the one-body and spring/damper scenes of
 SCENES (from tests/test_model_widening.py and tests/test_exact_springs.py); and
@@ -37,6 +37,9 @@ import impact1d  # noqa: E402
 GENERATED = sorted(set(range(0, 150, 4)) | {6, 12, 56, 90})
 GENERATED_DT = (1e-2, 1e-3)
 COARSE_DT = 0.1
+# N-body scenes of input/ also run under method='vissim' (its N-body form): impacts between
+# bodies, walls, springs, tables and friction.
+VISSIM_NBODY = ("newtons_cradle.nml", "gear_train.nml", "burridge_knopoff.nml")
 
 # One body (the engine keeps a phantom second body for it: its tolerances read min(m1, 1),
 # so m1 on either side of 1) and every spring and damper element, both methods.
@@ -105,6 +108,7 @@ def scenes():
             yield f"input/{path.name}", _run(scene)
             if path.name.startswith("case"):
                 yield f"input/{path.name}@dt={COARSE_DT}", _run(scene, dt=COARSE_DT)
+            if path.name.startswith("case") or path.name in VISSIM_NBODY:
                 yield f"input/{path.name}@method=vissim", _run(scene, method="vissim")
         for path in sorted((ROOT / "bench" / "scenes").glob("*.nml")):
             scene = impact1d.load_scene(str(path.relative_to(ROOT)))
