@@ -41,8 +41,16 @@ def _core_call(form):
     buffers = _simulate._buffers
     samples = np.empty((form.sample_capacity, len(_simulate.COLUMNS)), order="F")
     return lambda: _scene._api.simulate(
-        form.core[0], form.core[1], form.blob, form.text_end, *form.records, 0, samples, buffers.has_column, buffers.event_real,
-        buffers.event_int, buffers.row_name_codes, buffers.info, buffers.energy_residual, buffers.text_codes)
+        form.core[0], form.core[1], form.blob, form.text_end, *form.records, 0, samples, *buffers.outputs)
+
+
+def _prepared_call(form):
+    """The core call of a form run before (simulate's: run_prepared on its handle)."""
+    buffers = _simulate._buffers
+    samples = np.empty((form.sample_capacity, len(_simulate.COLUMNS)), order="F")
+    for _ in range(2):
+        _simulate._prepared(form)
+    return lambda: _scene._api.run_prepared(form.handle, 0, samples, *buffers.outputs, -1)
 
 
 def _fortran_stages() -> dict:
@@ -68,6 +76,7 @@ def run() -> dict:
         "the core form from the cache (key and look-up)": _timed(lambda: _scene.core_form(scene, SHORT, _simulate._make_form)),
         "the core form made whole (a scene not run before: overrides, to_core)": _timed(lambda: _simulate._make_form(short_scene, {})),
         "the f2py call (arguments, validation, build_scene, sink, run)": _timed(_core_call(short)),
+        "the prepared f2py call (run_prepared: arguments, sink, run)": _timed(_prepared_call(short)),
         "case 3 at dt = 0.1, simulate() whole": _timed(lambda: impact1d.simulate(scene, **EVENTS)),
         "case 3 at dt = 0.1, the f2py call": _timed(_core_call(events)),
     }
@@ -75,7 +84,8 @@ def run() -> dict:
     log = np.empty(41, dtype=_simulate.EVENT_DTYPE)
     stages["case 3 at dt = 0.1, the event log rebuilt (41 events)"] = _timed(
         lambda: _simulate._fill_events(log, _simulate._buffers, 41, 4, False))
-    res = {"stages": stages, "fortran": _fortran_stages()}
+    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=common.REPO, capture_output=True, text=True)
+    res = {"stages": stages, "fortran": _fortran_stages(), "timed_at": commit.stdout.strip()}
     common.save_json("call_profile", res)
     return res
 
@@ -98,15 +108,19 @@ def performance_section(res) -> str:
            common.markdown_table([[name, f"{old:.2f} us", f"{new:.2f} us", f"{old / new:.1f}x"]
                                   for name, old, new in before["side_by_side"]["rows"]],
                                  ["run", "before", "after", "faster"]), ""]
+    out += _instructions_section()
     if res is None:
-        return "\n".join(out + ["After: not measured (run `make bench`)."])
+        return "\n".join(out + ["After: not timed (run `make bench`)."])
     stages, fortran = res["stages"], res["fortran"]
+    # (the short run's core call: the prepared one once simulate has it)
+    core = stages.get("the prepared f2py call (run_prepared: arguments, sink, run)",
+                      stages["the f2py call (arguments, validation, build_scene, sink, run)"])
     rest = (stages["short run, simulate() whole"]["min_us"]
-            - stages["the core form from the cache (key and look-up)"]["min_us"]
-            - stages["the f2py call (arguments, validation, build_scene, sink, run)"]["min_us"])
-    out += ["After (the scene's core form kept per scene and override set, keyed on the field "
+            - stages["the core form from the cache (key and look-up)"]["min_us"] - core["min_us"])
+    out += ["Timed (the scene's core form kept per scene and override set, keyed on the field "
             "values; the core's result arrays the caller's, the event and message buffers made once "
-            "per thread; the event kinds' table made once per layout):", "",
+            "per thread; the event kinds' table made once per layout), at "
+            + res.get("timed_at", "an unrecorded commit") + ":", "",
             common.markdown_table(_rows(stages), ["stage", "min", "mean"]), "",
             f"Of the short run's minimum, {rest:.2f} us is the Python around the call (the override "
             "check, the samples array, reading the counts, the Result with its column views, an "
@@ -120,6 +134,47 @@ def performance_section(res) -> str:
                     "(validation messages, the scene's and the run's arrays: valgrind counts "
                     "them), not arithmetic.")
     return "\n".join(out)
+
+
+def _instructions_section() -> list:
+    """The instruction counts of bench/call_instructions.py, before and after, per stage, and
+    what is left of the call besides its f2py call (the Python around it)."""
+    if not (common.RESULTS / "call_instructions.json").exists():
+        return []
+    counts = common.load_json("call_instructions")
+    before = counts.get("before", {}).get("stages")
+    after = counts["after"]["stages"]
+    columns = [before, after] if before else [after]
+
+    def rest(stages):
+        return stages["simulate() whole"] - stages["the f2py call (arguments, set-up, sink, run)"]
+
+    rows = [[name, *(f"{stages[name]:,}" for stages in columns)] for name in after]
+    rows.append(["the rest: Python around the call (the core form's look-up, the samples array, the Result)",
+                 *(f"{rest(stages):,}" for stages in columns)])
+    return ["Instructions per short call (bench/call_instructions.py: callgrind, which the machine's load "
+            "does not move; a stage's inclusive count, its callees in it). "
+            + (f"Before: {counts['before']['label']}, the scene set up whole at every call; after: " if before
+               else "")
+            + counts["after"].get("label", "") + ", the scene prepared once per core form (the api's prepare / run_prepared: validation, "
+            "build_scene and the records made at the form's second run, not at every call), the Result "
+            "built from a layout worked out once, the thread's buffers read as one tuple:", "",
+            common.markdown_table(rows, ["stage", *(["before", "after"] if before else ["instructions"])]), ""] \
+        + _estimate(counts)
+
+
+def _estimate(counts) -> list:
+    """The after's time at the instructions per microsecond of the last quiet timing: an
+    estimate for a machine too loaded to time the change (not a measurement)."""
+    quiet = counts.get("quiet_reference")
+    if not quiet:
+        return []
+    rate = quiet["instructions"] / quiet["us"]
+    after = counts["after"]["stages"]["simulate() whole"]
+    return [f"At the rate of the last quiet timing ({quiet['label']}: {quiet['us']:.2f} us for about "
+            f"{quiet['instructions']:,} instructions; {quiet['how']}), the after's {after:,} instructions "
+            f"would take about {after / rate:.1f} us: an estimate, not a timing (the aim is 5 us; "
+            "the machine was too loaded to time this change: the times below are of 7ae8c29).", ""]
 
 
 if __name__ == "__main__":

@@ -9,9 +9,11 @@ docs/convergence.png, docs/work_precision.png, docs/performance.png).
 
 from __future__ import annotations
 
+import shutil
 import sys
 import time
 
+import call_instructions
 import call_profile
 import common
 import convergence
@@ -411,6 +413,9 @@ def main(argv):
         sweep_study.run()
         print("call profile ...", flush=True)
         call_profile.run()
+        if shutil.which("valgrind") and shutil.which("callgrind_annotate"):
+            print("call instructions (callgrind) ...", flush=True)
+            call_instructions.run()
         print(f"studies done in {time.perf_counter() - start:.0f} s", flush=True)
     info = common.load_json("machine") if info_path.exists() else common.machine()
     conv, wp, perf = (common.load_json(n) for n in ("convergence", "work_precision", "performance"))

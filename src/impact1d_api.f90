@@ -2,9 +2,10 @@
 !> code and a message; derived types stay inside. Status 0 ok, 1 input error, 2 simulation
 !> error, 3 the caller's arrays were too small (see simulate). No state is kept between calls:
 !> everything a run produced comes back from the call that ran it, so threads may run scenes
-!> at once (the long calls are `threadsafe` for f2py: they release the GIL).
+!> at once (the long calls are `threadsafe` for f2py: they release the GIL). A prepared scene
+!> (prepare) is what that call returns: the caller owns it by its handle and frees it.
 module impact1d_api
-  use, intrinsic :: iso_c_binding, only: c_double, c_int
+  use, intrinsic :: iso_c_binding, only: c_double, c_int, c_intptr_t
   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
   use impact1d_kinds, only: wp
   use impact1d_error, only: error_type, status_ok, status_input, status_interrupted, raise, fmt
@@ -14,15 +15,17 @@ module impact1d_api
   use impact1d_io, only: read_scene_file, prepare_scene
   use impact1d_chain, only: settle_chain, validate_chain, n_ids, id_arrays, id_r_meet, field_name, assign_number, &
     assign_text, scene_assignments
-  use impact1d_fields, only: text_item
+  use impact1d_fields, only: text_item, a_f_table
   use impact1d_output, only: memory_sink, summary_sink, column_names_text => column_names, event_names, &
     n_columns, event_impact, event_rest, present_columns, class_impact, impacts_on, &
     row_length, row_ledger, final_row, check_bodies_out
   use impact1d_solver, only: run, run_stats
+  use impact1d_prepared, only: prepared_scene, prepared_handle, prepared_entry, prepared_free
   implicit none
   private
   public :: field_names, column_names, event_kind_names, read_scene, simulate, simulate_summaries, &
-    summary_column_names, input_field_names, settle_scene, interrupt_epoch_now
+    summary_column_names, input_field_names, settle_scene, interrupt_epoch_now, prepare, run_prepared, &
+    release_prepared
 
   integer(c_int), parameter :: status_too_small = 3   !< arrays too small: sizes needed returned
   !> Room for a message: whole for any message the core builds from the paths and texts it
@@ -215,20 +218,105 @@ contains
     integer(c_int), intent(in) :: interrupt_epoch   !< from interrupt_epoch_now (-1: the count at the run's start)
     type(scene_input) :: input
     type(scene_type) :: scene
-    type(run_stats) :: stats
-    type(memory_sink) :: sink
     type(error_type), allocatable :: error
-    integer, allocatable :: columns(:)
-    character(len=:), allocatable :: note, warnings
-    integer :: k, n_samples, n_events, n_rows
 
     info = 0
     has_column = 0
     energy_residual = 0.0_c_double
+    call set_up(n, values, given, text_blob, text_end, n_numbers, n_texts, field, index, value, record_text_field, &
+      record_text_index, record_text_end, record_blob, n_cols, input, scene, error)
+    if (put_error(error, info, text_codes)) return
+    call run_scene(scene, present_columns(input), progress, max_samples, n_cols, max_events, max_rows, text_room, &
+      samples, has_column, event_real, event_int, row_name_codes, info, energy_residual, text_codes, interrupt_epoch)
+  end subroutine simulate
+
+  !> A scene in simulate's form (n to record_blob, as simulate takes them) validated and
+  !> built once, kept for run_prepared: handle (non-zero) names it until release_prepared
+  !> frees it (impact1d_prepared: the caller owns it). handle is 0 when the scene fails its
+  !> checks or reads a force table (a file, read afresh each run): the caller runs it
+  !> through simulate, which says what is wrong.
+  subroutine prepare(n, values, given, text_blob, text_end, n_numbers, n_texts, number_room, field, index, value, &
+      record_text_room, record_text_field, record_text_index, record_text_end, record_blob, handle)
+    !f2py threadsafe
+    integer(c_int), intent(in) :: n
+    real(c_double), intent(in) :: values(n)
+    integer(c_int), intent(in) :: given(n), text_end(6)          ! 6: n_text (f2py needs the number)
+    character(len=*), intent(in) :: text_blob
+    integer(c_int), intent(in) :: n_numbers, n_texts, number_room, record_text_room
+    integer(c_int), intent(in) :: field(number_room), index(number_room), record_text_field(record_text_room), &
+      record_text_index(record_text_room), record_text_end(record_text_room)
+    real(c_double), intent(in) :: value(number_room)
+    character(len=*), intent(in) :: record_blob
+    integer(c_intptr_t), intent(out) :: handle
+    type(scene_input) :: input
+    type(prepared_scene), pointer :: entry
+    type(error_type), allocatable :: error
+
+    handle = 0
+    allocate(entry)
+    call set_up(n, values, given, text_blob, text_end, n_numbers, n_texts, field, index, value, record_text_field, &
+      record_text_index, record_text_end, record_blob, n_columns, input, entry%scene, error)
+    if (allocated(error) .or. reads_tables(input)) then
+      deallocate(entry)
+      return
+    end if
+    entry%columns = present_columns(input)
+    handle = prepared_handle(entry)
+  end subroutine prepare
+
+  !> Run the scene prepare made (handle): simulate's outputs and statuses, the same
+  !> arrays (a handle that names none: status 1, an internal error). interrupt_epoch is
+  !> not optional here: Python passes it by position (f2py reads keywords more slowly).
+  subroutine run_prepared(handle, progress, max_samples, n_cols, max_events, max_rows, text_room, samples, &
+      has_column, event_real, event_int, row_name_codes, info, energy_residual, text_codes, interrupt_epoch)
+    !f2py threadsafe
+    integer(c_intptr_t), intent(in) :: handle
+    integer(c_int), intent(in) :: progress, max_samples, n_cols, max_events, max_rows, text_room
+    real(c_double), intent(inout), target :: samples(max_samples, n_cols)
+    integer(c_int), intent(inout) :: has_column(n_cols), event_int(max_events, 4), info(8)
+    real(c_double), intent(inout) :: event_real(max_events, 5), energy_residual(1)
+    integer(c_int), intent(inout) :: row_name_codes(32, max_rows)   ! 32: name_len (f2py needs the number)
+    integer(c_int), intent(inout) :: text_codes(text_room, 2)
+    integer(c_int), intent(in) :: interrupt_epoch
+    type(prepared_scene), pointer :: entry
+    type(error_type), allocatable :: error
+
+    info = 0
+    has_column = 0
+    energy_residual = 0.0_c_double
+    entry => prepared_entry(handle)
+    if (.not. associated(entry) .or. n_cols < n_columns) &
+      call raise(error, status_input, 'internal: no prepared scene of that handle, or too few sample columns')
+    if (put_error(error, info, text_codes)) return
+    call run_scene(entry%scene, entry%columns, progress, max_samples, n_cols, max_events, max_rows, text_room, &
+      samples, has_column, event_real, event_int, row_name_codes, info, energy_residual, text_codes, interrupt_epoch)
+  end subroutine run_prepared
+
+  !> Free the scene prepare made (handle, once; 0: nothing), when no run uses it.
+  subroutine release_prepared(handle)
+    integer(c_intptr_t), intent(in) :: handle
+    call prepared_free(handle)
+  end subroutine release_prepared
+
+  !> simulate's scene (its arguments n to record_blob) checked and built: input as written,
+  !> scene as run. n_cols: the caller's sample columns (too few is an internal error).
+  subroutine set_up(n, values, given, text_blob, text_end, n_numbers, n_texts, field, index, value, &
+      record_text_field, record_text_index, record_text_end, record_blob, n_cols, input, scene, error)
+    integer(c_int), intent(in) :: n, n_cols
+    real(c_double), intent(in) :: values(:)
+    integer(c_int), intent(in) :: given(:), text_end(:)
+    character(len=*), intent(in) :: text_blob
+    integer(c_int), intent(in) :: n_numbers, n_texts, field(:), index(:), record_text_field(:), &
+      record_text_index(:), record_text_end(:)
+    real(c_double), intent(in) :: value(:)
+    character(len=*), intent(in) :: record_blob
+    type(scene_input), intent(out) :: input
+    type(scene_type), intent(out) :: scene
+    type(error_type), allocatable, intent(out) :: error
     if (n /= n_real .or. n_cols < n_columns .or. any(text_end < 0 .or. text_end > len(text_blob)) .or. &
         any(text_end(2:) < text_end(:5))) then
       call raise(error, status_input, 'internal: the scene''s fields, texts or sample columns do not match the core')
-      if (put_error(error, info, text_codes)) return
+      return
     end if
     input = flat_input(values, given, text_blob(:text_end(1)), text_blob(text_end(1) + 1:text_end(2)), &
       text_blob(text_end(2) + 1:text_end(3)), text_blob(text_end(3) + 1:text_end(4)), &
@@ -237,7 +325,38 @@ contains
       record_text_index, record_text_end, record_blob, error)
     if (.not. allocated(error)) call prepare_scene(input, scene, error)
     if (.not. allocated(error)) call check_bodies_out(input, error)
-    if (put_error(error, info, text_codes)) return
+  end subroutine set_up
+
+  !> Whether the scene names a force table (f1_table, f2_table, f_table(i)): a file that
+  !> may change between runs, so its scene is not prepared once for many.
+  logical function reads_tables(input)
+    type(scene_input), intent(in) :: input
+    integer :: i
+    reads_tables = len_trim(input%text(i_f1_table)%s) > 0 .or. len_trim(input%text(i_f2_table)%s) > 0
+    do i = 1, input%chain%array(a_f_table)%n
+      reads_tables = reads_tables .or. len_trim(input%chain%array(a_f_table)%t(i)%s) > 0
+    end do
+  end function reads_tables
+
+  !> The run of a scene set up (simulate's, or a prepared one) with the present columns,
+  !> into the caller's arrays: simulate's outputs from info on (info, has_column and
+  !> energy_residual already zero).
+  subroutine run_scene(scene, columns, progress, max_samples, n_cols, max_events, max_rows, text_room, samples, &
+      has_column, event_real, event_int, row_name_codes, info, energy_residual, text_codes, interrupt_epoch)
+    type(scene_type), intent(in) :: scene
+    integer, intent(in) :: columns(:)
+    integer(c_int), intent(in) :: progress, max_samples, n_cols, max_events, max_rows, text_room, interrupt_epoch
+    real(c_double), intent(inout), target :: samples(max_samples, n_cols)
+    integer(c_int), intent(inout) :: has_column(n_cols), event_int(max_events, 4), info(8)
+    real(c_double), intent(inout) :: event_real(max_events, 5), energy_residual(1)
+    integer(c_int), intent(inout) :: row_name_codes(32, max_rows)
+    integer(c_int), intent(inout) :: text_codes(text_room, 2)
+    type(run_stats) :: stats
+    type(memory_sink) :: sink
+    type(error_type), allocatable :: error
+    character(len=:), allocatable :: note, warnings
+    integer :: k, n_samples, n_events, n_rows
+
     warnings = trim(scene%warnings)
     info(8) = scene%n_bodies
     if (n_cols < row_length(scene%n_bodies)) then
@@ -245,7 +364,6 @@ contains
       return
     end if
     call catch_interrupts()
-    columns = present_columns(input)
     has_column(columns) = 1
     ! The rows go straight into samples when it has room (else the sink keeps them and the
     ! caller learns the size needed).
@@ -283,7 +401,7 @@ contains
     do k = 1, n_rows
       call put_codes(trim(scene%row_name(k)), row_name_codes(:, k))
     end do
-  end subroutine simulate
+  end subroutine run_scene
 
   !> simulate's error out: info(1) its status, the message in text_codes(:info(6), 1) (cut
   !> to the room given). True when there was one.

@@ -108,3 +108,22 @@ def test_a_sweep_run_that_starts_after_an_interrupt_ends(name, first):
     lines = run_child(CALLS[name], setup=setup, interrupt="", timeout=120)
     assert lines[0].split()[0] == "interrupted", lines
     assert lines[1] == "next run 41", lines
+
+
+# The long call's form marked as run once before: the call prepares it (api prepare) and
+# runs the prepared scene (run_prepared), which an interrupt ends as it ends a whole set-up's
+# (the child says at exit whether the form was prepared).
+PREPARED = """
+import atexit
+from impact1d import _scene, _simulate
+form = _scene.core_form(scene, dict(t_end=1e7, dt_out=1e5), _simulate._make_form)
+form.handle = form.RUN_ONCE
+atexit.register(lambda: print("prepared", form.handle > 0))
+"""
+
+
+def test_an_interrupt_ends_a_prepared_run():
+    lines = run_child(CALLS["simulate"], setup=PREPARED)
+    word, seconds = lines[0].split()
+    assert word == "interrupted" and float(seconds) < RAISED_WITHIN, lines
+    assert lines[1:3] == ["next run 41", "prepared True"], lines

@@ -255,9 +255,28 @@ class CoreForm:
     `fields` the Scene fields of the scene run (Result.scene), `sample_capacity` the rows
     its run will emit, `flat` whether the scene is in the tutorial's fields (not settled
     from arrays or records), `records` its &contact and &spring records as simulate takes
-    them (record_assignments)."""
+    them (record_assignments), `row_length` the core's full row of its bodies, `names` the
+    columns its runs have (once one ran). `handle`:
+    the core's prepared scene (impact1d_prepared) once the form runs a second time, freed
+    with the form (FRESH before its first run, RUN_ONCE after it, 0 when the core does not
+    prepare it: simulate sets it up whole each run)."""
 
-    __slots__ = ("core", "blob", "text_end", "fields", "sample_capacity", "flat", "records")
+    __slots__ = ("core", "blob", "text_end", "fields", "sample_capacity", "flat", "records", "row_length",
+                 "handle", "names")
+
+    # (a handle is the entry's address: positive, as user-space addresses are)
+    FRESH, RUN_ONCE = -2, -1
+    _release = staticmethod(_api.release_prepared)
+
+    def __init__(self):
+        self.handle = CoreForm.FRESH
+        self.names = None          # (the run's column names: simulate's, after its first run)
+
+    def __del__(self):
+        # (the form goes when the cache drops it and no run holds it: a run in another
+        # thread keeps its form, so the core never frees a scene while it runs)
+        if self.handle > 0:
+            self._release(self.handle)
 
 
 # Core forms by the scene's field values and the overrides (marshal's bytes, version 2: each

@@ -84,13 +84,20 @@ class _Buffers(threading.local):
         self.make(_EVENT_CAPACITY, _ROW_CAPACITY)
 
     def make(self, events: int, rows: int) -> None:
-        self.has_column = np.zeros(len(COLUMNS), dtype=np.int32)
         self.event_real = np.zeros((events, 5), dtype=np.float64, order="F")
         self.event_int = np.zeros((events, 4), dtype=np.int32, order="F")
         self.row_name_codes = np.zeros((32, rows), dtype=np.int32, order="F")
         self.info = np.zeros(8, dtype=np.int32)
         self.energy_residual = np.zeros(1, dtype=np.float64)
         self.text_codes = np.zeros((_TEXT_ROOM, 2), dtype=np.int32, order="F")
+        self.columns(len(COLUMNS))
+
+    def columns(self, n_columns: int) -> None:
+        """has_column n_columns long, and `outputs`: the arrays the core call fills after the
+        samples, in its order (one attribute of the thread's read per call, not seven)."""
+        self.has_column = np.zeros(n_columns, dtype=np.int32)
+        self.outputs = (self.has_column, self.event_real, self.event_int, self.row_name_codes, self.info,
+                        self.energy_residual, self.text_codes)
 
 
 _buffers = _Buffers()
@@ -384,16 +391,32 @@ def _fill_result(columns: dict, samples: np.ndarray, names: tuple) -> None:
     """A Result's sample fields from the (rows, >= len(names)) column-major samples whose
     first columns are `names`: each a view of its column, x and v views of every other
     column from the first x (the core writes x1 v1 x2 v2 ...), x1 ... views of theirs."""
-    columns.update(_ABSENT)
-    # (the present columns first: zip stops at the last name)
-    columns.update(zip(names, samples.T))
+    fields, head, tail, tail_start, x, v = _result_layout(names)
+    columns.update(fields)
+    # (zip stops at the last name)
+    columns.update(zip(head, samples.T))
+    if tail:
+        columns.update(zip(tail, samples.T[tail_start:]))
+    columns["x"] = samples[:, x]
+    columns["v"] = samples[:, v]
+
+
+@lru_cache(maxsize=64)
+def _result_layout(names: tuple):
+    """What _fill_result does for the columns `names`, worked out once per layout: the
+    fields that are no column's view (the absent columns None, `bodies`), the names of the
+    columns that are fields (head: t, and x1 .. v2 of the bodies written, the columns they
+    open with; tail: the ledger's, from column tail_start; () when head has them all), and
+    the slices of x and v (x3 ...: __getattr__'s views of them)."""
     n_written = sum(1 for name in names if name[0] == "x")
-    columns["x"] = samples[:, 1:2 * n_written:2]
-    columns["v"] = samples[:, 2:2 * n_written + 1:2]
-    columns["bodies"] = tuple(int(name[1:]) for name in names[1:2 * n_written:2])
-    for name in names[1:2 * n_written + 1]:
-        if name[1:] not in ("1", "2"):
-            del columns[name]      # (x3 ...: __getattr__'s views of x, v)
+    bodies = tuple(int(name[1:]) for name in names[1:2 * n_written:2])
+    fields = {**_ABSENT, "bodies": bodies}
+    head = names[:1 + 2 * sum(1 for body in bodies if body <= 2)]
+    tail_start = 1 + 2 * n_written
+    tail = names[tail_start:] if len(head) < tail_start else ()
+    if not tail:
+        head = names
+    return fields, head, tail, tail_start, slice(1, 2 * n_written, 2), slice(2, 2 * n_written + 1, 2)
 
 
 def _body_count(scene) -> int:
@@ -432,6 +455,7 @@ def _make_form(scene: Scene, overrides: dict) -> CoreForm:
     form.text_end = np.array(list(itertools.accumulate(map(len, texts))), dtype=np.int32)
     form.fields = vars(scene)
     form.sample_capacity = _sample_capacity(scene)
+    form.row_length = row_length(_body_count(form.fields))
     return form
 
 
@@ -452,6 +476,7 @@ def _with_reals(base: CoreForm, overrides: dict) -> CoreForm:
         given[_REAL_INDEX[name]] = 1
     form.core = (values, given, *base.core[2:])
     form.blob, form.text_end, form.flat, form.records = base.blob, base.text_end, True, base.records
+    form.row_length = base.row_length
     form.fields = {**base.fields, **overrides}
     run_scene = object.__new__(Scene)
     vars(run_scene).update(form.fields)
@@ -476,44 +501,85 @@ def simulate(scene: Scene, *, progress: bool = False, _interrupt_epoch: Optional
         raise InputError(f"unknown scene field(s) in overrides: {', '.join(unknown)} "
                          f"(known: {', '.join(_OVERRIDABLE)})")
     form = core_form(scene, overrides, _make_form)
-    values, given = form.core[0], form.core[1]
+    handle = _prepared(form)
+    progress = 1 if progress else 0
     # The samples are made for this call (the Result's columns are views of them); the rest
     # is the thread's buffers, read out below (so threads may run at once).
     buffers = _buffers
+    outputs = buffers.outputs
     # (columns: the full row of the scene's bodies, has_column as long; N is the core's)
-    samples = np.empty((form.sample_capacity, row_length(_body_count(form.fields))), dtype=np.float64, order="F")
+    samples = np.empty((form.sample_capacity, form.row_length), dtype=np.float64, order="F")
     while True:
-        if len(buffers.has_column) != samples.shape[1]:
-            buffers.has_column = np.zeros(samples.shape[1], dtype=np.int32)
-        _api.simulate(values, given, form.blob, form.text_end, *form.records, 1 if progress else 0, samples,
-                      buffers.has_column, buffers.event_real, buffers.event_int, buffers.row_name_codes, buffers.info,
-                      buffers.energy_residual, buffers.text_codes, interrupt_epoch=epoch)
+        if len(outputs[0]) != samples.shape[1]:
+            buffers.columns(samples.shape[1])
+            outputs = buffers.outputs
+        if handle:
+            _api.run_prepared(handle, progress, samples, *outputs, epoch)
+        else:
+            _api.simulate(form.core[0], form.core[1], form.blob, form.text_end, *form.records, progress,
+                          samples, *outputs, interrupt_epoch=epoch)
         status, n_samples, n_events, n_rows, steps, message_length, warnings_length, n_bodies = \
-            buffers.info.tolist()
+            outputs[4].tolist()
         if status != _STATUS_TOO_SMALL:
             break
         n_columns = max(row_length(n_bodies), samples.shape[1])
         if n_samples > samples.shape[0] or n_columns > samples.shape[1]:
             samples = np.empty((max(n_samples, samples.shape[0]), n_columns), dtype=np.float64, order="F")
         buffers.make(max(n_events, buffers.event_int.shape[0]), max(n_rows, buffers.row_name_codes.shape[1]))
+        outputs = buffers.outputs
+    has_column, _, event_int, row_name_codes, _, energy_residual, text_codes = outputs
     if status:
-        raise_for_status(status, _codes_text(buffers.text_codes[:message_length, 0]))
-    names = _column_layout(buffers.has_column[:row_length(n_bodies)].tobytes(), n_bodies)
+        raise_for_status(status, _codes_text(text_codes[:message_length, 0]))
+    # (a form's columns are its scene's: the core's has_column read once per form)
+    names = form.names
+    if names is None:
+        names = form.names = _column_layout(has_column[:row_length(n_bodies)].tobytes(), n_bodies)
     events = np.empty(n_events, dtype=event_dtype(n_bodies))
     if n_events > 0:
         _fill_events(events, buffers, n_events, n_rows, n_bodies)
-    if buffers.event_int.shape[0] > _EVENT_CAPACITY_KEPT:
-        buffers.make(_EVENT_CAPACITY, buffers.row_name_codes.shape[1])
-    # The Result made without dataclass __init__ (every field set here): a short run's time.
-    result = object.__new__(Result)
-    columns = vars(result)
+    if event_int.shape[0] > _EVENT_CAPACITY_KEPT:
+        buffers.make(_EVENT_CAPACITY, row_name_codes.shape[1])
+    # The Result and its scene made without their dataclass __init__ (every field set here,
+    # the scene's copied whole): a short run's time.
+    columns = {}
     _fill_result(columns, samples if n_samples == len(samples) else samples[:n_samples], names)
     run_scene = object.__new__(Scene)
-    vars(run_scene).update(form.fields)
-    columns.update(events=events, energy_residual=float(buffers.energy_residual[0]), steps=steps,
+    run_scene.__dict__ = form.fields.copy()
+    columns.update(events=events, energy_residual=float(energy_residual[0]), steps=steps,
                    scene=run_scene, forces_known=True,
-                   warnings=_lines(_codes_text(buffers.text_codes[:warnings_length, 1])) if warnings_length else ())
+                   warnings=_lines(_codes_text(text_codes[:warnings_length, 1])) if warnings_length else ())
+    result = object.__new__(Result)
+    result.__dict__ = columns
     return result
+
+
+# Guards a form's handle while it changes (a form two threads run at once keeps one prepared
+# scene).
+_PREPARING = threading.Lock()
+
+
+def _prepared(form: CoreForm) -> int:
+    """The core's prepared scene to run `form` with, or 0 to set it up whole: a form's first
+    run sets it up whole (most forms of a fit or a sweep run once), its second prepares it
+    (the core validates and builds it once: impact1d_prepared), and later runs use that."""
+    handle = form.handle
+    if handle >= 0:
+        return handle
+    with _PREPARING:
+        if form.handle == CoreForm.FRESH:
+            form.handle = CoreForm.RUN_ONCE
+            return 0
+        if form.handle != CoreForm.RUN_ONCE:
+            return form.handle
+    # (the set-up releases the GIL, as a run's does: a large scene's takes a while)
+    handle = int(_api.prepare(form.core[0], form.core[1], form.blob, form.text_end, *form.records))
+    with _PREPARING:
+        if form.handle == CoreForm.RUN_ONCE:
+            form.handle = handle
+            return handle
+    if handle > 0:
+        form._release(handle)       # (another thread prepared the form meanwhile)
+    return form.handle
 
 
 def _codes_text(codes) -> bytes:
