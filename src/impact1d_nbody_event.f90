@@ -104,8 +104,8 @@ contains
     if (status == lcp_too_large) then
       call raise(error, status_simulation, 'at t = ' // trim(fmt(s%t)) // ': the bodies joined by closed ' // &
         'contacts form a cluster too large for the dense mode solve (more than ' // &
-        trim(fmt(max_dense_unknowns)) // ' unknowns: a chain of some 5000 bodies all in contact; ' // &
-        'a factored solve for chains is issue 20''s)')
+        trim(fmt(max_dense_unknowns)) // ' unknowns: some 5000 bodies in contact, their contacts not ' // &
+        'a path, such as rigid links with two closed limits)')
       return
     else if (status /= mode_solved) then
       call raise(error, status_simulation, 'at t = ' // trim(fmt(s%t)) // &

@@ -1,0 +1,151 @@
+!> The path solve (impact1d_path_mode) against the dense one (impact1d_cluster_mode's LCP and
+!> impact1d_body_mode's preference for friction), both through impact1d_body_mode's
+!> gathered_mode: on random clusters whose rows form a path (bodies and rows numbered at
+!> random, a wall at either end or none, bodies at rest and sliding, forces, rates, bounds and
+!> masses drawn from few values so that ties are common), the same mode: held rows, stuck
+!> bodies, sliding directions. And clusters that are not paths (a body in three rows, rows
+!> ordering the path both ways) are left to the dense solve.
+program test_path_mode
+  use impact1d_kinds, only: wp
+  use impact1d_body_mode, only: mode_work_type, mode_reserve, gathered_mode, mode_solved
+  use impact1d_path_mode, only: path_order
+  use testing, only: check, finish, seed_random
+  implicit none
+  integer, parameter :: max_n = 12, trials = 40000
+  type(mode_work_type) :: work
+  integer :: trial, n, nr, status, differ, shown, paths, motion = 0
+  logical :: stuck(max_n), active(max_n + 1), same
+  real(wp) :: sgn(max_n)
+
+  call seed_random(7919, 11)
+  call mode_reserve(work, max_n, max_n + 1)
+  differ = 0
+  shown = 0
+  paths = 0
+  do trial = 1, trials
+    call random_path(n, nr)
+    if (path_order(work%path, n, work%row_body(:, 1:nr), work%row_normal(:, 1:nr))) paths = paths + 1
+    work%dense_only = .true.
+    call gathered_mode(work, n, nr, status)
+    if (status /= mode_solved) cycle
+    stuck(1:n) = work%stuck(1:n)
+    sgn(1:n) = work%sgn(1:n)
+    active(1:nr) = work%active(1:nr)
+    work%dense_only = .false.
+    call gathered_mode(work, n, nr, status)
+    same = status == mode_solved .and. all(stuck(1:n) .eqv. work%stuck(1:n)) .and. all(sgn(1:n) == work%sgn(1:n)) &
+      .and. all(active(1:nr) .eqv. work%active(1:nr))
+    if (.not. (all(stuck(1:n) .eqv. work%stuck(1:n)) .and. all(sgn(1:n) == work%sgn(1:n)))) motion = motion + 1
+    if (.not. same) then
+      differ = differ + 1
+      if (shown < 5) call show(n, nr, stuck, sgn, active)
+      shown = shown + 1
+    end if
+  end do
+  print '(a, i0, a, i0, a, i0, a, i0)', 'random paths: ', trials, ', accepted as paths ', paths, ', modes differing ', &
+    differ, ', in motion ', motion
+  call check(paths == trials, 'every random path is taken by the path solve')
+  call check(differ == 0, 'the path solve finds the dense solve''s mode')
+  call not_paths()
+  call finish('test_path_mode')
+
+contains
+
+  !> A random cluster along a path (program header) in work's gathered arrays.
+  subroutine random_path(n, nr)
+    integer, intent(out) :: n, nr
+    integer :: perm(max_n), row_of(max_n + 1), t, i, k, wall_end
+    real(wp) :: s, r
+    n = 1 + int(rand() * max_n)
+    call shuffle(perm, n)
+    s = merge(1.0_wp, -1.0_wp, rand() < 0.5_wp)
+    wall_end = int(rand() * 3.0_wp)         ! 0 none, 1 before p_1, 2 after p_n
+    nr = n - 1 + merge(0, 1, wall_end == 0)
+    call shuffle(row_of, nr)
+    do t = 1, n - 1
+      k = row_of(t)
+      ! The row says s (a(p_(t+1)) - a(p_t)) >= 0, written from either end.
+      if (rand() < 0.5_wp) then
+        work%row_body(:, k) = [perm(t), perm(t + 1)]
+        work%row_normal(:, k) = [-s, s]
+      else
+        work%row_body(:, k) = [perm(t + 1), perm(t)]
+        work%row_normal(:, k) = [s, -s]
+      end if
+    end do
+    if (wall_end > 0) then
+      k = row_of(nr)
+      work%row_body(:, k) = [0, merge(perm(1), perm(n), wall_end == 1)]
+      work%row_normal(:, k) = [0.0_wp, merge(s, -s, wall_end == 1)]
+    end if
+    do i = 1, n
+      work%mass(i) = pick([1.0_wp, 2.0_wp, 0.5_wp, 1.0_wp + rand()])
+      work%force(i) = pick([0.0_wp, 1.0_wp, -1.0_wp, 2.0_wp, -3.0_wp, 4.0_wp * rand() - 2.0_wp])
+      work%rate(i) = pick([0.0_wp, 0.0_wp, 1.0_wp, -1.0_wp])
+      work%friction(i) = pick([0.0_wp, 1.0_wp, 0.5_wp, 2.0_wp])
+      work%static(i) = work%friction(i) + pick([0.0_wp, 0.5_wp, 1.0_wp])
+      r = rand()
+      work%velocity(i) = 0.0_wp
+      if (r < 0.2_wp) work%velocity(i) = 1.0_wp
+      if (r >= 0.2_wp .and. r < 0.35_wp) work%velocity(i) = -2.0_wp
+    end do
+  end subroutine random_path
+
+  !> Clusters that are not paths go to the dense solve: a body in three rows, rows that order
+  !> the path both ways (a buffer and a coupler on one body), two walls.
+  subroutine not_paths()
+    work%row_body(:, 1:3) = reshape([1, 2, 1, 3, 1, 4], [2, 3])
+    work%row_normal(:, 1:3) = reshape([-1.0_wp, 1.0_wp, -1.0_wp, 1.0_wp, -1.0_wp, 1.0_wp], [2, 3])
+    call check(.not. path_order(work%path, 4, work%row_body(:, 1:3), work%row_normal(:, 1:3)), 'a star is not a path')
+    work%row_body(:, 1:2) = reshape([1, 2, 2, 3], [2, 2])
+    work%row_normal(:, 1:2) = reshape([-1.0_wp, 1.0_wp, 1.0_wp, -1.0_wp], [2, 2])
+    call check(.not. path_order(work%path, 3, work%row_body(:, 1:2), work%row_normal(:, 1:2)), &
+      'a path ordered both ways is not taken')
+    work%row_normal(:, 1:2) = reshape([-1.0_wp, 1.0_wp, -1.0_wp, 1.0_wp], [2, 2])
+    call check(path_order(work%path, 3, work%row_body(:, 1:2), work%row_normal(:, 1:2)), 'a path ordered one way is')
+    work%row_body(:, 1:3) = reshape([0, 1, 1, 2, 0, 2], [2, 3])
+    work%row_normal(:, 1:3) = reshape([0.0_wp, 1.0_wp, -1.0_wp, 1.0_wp, 0.0_wp, -1.0_wp], [2, 3])
+    call check(.not. path_order(work%path, 2, work%row_body(:, 1:3), work%row_normal(:, 1:3)), &
+      'a path between two walls is not taken')
+  end subroutine not_paths
+
+  subroutine show(n, nr, stuck, sgn, active)
+    integer, intent(in) :: n, nr
+    logical, intent(in) :: stuck(:), active(:)
+    real(wp), intent(in) :: sgn(:)
+    integer :: i
+    print '(a, i0, a, i0)', 'differs: n = ', n, ' rows = ', nr
+    do i = 1, n
+      print '(a, i3, 6es25.17, a, l2, f5.1, a, l2, f5.1)', ' body', i, work%mass(i), work%force(i), work%rate(i), &
+        work%friction(i), work%static(i), work%velocity(i), '  dense', stuck(i), sgn(i), '  path', work%stuck(i), &
+        work%sgn(i)
+    end do
+    do i = 1, nr
+      print '(a, i3, 2i4, 2f5.1, a, l2, a, l2)', ' row', i, work%row_body(:, i), work%row_normal(:, i), '  dense', &
+        active(i), '  path', work%active(i)
+    end do
+  end subroutine show
+
+  real(wp) function rand()
+    call random_number(rand)
+  end function rand
+
+  real(wp) function pick(values)
+    real(wp), intent(in) :: values(:)
+    pick = values(1 + min(size(values) - 1, int(rand() * size(values))))
+  end function pick
+
+  !> A random permutation of 1..n in p(1:n).
+  subroutine shuffle(p, n)
+    integer, intent(out) :: p(:)
+    integer, intent(in) :: n
+    integer :: i, j, tmp
+    p(1:n) = [(i, i = 1, n)]
+    do i = n, 2, -1
+      j = 1 + int(rand() * i)
+      tmp = p(i)
+      p(i) = p(j)
+      p(j) = tmp
+    end do
+  end subroutine shuffle
+end program test_path_mode
