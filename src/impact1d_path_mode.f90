@@ -33,7 +33,7 @@ module impact1d_path_mode
   use impact1d_clusters, only: uf_join, row_closed
   implicit none
   private
-  public :: path_work_type, path_reserve, path_order, path_mode
+  public :: path_work_type, path_reserve, path_order, path_walk, path_mode
 
   !> Relative size of a zero force (impact1d_cluster_mode's).
   real(wp), parameter :: rel_tol = 1.0e3_wp * eps_wp
@@ -51,8 +51,10 @@ module impact1d_path_mode
     integer :: n = 0                              !< bodies of the path last ordered
     integer :: wall = 0                           !< the wall row (before p_1), or 0
     real(wp) :: s = 1.0_wp                        !< orientation: u = s a
+    real(wp) :: wall_coef = 0                     !< the wall's coefficient on its body
     integer, allocatable :: order(:)              !< (n) p_t: body at position t
     integer, allocatable :: edge(:)               !< (n) row between p_t and p_(t+1) (edge(n) unused)
+    real(wp), allocatable :: coef(:)              !< (n) its coefficient on p_(t+1)
     integer, allocatable :: adj(:, :), degree(:)  !< (2, n), (n) body-body rows on each body
     integer, allocatable :: position(:)           !< (n) the position of each body
     type(path_solution_type) :: x, trial          !< the cluster's solve; a row's let-go tried
@@ -77,13 +79,13 @@ contains
     integer, intent(in) :: n
     if (allocated(work%order)) then
       if (size(work%order) >= n) return
-      deallocate(work%order, work%edge, work%adj, work%degree, work%position, work%lo, work%dlo, work%hi, &
+      deallocate(work%order, work%edge, work%coef, work%adj, work%degree, work%position, work%lo, work%dlo, work%hi, &
         work%dhi, work%fw, work%dfw, work%bw, work%dbw, work%gone, work%first, work%bm, work%bb, work%bdb, &
         work%bbeta, work%fixed, work%root)
       call free_solution(work%x)
       call free_solution(work%trial)
     end if
-    allocate(work%order(n), work%edge(n), work%adj(2, n), work%degree(n), work%position(n), work%lo(n), &
+    allocate(work%order(n), work%edge(n), work%coef(n), work%adj(2, n), work%degree(n), work%position(n), work%lo(n), &
       work%dlo(n), work%hi(n), work%dhi(n), work%fw(0:n), work%dfw(0:n), work%bw(0:n), work%dbw(0:n), &
       work%gone(0:n), work%first(n + 2), work%bm(n + 1), work%bb(n + 1), work%bdb(n + 1), work%bbeta(n + 1), &
       work%fixed(n + 1), work%root(0:n))
@@ -102,14 +104,34 @@ contains
     deallocate(x%b, x%db, x%beta, x%u, x%du, x%boxed, x%broken, x%stuck, x%sgn)
   end subroutine free_solution
 
-  !> Whether the n bodies and the rows (all candidates) of a cluster form a path (module
-  !> header); if so, the path's order, edges, wall and orientation are left in work.
+  !> Whether the n bodies and the rows (all candidates) of a cluster form a path ordered one
+  !> way (module header); if so, the path's order, edges, wall and orientation are in work.
   logical function path_order(work, n, row_body, row_normal) result(fits)
     type(path_work_type), intent(inout) :: work
     integer, intent(in) :: n, row_body(:, :)
     real(wp), intent(in) :: row_normal(:, :)
+    fits = path_walk(work, n, row_body, row_normal)
+    if (.not. fits) return
+    work%s = 1.0_wp
+    if (n > 1) then
+      work%s = work%coef(1)
+    else if (work%wall /= 0) then
+      work%s = work%wall_coef
+    end if
+    fits = all(work%coef(1:n - 1) == work%s)
+    if (work%wall /= 0) fits = fits .and. work%wall_coef == work%s
+  end function path_order
+
+  !> Whether the n bodies and the rows of a cluster form a path: each body in at most two
+  !> rows, the body-body rows (-1, 1) or (1, -1), at most one wall, on an end body. If so,
+  !> work has the bodies in path order from the wall's end (order, position), the row
+  !> between positions t and t + 1 (edge) with its coefficient on the later body (coef), and
+  !> the wall's row and its coefficient.
+  logical function path_walk(work, n, row_body, row_normal) result(fits)
+    type(path_work_type), intent(inout) :: work
+    integer, intent(in) :: n, row_body(:, :)
+    real(wp), intent(in) :: row_normal(:, :)
     integer :: k, i, t, prev, next, e, wall_body
-    real(wp) :: c
     fits = .false.
     work%n = n
     work%wall = 0
@@ -121,6 +143,7 @@ contains
         e = merge(2, 1, row_body(1, k) == 0)
         if (abs(row_normal(e, k)) /= 1.0_wp) return
         work%wall = k
+        work%wall_coef = row_normal(e, k)
         wall_body = row_body(e, k)
         cycle
       end if
@@ -153,24 +176,14 @@ contains
       next = row_body(1, k) + row_body(2, k) - i
       work%edge(t) = k
       work%order(t + 1) = next
-      ! The row's coefficient on its later body orders the path.
-      c = row_normal(merge(1, 2, row_body(1, k) == next), k)
-      if (t == 1) work%s = c
-      if (c /= work%s) return
+      work%coef(t) = row_normal(merge(1, 2, row_body(1, k) == next), k)
       prev = k
     end do
-    if (work%wall /= 0) then
-      c = row_normal(merge(2, 1, row_body(1, work%wall) == 0), work%wall)
-      if (n == 1) work%s = c
-      if (c /= work%s) return
-    else if (n == 1) then
-      work%s = 1.0_wp
-    end if
     do t = 1, n
       work%position(work%order(t)) = t
     end do
     fits = .true.
-  end function path_order
+  end function path_walk
 
   !> The mode of the cluster path_order accepted last (module header; the arguments as
   !> impact1d_cluster_mode's cluster_mode, every row a candidate). Out: active, stuck, sgn,
