@@ -12,7 +12,7 @@
 !> projection): each chain pooled from its foot (pooling adjacent violators; the wall a
 !> block held at 0), then at the top the chains' blocks joined into p's block, the larger
 !> first, while they stand above it (the tree's pooling). Impulses follow from the momentum
-!> of each body, summed from the far foot.
+!> of each body, summed along each chain from its foot.
 !> As impact1d_cluster_impact: nothing changes unless a row approaches beyond its rounding;
 !> pushed rows are those whose impulse is above rounding of the largest momentum, and the
 !> bodies they join get one velocity exactly (their mean weighted by mass; 0 at a wall).
@@ -98,18 +98,30 @@ contains
     end do
     if (k > size(tol)) return                ! nothing approaches: nothing changes
     call regress(work, mass, velocity, sigma, top)
-    ! Impulses from the far foot: a body's momentum change is what its two rows give it.
+    ! Impulses: a body's momentum change is what its two rows give it, summed along each
+    ! chain from its foot, so that a chain that does not move gets none, not the rounding
+    ! of the other chain's sum (with a wall the left chain is summed from the top).
     work%p(n) = 0.0_wp
-    do t = n, 1, -1
+    do t = n, top + 1, -1
       i = work%path%order(t)
-      if (t > top) then
-        work%p(t - 1) = work%p(t) - mass(i) * (work%u(t) - sigma * velocity(i))
-      else if (t == top) then
-        work%p(t - 1) = mass(i) * (work%u(t) - sigma * velocity(i)) - work%p(t)
-      else
-        work%p(t - 1) = work%p(t) + mass(i) * (work%u(t) - sigma * velocity(i))
-      end if
+      work%p(t - 1) = work%p(t) - mass(i) * (work%u(t) - sigma * velocity(i))
     end do
+    work%p(0) = 0.0_wp
+    if (work%path%wall /= 0) then
+      do t = top, 1, -1
+        i = work%path%order(t)
+        if (t == top) then
+          work%p(t - 1) = mass(i) * (work%u(t) - sigma * velocity(i)) - work%p(t)
+        else
+          work%p(t - 1) = work%p(t) + mass(i) * (work%u(t) - sigma * velocity(i))
+        end if
+      end do
+    else
+      do t = 1, top - 1
+        i = work%path%order(t)
+        work%p(t) = work%p(t - 1) - mass(i) * (work%u(t) - sigma * velocity(i))
+      end do
+    end if
     p_tol = 0.0_wp
     do i = 1, n
       p_tol = max(p_tol, mass(i) * abs(velocity(i)))

@@ -56,6 +56,7 @@ program test_path_mode
   call not_paths()
   call rising_into_a_stuck_body()
   call projections()
+  call take_up()
   call finish('test_path_mode')
 
 contains
@@ -200,6 +201,41 @@ contains
     call check(fitted > tries / 2, 'most random impacts along a path turning at most once are taken')
     call check(differ == 0, 'the path projection is the dense one')
   end subroutine projections
+
+  !> A train of 2000 wagons takes up the coupler of a wagon: the moving part (taut couplers)
+  !> and the standing part (buffers closed) are one group; 400 take-ups, the moving part
+  !> growing. The standing part's buffers take no impulse and its wagons stay at rest
+  !> (summed from the moving part's end, the impulses' rounding once reached every buffer
+  !> as the same tiny push, and the whole train was joined at one velocity).
+  subroutine take_up()
+    integer, parameter :: n = 2000
+    type(path_impact_work_type) :: path_work
+    integer, allocatable :: row_body(:, :)
+    real(wp), allocatable :: row_normal(:, :), mass(:), v(:), tol(:), v_after(:), impulse(:)
+    logical, allocatable :: pushed(:)
+    logical :: fits, ok
+    integer :: i, picked
+    allocate(row_body(2, n - 1), row_normal(2, n - 1), mass(n), v(n), tol(n - 1), v_after(n), impulse(n - 1), &
+      pushed(n - 1))
+    call path_impact_reserve(path_work, n)
+    mass = 40.0_wp
+    mass(n) = 80.0_wp
+    tol = 1.0e-12_wp
+    ok = .true.
+    ! The moving part grown wagon by wagon, its speed that of a take-up series.
+    do picked = n - 1, n - 400, -1
+      v = 0.0_wp
+      v(picked + 1:) = 17.735625006869562_wp * (1.0_wp + 0.37_wp * (n - picked) / 400.0_wp)
+      do i = 1, n - 1
+        row_body(:, i) = [i, i + 1]
+        row_normal(:, i) = merge([-1.0_wp, 1.0_wp], [1.0_wp, -1.0_wp], i < picked)   ! buffers, then couplers
+      end do
+      call path_projection(path_work, mass, v, row_body, row_normal, tol, v_after, impulse, pushed, fits)
+      ok = ok .and. fits .and. all(v_after(1:picked - 1) == 0.0_wp) .and. .not. any(pushed(1:picked - 1)) .and. &
+        all(v_after(picked:) == v_after(n)) .and. all(pushed(picked:))
+    end do
+    call check(ok, 'a take-up moves the picked wagon with the moving part, the standing part not at all')
+  end subroutine take_up
 
   !> Clusters that are not paths go to the dense solve: a body in three rows, rows that order
   !> the path both ways (a buffer and a coupler on one body), two walls.
