@@ -351,21 +351,28 @@ contains
   end subroutine impacts
 
   !> The closed rows joined to row `start` through shared bodies (the ground joins nothing).
+  !> Sweeps over the rows until none joins, every other one in reverse: a chain numbered
+  !> along its length is then reached in three sweeps whichever way it grows from start (in
+  !> one direction only a sweep added one row: a train's take-up, reaching back through its
+  !> standing part, took N sweeps and 88% of a 10,000-wagon run).
   pure subroutine closed_group(scene, closed, start, group)
     type(scene_type), intent(in) :: scene
     logical, intent(in) :: closed(:)
     integer, intent(in) :: start
     logical, intent(out) :: group(:)
     logical :: reached(0:scene%n_bodies), grew
-    integer :: k
+    integer :: k, sweep
     group = .false.
     group(start) = .true.
     reached = .false.
     reached(scene%row_body(:, start)) = .true.
     grew = .true.
+    sweep = 0
     do while (grew)
       grew = .false.
-      do k = 1, scene%n_rows
+      sweep = sweep + 1
+      do k = merge(1, scene%n_rows, mod(sweep, 2) == 1), merge(scene%n_rows, 1, mod(sweep, 2) == 1), &
+          merge(1, -1, mod(sweep, 2) == 1)
         if (group(k) .or. .not. closed(k)) cycle
         if (.not. (reached(scene%row_body(2, k)) .or. (scene%row_body(1, k) > 0 .and. &
             reached(scene%row_body(1, k))))) cycle
