@@ -5,9 +5,10 @@
 !>
 !> At an event point the bodies fall into clusters joined by candidate rows (closed, zero
 !> normal velocity) between bodies; each cluster with a candidate row or a body at rest with
-!> friction is one complementarity problem, solved by impact1d_cluster_mode (Lemke's method:
-!> no enumeration of 3^N modes); a body alone and sliding needs none. Work is O(N + rows) to
-!> partition plus the clusters' own solves.
+!> friction is one complementarity problem: a cluster whose rows form a path (a train, a
+!> chain) by impact1d_path_mode in O(its size), any other by impact1d_cluster_mode (Lemke's
+!> method: no enumeration of 3^N modes); a body alone and sliding needs none. Work is
+!> O(N + rows) to partition plus the clusters' own solves.
 !>
 !> Within a mode every row is of the form (-1, 1), (1, -1) or a wall, so held rows make their
 !> ends move as one: the bodies fall into groups (union-find over held rows and stuck bodies,
@@ -20,13 +21,16 @@ module impact1d_body_mode
   use impact1d_clusters, only: uf_join, uf_find
   use impact1d_cluster_mode, only: cluster_work_type, cluster_reserve, cluster_mode, cluster_solved
   use impact1d_lcp, only: lcp_too_large
+  use impact1d_path_mode, only: path_work_type, path_reserve, path_order, path_mode
   implicit none
   private
   public :: body_mode_type, mode_work_type, new_mode, solve_body_mode, same_mode, mode_solved
+  public :: mode_reserve, gathered_mode
 
   integer, parameter :: mode_solved = cluster_solved   !< otherwise an impact1d_lcp status
-  !> The largest cluster problem solved (rows + 2 bodies' unknowns): its dense matrices take
-  !> about 24 n^2 bytes, 2.4 GB here (issue 20: a factored solve for chains lifts this).
+  !> The largest cluster problem solved densely (rows + 2 bodies' unknowns): its matrices take
+  !> about 24 n^2 bytes, 2.4 GB here. A cluster whose rows form a path (a train) is solved
+  !> in O(n) by impact1d_path_mode, whatever its size.
   integer, parameter, public :: max_dense_unknowns = 10000
 
   type :: body_mode_type
@@ -47,6 +51,9 @@ module impact1d_body_mode
   !> a cluster is larger than any before.
   type :: mode_work_type
     type(cluster_work_type) :: cluster
+    type(path_work_type) :: path
+    !> Solve every cluster densely, paths too (tests compare the two solves).
+    logical :: dense_only = .false.
     integer, allocatable :: root(:)                  !< (0:N) union-find
     integer, allocatable :: first(:), member(:)      !< (N+1), (N) bodies of each cluster, by root
     integer, allocatable :: first_row(:), row(:)     !< (N+1), (nr) candidate rows of each cluster
@@ -54,7 +61,7 @@ module impact1d_body_mode
     logical, allocatable :: needs_solve(:)           !< (N) by root: a candidate row or a body at rest
     ! One cluster's problem, gathered (size: the largest cluster so far).
     real(wp), allocatable, dimension(:) :: mass, force, rate, friction, static, velocity, acc, sgn, &
-      contact_force, friction_force
+      contact_force, friction_force, acc_rate
     logical, allocatable :: candidate(:), active(:), stuck(:)
     integer, allocatable :: row_body(:, :)
     real(wp), allocatable :: row_normal(:, :)
@@ -219,11 +226,7 @@ contains
     integer :: nb, nr, j, i, k
     nb = work%first(c + 1) - work%first(c)
     nr = work%first_row(c + 1) - work%first_row(c)
-    ! The solve is dense: a cluster past max_dense_unknowns (a long train with every coupler
-    ! closed) is refused with a status, not an allocation the machine cannot make.
-    status = lcp_too_large
-    if (max(nr, 1) + 2 * nb > max_dense_unknowns) return
-    call reserve(work, nb, nr)
+    call mode_reserve(work, nb, nr)
     work%local(0) = 0
     do j = 1, nb
       i = work%member(work%first(c) + j - 1)
@@ -240,10 +243,7 @@ contains
       work%row_body(:, j) = work%local(scene%row_body(:, k))
       work%row_normal(:, j) = scene%row_normal(:, k)
     end do
-    work%candidate(1:nr) = .true.
-    call solve_gathered(work, nb, nr, status)
-    if (status /= cluster_solved) return
-    call prefer_friction(work, nb, nr, status)
+    call gathered_mode(work, nb, nr, status)
     if (status /= cluster_solved) return
     do j = 1, nb
       i = work%member(work%first(c) + j - 1)
@@ -254,6 +254,32 @@ contains
       mode%active(work%row(work%first_row(c) + j - 1)) = work%active(j)
     end do
   end subroutine solve_cluster
+
+  !> The mode of the gathered problem of nb bodies and nr rows, every row a candidate (work's
+  !> arrays; out: work%active, stuck, sgn): a path of rows by impact1d_path_mode, in O(nb);
+  !> any other cluster by the dense LCP (refused past max_dense_unknowns, a status, not an
+  !> allocation the machine cannot make), friction then preferred over held rows.
+  subroutine gathered_mode(work, nb, nr, status)
+    type(mode_work_type), intent(inout) :: work
+    integer, intent(in) :: nb, nr
+    integer, intent(out) :: status
+    work%candidate(1:nr) = .true.
+    if (.not. work%dense_only) then
+      if (path_order(work%path, nb, work%row_body(:, 1:nr), work%row_normal(:, 1:nr))) then
+        call path_mode(work%path, work%mass(1:nb), work%force(1:nb), work%rate(1:nb), work%friction(1:nb), &
+          work%static(1:nb), work%velocity(1:nb), work%row_body(:, 1:nr), work%row_normal(:, 1:nr), &
+          work%acc(1:nb), work%acc_rate(1:nb), work%active(1:nr), work%stuck(1:nb), work%sgn(1:nb))
+        status = cluster_solved
+        return
+      end if
+    end if
+    status = lcp_too_large
+    if (max(nr, 1) + 2 * nb > max_dense_unknowns) return
+    call cluster_reserve(work%cluster, nb, max(nr, 1))
+    call solve_gathered(work, nb, nr, status)
+    if (status /= cluster_solved) return
+    call prefer_friction(work, nb, nr, status)
+  end subroutine gathered_mode
 
   !> The gathered problem of nb bodies and nr rows (work's arrays) solved by cluster_mode.
   subroutine solve_gathered(work, nb, nr, status)
@@ -269,32 +295,34 @@ contains
   !> Among the force distributions of a cluster with stuck bodies (statically indeterminate:
   !> a block pressed onto a wall that its static friction can hold), the one that leaves a
   !> held row without load when friction alone keeps the same motion: each held row in turn
-  !> is let go, and stays so when the cluster then moves as before without closing into it
-  !> (the choice of impact1d_modes, "more bodies stuck, then more contacts held", and of
+  !> is let go, and stays so when the cluster then moves as before, accelerations and their
+  !> rates, so that it does not close into the row even at the rate (the choice of
+  !> impact1d_modes, "more bodies stuck, then more contacts held", and of
   !> tests/exact_nbody.py, the least contact force).
   subroutine prefer_friction(work, nb, nr, status)
     type(mode_work_type), intent(inout) :: work
     integer, intent(in) :: nb, nr
     integer, intent(out) :: status
-    real(wp) :: acc(nb), sgn(nb), rate
+    real(wp) :: acc(nb), da(nb), sgn(nb), tol_f, tol_rate
     logical :: active(nr), stuck(nb)
-    integer :: j, e
+    integer :: j
     status = cluster_solved
     if (.not. any(work%stuck(1:nb))) return
+    ! The same motion to rounding (impact1d_cluster_mode's zero force and rate).
+    tol_f = 1.0e3_wp * epsilon(1.0_wp) * (sum(abs(work%force(1:nb))) + 2.0_wp * sum(work%static(1:nb))) + tiny(1.0_wp)
+    tol_rate = 1.0e3_wp * epsilon(1.0_wp) * sum(abs(work%rate(1:nb)))
     do j = 1, nr
       if (.not. work%active(j)) cycle
       acc = work%acc(1:nb)
+      da = work%cluster%da(1:nb)
       sgn = work%sgn(1:nb)
       active = work%active(1:nr)
       stuck = work%stuck(1:nb)
       work%candidate(j) = .false.
       call solve_gathered(work, nb, nr, status)
-      rate = 0.0_wp
-      do e = 1, 2
-        if (work%row_body(e, j) > 0) rate = rate + work%row_normal(e, j) * work%acc(work%row_body(e, j))
-      end do
-      if (status == cluster_solved .and. all(work%acc(1:nb) == acc) .and. all(work%stuck(1:nb) .eqv. stuck) &
-          .and. all(work%sgn(1:nb) == sgn) .and. rate >= 0.0_wp) cycle
+      if (status == cluster_solved .and. all(work%stuck(1:nb) .eqv. stuck) .and. all(work%sgn(1:nb) == sgn) &
+          .and. all(abs(work%mass(1:nb) * (work%acc(1:nb) - acc)) <= tol_f) &
+          .and. all(abs(work%mass(1:nb) * (work%cluster%da(1:nb) - da)) <= tol_rate)) cycle
       ! Friction cannot carry it alone: the row stays held, the solve as it was.
       work%candidate(j) = .true.
       call solve_gathered(work, nb, nr, status)
@@ -302,22 +330,23 @@ contains
     end do
   end subroutine prefer_friction
 
-  !> Room for a cluster of nb bodies and nr rows (grown, never shrunk).
-  subroutine reserve(work, nb, nr)
+  !> Room for a cluster of nb bodies and nr rows (grown, never shrunk); the dense solve's
+  !> own memory is reserved only when a cluster needs it (gathered_mode).
+  subroutine mode_reserve(work, nb, nr)
     type(mode_work_type), intent(inout) :: work
     integer, intent(in) :: nb, nr
+    call path_reserve(work%path, nb)
     if (allocated(work%mass)) then
       if (size(work%mass) >= nb .and. size(work%candidate) >= max(nr, 1)) return
       deallocate(work%mass, work%force, work%rate, work%friction, work%static, work%velocity, work%acc, &
-        work%sgn, work%friction_force, work%stuck, work%contact_force, work%candidate, work%active, &
-        work%row_body, work%row_normal)
+        work%acc_rate, work%sgn, work%friction_force, work%stuck, work%contact_force, work%candidate, &
+        work%active, work%row_body, work%row_normal)
     end if
     allocate(work%mass(nb), work%force(nb), work%rate(nb), work%friction(nb), work%static(nb), &
-      work%velocity(nb), work%acc(nb), work%sgn(nb), work%friction_force(nb), work%stuck(nb), &
-      work%contact_force(max(nr, 1)), work%candidate(max(nr, 1)), work%active(max(nr, 1)), &
+      work%velocity(nb), work%acc(nb), work%acc_rate(nb), work%sgn(nb), work%friction_force(nb), &
+      work%stuck(nb), work%contact_force(max(nr, 1)), work%candidate(max(nr, 1)), work%active(max(nr, 1)), &
       work%row_body(2, max(nr, 1)), work%row_normal(2, max(nr, 1)))
-    call cluster_reserve(work%cluster, nb, max(nr, 1))
-  end subroutine reserve
+  end subroutine mode_reserve
 
   !> The groups of the mode (module header), their masses and the sliding friction forces.
   subroutine set_groups(scene, mode, root)

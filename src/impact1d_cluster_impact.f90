@@ -21,6 +21,7 @@ module impact1d_cluster_impact
   use impact1d_kinds, only: wp, eps_wp
   use impact1d_lcp, only: lcp_work_type, lcp_reserve, lcp_solve, lcp_solved, lcp_too_large
   use impact1d_clusters, only: uf_join, group_means, row_coupling, row_rate
+  use impact1d_path_impact, only: path_impact_work_type
   implicit none
   private
   public :: impact_work_type, impact_reserve, cluster_projection
@@ -28,6 +29,9 @@ module impact1d_cluster_impact
   !> The projection's memory, owned by the caller and sized once (impact_reserve).
   type :: impact_work_type
     integer :: max_bodies = 0, max_rows = 0
+    !> A group whose rows form a path is projected in O(n) (impact1d_path_impact), the caller
+    !> trying it first.
+    type(path_impact_work_type) :: path
     type(lcp_work_type) :: lcp
     real(wp), allocatable :: m(:, :)                 !< (max_rows, max_rows) n_k M^-1 n_l over closed rows
     real(wp), allocatable :: q(:), z(:), w(:)        !< (max_rows) n_k . v, impulses, n_k . w

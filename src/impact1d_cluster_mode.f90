@@ -29,7 +29,7 @@
 !> - No allocation: the caller sizes a cluster_work_type once (cluster_reserve).
 module impact1d_cluster_mode
   use impact1d_kinds, only: wp, eps_wp
-  use impact1d_clusters, only: uf_join, group_means, row_coupling, row_rate
+  use impact1d_clusters, only: uf_join, group_means, row_coupling, row_closed
   use impact1d_lcp, only: lcp_work_type, lcp_reserve, lcp_solve, lcp_basis_values, lcp_solved, &
     lcp_too_large
   implicit none
@@ -328,14 +328,7 @@ contains
     !> Row k closed and staying closed: n.a and its rate zero.
     logical function closed(k)
       integer, intent(in) :: k
-      real(wp) :: inverse_mass
-      integer :: e
-      inverse_mass = 0.0_wp
-      do e = 1, 2
-        if (row_body(e, k) > 0) inverse_mass = inverse_mass + abs(row_normal(e, k)) / mass(row_body(e, k))
-      end do
-      closed = abs(row_rate(row_body, row_normal, k, acceleration)) <= 2.0_wp * tol_f * inverse_mass .and. &
-        abs(row_rate(row_body, row_normal, k, work%da)) <= 2.0_wp * tol_rate * inverse_mass
+      closed = row_closed(row_body, row_normal, k, mass, acceleration, work%da, tol_f, tol_rate)
     end function closed
 
     !> A wall, or a body-body row of the form (-1, 1) or (1, -1): it makes its ends move alike.

@@ -21,7 +21,7 @@ module impact1d_clusters
   implicit none
   private
   public :: cluster_set_type, clusters_build, clusters_close, clusters_open
-  public :: uf_join, uf_find, group_means, row_coupling, row_rate
+  public :: uf_join, uf_find, group_means, row_coupling, row_rate, row_closed
 
   type :: cluster_set_type
     integer :: n_bodies = 0, n_rows = 0
@@ -259,6 +259,21 @@ contains
       if (row_body(e, k) > 0) rate = rate + row_normal(e, k) * u(row_body(e, k))
     end do
   end function row_rate
+
+  !> Row k closed and staying closed under accelerations a with rates da: n.a and n.da zero
+  !> within the zero force tol_f and rate tol_rate through the row's ends' inverse masses.
+  pure logical function row_closed(row_body, row_normal, k, mass, a, da, tol_f, tol_rate) result(closed)
+    integer, intent(in) :: row_body(:, :), k
+    real(wp), intent(in) :: row_normal(:, :), mass(:), a(:), da(:), tol_f, tol_rate
+    real(wp) :: inverse_mass
+    integer :: e
+    inverse_mass = 0.0_wp
+    do e = 1, 2
+      if (row_body(e, k) > 0) inverse_mass = inverse_mass + abs(row_normal(e, k)) / mass(row_body(e, k))
+    end do
+    closed = abs(row_rate(row_body, row_normal, k, a)) <= 2.0_wp * tol_f * inverse_mass .and. &
+      abs(row_rate(row_body, row_normal, k, da)) <= 2.0_wp * tol_rate * inverse_mass
+  end function row_closed
 
   !> The selected rows numbered 1..n_selected in row order (row_var(k), 0 for the others) and
   !> their coupling through the bodies, coupling(p, q) = n_p M^-1 n_q (1:n_selected square).

@@ -17,6 +17,7 @@ module impact1d_nbody_event
   use impact1d_clusters, only: uf_join, uf_find
   use impact1d_accumulation, only: join_cycle
   use impact1d_cluster_impact, only: impact_work_type, impact_reserve, cluster_projection
+  use impact1d_path_impact, only: path_impact_reserve, path_projection
   use impact1d_lcp, only: lcp_solved, lcp_too_large
   use impact1d_body_mode, only: body_mode_type, mode_work_type, solve_body_mode, mode_solved, max_dense_unknowns
   use impact1d_nbody_step, only: nbody_force, nbody_rate, row_gap, row_velocity, row_gap_tolerance, &
@@ -104,8 +105,8 @@ contains
     if (status == lcp_too_large) then
       call raise(error, status_simulation, 'at t = ' // trim(fmt(s%t)) // ': the bodies joined by closed ' // &
         'contacts form a cluster too large for the dense mode solve (more than ' // &
-        trim(fmt(max_dense_unknowns)) // ' unknowns: a chain of some 5000 bodies all in contact; ' // &
-        'a factored solve for chains is issue 20''s)')
+        trim(fmt(max_dense_unknowns)) // ' unknowns: some 5000 bodies in contact, their contacts not ' // &
+        'a path, such as rigid links with two closed limits)')
       return
     else if (status /= mode_solved) then
       call raise(error, status_simulation, 'at t = ' // trim(fmt(s%t)) // &
@@ -350,21 +351,28 @@ contains
   end subroutine impacts
 
   !> The closed rows joined to row `start` through shared bodies (the ground joins nothing).
+  !> Sweeps over the rows until none joins, every other one in reverse: a chain numbered
+  !> along its length is then reached in three sweeps whichever way it grows from start (in
+  !> one direction only a sweep added one row: a train's take-up, reaching back through its
+  !> standing part, took N sweeps and 88% of a 10,000-wagon run).
   pure subroutine closed_group(scene, closed, start, group)
     type(scene_type), intent(in) :: scene
     logical, intent(in) :: closed(:)
     integer, intent(in) :: start
     logical, intent(out) :: group(:)
     logical :: reached(0:scene%n_bodies), grew
-    integer :: k
+    integer :: k, sweep
     group = .false.
     group(start) = .true.
     reached = .false.
     reached(scene%row_body(:, start)) = .true.
     grew = .true.
+    sweep = 0
     do while (grew)
       grew = .false.
-      do k = 1, scene%n_rows
+      sweep = sweep + 1
+      do k = merge(1, scene%n_rows, mod(sweep, 2) == 1), merge(scene%n_rows, 1, mod(sweep, 2) == 1), &
+          merge(1, -1, mod(sweep, 2) == 1)
         if (group(k) .or. .not. closed(k)) cycle
         if (.not. (reached(scene%row_body(2, k)) .or. (scene%row_body(1, k) > 0 .and. &
             reached(scene%row_body(1, k))))) cycle
@@ -463,9 +471,10 @@ contains
     real(wp), intent(out) :: v_after(:)
     logical, intent(out) :: pushed(:)
     type(error_type), allocatable, intent(inout) :: error
-    integer :: local(0:scene%n_bodies), body(scene%n_bodies), rows(scene%n_rows), nb, nr, k, e, status
+    integer :: local(0:scene%n_bodies), body(scene%n_bodies), rows(scene%n_rows), row_local(2, scene%n_rows), nb, &
+      nr, k, e, status
     real(wp) :: v_local(scene%n_bodies), impulse_local(scene%n_rows)
-    logical :: pushed_local(scene%n_rows)
+    logical :: pushed_local(scene%n_rows), fits
     local = 0
     nb = 0
     nr = 0
@@ -486,22 +495,36 @@ contains
     v_after = v
     pushed = .false.
     if (nr == 0) return
-    if (nr > max_dense_unknowns) then
-      call raise(error, status_simulation, 'a joint impact of ' // trim(fmt(nr)) // ' closed contacts is ' // &
-        'too large for the dense projection (more than ' // trim(fmt(max_dense_unknowns)) // ': issue 20)')
-      return
-    end if
-    call impact_reserve(work, nb, nr)
-    call cluster_projection(work, scene%body_mass(body(:nb)), v(body(:nb)), &
-      reshape([(local(scene%row_body(:, rows(k))), k = 1, nr)], [2, nr]), scene%row_normal(:, rows(:nr)), &
-      spread(.true., 1, nr), tol(rows(:nr)), v_local(:nb), impulse_local(:nr), pushed_local(:nr), status)
-    if (status /= lcp_solved) then
-      call raise(error, status_simulation, 'internal: the joint inelastic impact has no solution (LCP status ' // &
-        trim(fmt(status)) // '): please report the scene')
-      return
+    row_local(:, :nr) = reshape([(local(scene%row_body(:, rows(k))), k = 1, nr)], [2, nr])
+    call path_impact_reserve(work%path, nb)
+    call path_projection(work%path, scene%body_mass(body(:nb)), v(body(:nb)), row_local(:, :nr), &
+      scene%row_normal(:, rows(:nr)), tol(rows(:nr)), v_local(:nb), impulse_local(:nr), pushed_local(:nr), fits)
+    if (.not. fits) then
+      call dense_projection()
+      if (allocated(error)) return
     end if
     v_after(body(:nb)) = v_local(:nb)
     pushed(rows(:nr)) = pushed_local(:nr)
+
+  contains
+
+    !> Any other group: the dense LCP (impact1d_cluster_impact).
+    subroutine dense_projection()
+      if (nr > max_dense_unknowns) then
+        call raise(error, status_simulation, 'a joint impact of ' // trim(fmt(nr)) // ' closed contacts is ' // &
+          'too large for the dense projection (more than ' // trim(fmt(max_dense_unknowns)) // ': issue 20)')
+        return
+      end if
+      call impact_reserve(work, nb, nr)
+      call cluster_projection(work, scene%body_mass(body(:nb)), v(body(:nb)), row_local(:, :nr), &
+        scene%row_normal(:, rows(:nr)), spread(.true., 1, nr), tol(rows(:nr)), v_local(:nb), impulse_local(:nr), &
+        pushed_local(:nr), status)
+      if (status /= lcp_solved) then
+        call raise(error, status_simulation, 'internal: the joint inelastic impact has no solution (LCP status ' // &
+          trim(fmt(status)) // '): please report the scene')
+        return
+      end if
+    end subroutine dense_projection
   end subroutine joint_projection
 
   !> A row between bodies that took an impulse gives both its ends the larger scale.
