@@ -61,7 +61,7 @@ contains
   !> impact1d_chain's numbering).
   subroutine input_field_names(names)
     character(len=2048), intent(out) :: names
-    character(len=16) :: words(n_ids)
+    character(len=24) :: words(n_ids)
     integer :: id
     do id = 1, n_ids
       words(id) = field_name(id)

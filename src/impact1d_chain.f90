@@ -15,7 +15,8 @@ module impact1d_chain
     record_input, a_m, a_mu, a_mus, a_x, a_f_amp, a_f_period, a_f_phase, a_k, a_x_rest, a_c, a_d_min, a_r_min, &
     a_d_max, a_r_max, a_k_link, a_d_rest, a_c_link, r_a, r_b, r_d_min, r_r_min, r_d_max, r_r_max, r_k, r_d_rest, &
     r_c, contact_fields, spring_fields, r_name, n_contact_fields, n_spring_fields, written_array, text_item, &
-    a_f_table, mechanism_records, n_sine_fields, sine_fields, r_body, r_amp, r_period, r_phase, r_stop_k, r_stop_c
+    a_f_table, mechanism_records, n_sine_fields, sine_fields, r_body, r_amp, r_period, r_phase, r_stop_k, r_stop_c, &
+    r_ground_v, r_spring_ground_v, n_ground_fields
   implicit none
   private
   public :: settle_chain, validate_chain, input_records, mechanism_records, n_bodies_of, slot_of, alias_slot
@@ -427,6 +428,8 @@ contains
         else if (.not. allocated(error)) then
           call spring_values(rec, where, error)
         end if
+        if (.not. allocated(error)) call ground_motion(rec, merge(r_ground_v, r_spring_ground_v, contact), &
+          where, error)
         if (allocated(error)) return
       end associate
     end do
@@ -480,7 +483,7 @@ contains
   pure function field_of(contact, f) result(name)
     logical, intent(in) :: contact
     integer, intent(in) :: f
-    character(len=8) :: name     ! blank padded: callers trim
+    character(len=13) :: name     ! blank padded: callers trim
     if (contact) then
       name = contact_fields(f)
     else
@@ -542,6 +545,38 @@ contains
     if (rec%given(r_stop_c) .and. .not. allocated(error)) call nonnegative_value(where // 'c', &
       rec%value(r_stop_c), error)
   end subroutine contact_limits
+
+  !> The prescribed motion of a record's ground end (fields first .. first + 3: ground_v,
+  !> ground_amp, ground_period, ground_phase): only on a record with a ground end (a or b =
+  !> 0); a sine has its amplitude and a positive period, a phase needs its sine.
+  subroutine ground_motion(rec, first, where, error)
+    type(record_input), intent(in) :: rec
+    integer, intent(in) :: first
+    character(len=*), intent(in) :: where
+    type(error_type), allocatable, intent(inout) :: error
+    if (.not. any(rec%given(first:first + n_ground_fields - 1))) return
+    if (rec%value(r_a) /= 0.0_wp .and. rec%value(r_b) /= 0.0_wp) then
+      call raise(error, status_input, where // 'ground_v, ground_amp, ground_period and ground_phase move ' // &
+        'the ground end, but this record joins two bodies (a = 0 or b = 0 is the ground)')
+    else if (rec%given(first + 1) .neqv. rec%given(first + 2)) then
+      call raise(error, status_input, where // 'ground_amp and ground_period go together: the ground''s ' // &
+        'sine is ground_amp sin(2 pi t / ground_period + ground_phase)')
+    else if (rec%given(first + 3) .and. .not. rec%given(first + 1)) then
+      call raise(error, status_input, where // 'ground_phase is given but ground_amp is not: a phase ' // &
+        'needs its sine')
+    else if (rec%given(first + 2)) then
+      call positive_value(where // 'ground_period', rec%value(first + 2), error)
+    end if
+  end subroutine ground_motion
+
+  !> The prescribed motion a record gives its ground end (fields first ..): v, amp, period,
+  !> phase, 0 where not given.
+  pure function ground_of(rec, first) result(ground)
+    type(record_input), intent(in) :: rec
+    integer, intent(in) :: first
+    real(wp) :: ground(n_ground_fields)
+    ground = merge(rec%value(first:first + n_ground_fields - 1), 0.0_wp, rec%given(first:first + n_ground_fields - 1))
+  end function ground_of
 
   !> A spring has k or c (not negative); k and d_rest go together.
   subroutine spring_values(rec, where, error)
@@ -649,6 +684,12 @@ contains
     allocate(records%contact_body(2, nc), records%contact_has(2, nc), records%contact_limit(2, nc), &
       records%contact_restitution(2, nc), records%contact_name(nc), records%contact_k(nc), records%contact_c(nc))
     allocate(records%element_body(2, ne), records%element_k(ne), records%element_c(ne), records%element_rest(ne))
+    allocate(records%contact_ground(n_ground_fields, nc), records%element_ground(n_ground_fields, ne), &
+      records%contact_moves(nc), records%element_moves(ne))
+    records%contact_ground = 0.0_wp
+    records%element_ground = 0.0_wp
+    records%contact_moves = .false.
+    records%element_moves = .false.
     records%contact_has = .false.
     records%contact_limit = 0.0_wp
     records%contact_restitution = 1.0_wp
@@ -755,6 +796,8 @@ contains
         records%contact_restitution(:, k) = merge(rec%value([r_r_min, r_r_max]), 1.0_wp, rec%given([r_r_min, r_r_max]))
         if (rec%given(r_stop_k)) records%contact_k(k) = rec%value(r_stop_k)
         if (rec%given(r_stop_c)) records%contact_c(k) = rec%value(r_stop_c)
+        records%contact_ground(:, k) = ground_of(rec, r_ground_v)
+        records%contact_moves(k) = any(rec%given(r_ground_v:r_ground_v + n_ground_fields - 1))
         if (ends(2) == 0) then
           records%contact_body(:, k) = [0, ends(1)]
           records%contact_has(:, k) = records%contact_has([2, 1], k)
@@ -806,6 +849,9 @@ contains
         else
           call add_element(records, ends(1), ends(2), rec%value(r_k), rec%value(r_d_rest), rec%value(r_c))
         end if
+        records%element_ground(:, records%n_elements) = ground_of(rec, r_spring_ground_v)
+        records%element_moves(records%n_elements) = any(rec%given(r_spring_ground_v:r_spring_ground_v + &
+          n_ground_fields - 1))
       end associate
     end do
   end subroutine element_records
@@ -835,6 +881,10 @@ contains
       records%contact_name = records%contact_name(:nc)
       records%contact_k = records%contact_k(:nc)
       records%contact_c = records%contact_c(:nc)
+      records%contact_ground = records%contact_ground(:, :nc)
+      records%element_ground = records%element_ground(:, :ne)
+      records%contact_moves = records%contact_moves(:nc)
+      records%element_moves = records%element_moves(:ne)
       records%element_body = records%element_body(:, :ne)
       records%element_k = records%element_k(:ne)
       records%element_c = records%element_c(:ne)
@@ -846,7 +896,7 @@ contains
   !> the arrays, r_meet, the &contact and &spring record fields as 'contact.a').
   pure function field_name(id) result(name)
     integer, intent(in) :: id
-    character(len=16) :: name     ! blank padded: callers trim
+    character(len=24) :: name     ! blank padded: callers trim
     name = ''
     if (id >= 1 .and. id <= n_real) then
       name = real_names(id)

@@ -8,6 +8,7 @@ module impact1d_scene
   use impact1d_forcing, only: forcing_type, table_type, angular_frequency
   use impact1d_springs, only: springs_type, pair_elements, assemble, rate_bound
   use impact1d_modes, only: pair_type, pair_rows
+  use impact1d_drives, only: drive_type
   use impact1d_fields, only: chain_input, mechanism_records, r_k, r_c, r_stop_k, r_stop_c, array_value, a_m, &
     a_mu, a_mus, a_x, a_v, &
     a_f, a_f_amp, a_f_period, a_f_phase, a_f_table
@@ -177,6 +178,13 @@ module impact1d_scene
     integer, allocatable :: row_partner(:)              !< (nr) the other limit of a rigid link (d_min = d_max), else 0
     character(len=name_len), allocatable :: row_name(:) !< (nr) one limit: the record's name; two (and
                                                         !< always the link 'slot'): <name>_min, <name>_max
+    ! Prescribed motion of ground ends (impact1d_drives): the ground end of a record that
+    ! names it is at w_d(t) (d its drive, 0: the ground at x = 0). Only the N-body engine
+    ! runs them (impact1d_solver's run hands it every scene with a drive).
+    type(drive_type) :: drives
+    integer, allocatable :: contact_drive(:)            !< (nc) the drive of the record's ground end, else 0
+    integer, allocatable :: element_drive(:)            !< (ne) the drive of the element's ground end, else 0
+    integer, allocatable :: row_drive(:)                !< (nr) its record's drive
     !> The bodies and rows as the two-body kernels see them (impact1d_modes' pair_type: in
     !> lanes, impact1d_lanes): with one body, padded by a phantom (unit mass, at rest, no
     !> friction, on no row) in the idle lane.
@@ -674,6 +682,8 @@ contains
       'method is the tutorial''s scheme, with rigid contacts only)', error)
     if (allocated(error)) return
     call set_records(input, records, scene)
+    if (scene%drives%n > 0) call refuse_drives(scene, records, error)
+    if (allocated(error)) return
     call set_rows(scene, error)
     if (allocated(error)) return
     call set_springs(scene, error)
@@ -700,6 +710,21 @@ contains
     ! (validate keeps the count within max_rows, a default integer)
     scene%n_samples = int(row_count(scene%t_end, scene%dt_out))
   end subroutine build_scene
+
+  !> A scene with a moving ground runs on the N-body engine (whatever its N), which has
+  !> neither the vissim method nor compliant stops.
+  subroutine refuse_drives(scene, records, error)
+    type(scene_type), intent(in) :: scene
+    type(mechanism_records), intent(in) :: records
+    type(error_type), allocatable, intent(inout) :: error
+    if (scene%method == 'vissim') then
+      call raise(error, status_input, "method = 'vissim' is the tutorial's fixed-step scheme: a scene " // &
+        'with a moving ground (ground_v, ground_amp) runs with method = ''event''')
+      return
+    end if
+    call refuse_stops(records, 'cannot be combined with a moving ground (ground_v, ground_amp) yet: ' // &
+      'such scenes run on the N-body engine, which has rigid contacts only', error)
+  end subroutine refuse_drives
 
   !> A scene whose engine has no compliant stops: the first &contact record with k named
   !> in the message (why: what the engine lacks).
@@ -834,10 +859,43 @@ contains
     scene%element_k = records%element_k
     scene%element_c = records%element_c
     scene%element_rest = records%element_rest
+    call set_drives(records, scene)
     named = springs_named(input)
     scene%springs%has_spring = named(1)
     scene%springs%has_damper = named(2)
   end subroutine set_records
+
+  !> The records' moving grounds as drives (contacts', then elements', in record order): a
+  !> record that names any ground_* field has one, even if all are 0 (a ground that moves
+  !> at 0 m/s: the same motion on the N-body engine, which tests compare).
+  subroutine set_drives(records, scene)
+    type(mechanism_records), intent(in) :: records
+    type(scene_type), intent(inout) :: scene
+    integer :: j
+    allocate(scene%contact_drive(records%n_contacts), scene%element_drive(records%n_elements))
+    scene%contact_drive = 0
+    scene%element_drive = 0
+    if (.not. allocated(records%contact_ground)) return
+    do j = 1, records%n_contacts
+      if (records%contact_moves(j)) call add_drive(records%contact_ground(:, j), scene%contact_drive(j))
+    end do
+    do j = 1, records%n_elements
+      if (records%element_moves(j)) call add_drive(records%element_ground(:, j), scene%element_drive(j))
+    end do
+
+  contains
+
+    !> ground = (v, amp, period, phase): drive d.
+    subroutine add_drive(ground, d)
+      real(wp), intent(in) :: ground(:)
+      integer, intent(out) :: d
+      real(wp) :: omega
+      omega = 0.0_wp
+      if (ground(3) > 0.0_wp .and. ground(2) /= 0.0_wp) omega = angular_frequency(ground(3))
+      call scene%drives%add(ground(1), ground(2), omega, ground(4))
+      d = scene%drives%n
+    end subroutine add_drive
+  end subroutine set_drives
 
   !> Whether the scene names a stiffness, and a damping: the tutorial's k1, k2, k12 (c1, c2,
   !> c12), a &spring record's k (c) or a compliant &contact's k (c). They decide the pe and damping_loss columns.
@@ -938,8 +996,10 @@ contains
     scene%n_stops = count(scene%contact_has .and. spread(scene%contact_k > 0.0_wp, 1, 2))
     scene%n_rows = nr - scene%n_stops
     allocate(scene%row_contact(nr), scene%row_body(2, nr), scene%row_normal(2, nr), scene%row_offset(nr), &
-      scene%row_restitution(nr), scene%row_partner(nr), scene%row_name(nr), scene%row_k(nr), scene%row_c(nr))
+      scene%row_restitution(nr), scene%row_partner(nr), scene%row_name(nr), scene%row_k(nr), scene%row_c(nr), &
+      scene%row_drive(nr))
     scene%row_partner = 0
+    scene%row_drive = 0
     r = 0
     ! The rigid records' rows, then the compliant stops' (pass 2), each in record order.
     do pass = 1, 2
@@ -958,6 +1018,7 @@ contains
           scene%row_k(r) = scene%contact_k(j)
           scene%row_c(r) = scene%contact_c(j)
           scene%row_name(r) = scene%contact_name(j)
+          if (allocated(scene%contact_drive)) scene%row_drive(r) = scene%contact_drive(j)
           if (suffix) scene%row_name(r) = trim(scene%contact_name(j)) // trim(merge('_min', '_max', e == 1))
         end do
         if (all(scene%contact_has(:, j)) .and. pass == 1) then

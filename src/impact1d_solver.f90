@@ -77,7 +77,7 @@ contains
     call start_counts(stats, scene%n_rows + scene%n_stops, scene%n_bodies)
     ! The stepping kernels here take the bodies in lanes (impact1d_lanes); more bodies run
     ! on the N-body engine.
-    if (scene%n_bodies > max_lanes) then
+    if (scene%n_bodies > max_lanes .or. scene%drives%n > 0) then
       call run_nbody(scene, sink, stats, error)
       return
     end if

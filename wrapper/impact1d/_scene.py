@@ -55,8 +55,10 @@ TEXT_FIELDS = ("title", "f1_table", "f2_table", "method", "substeps", "events")
 # the &contact, &spring and &sine records. Checked against _api.input_field_names() at import.
 ARRAY_FIELDS = ("m", "mu", "mus", "x", "v", "f", "f_amp", "f_period", "f_phase", "k", "x_rest", "c",
                 "d_min", "r_min", "d_max", "r_max", "k_link", "d_rest", "c_link", "f_table")
-CONTACT_FIELDS = ("a", "b", "d_min", "r_min", "d_max", "r_max", "name", "k", "c")
-SPRING_FIELDS = ("a", "b", "k", "d_rest", "c")
+# A record with a ground end (a or b = 0) may move it: GROUND_FIELDS (DESIGN "Laws added").
+GROUND_FIELDS = ("ground_v", "ground_amp", "ground_period", "ground_phase")
+CONTACT_FIELDS = ("a", "b", "d_min", "r_min", "d_max", "r_max", "name", "k", "c") + GROUND_FIELDS
+SPRING_FIELDS = ("a", "b", "k", "d_rest", "c") + GROUND_FIELDS
 SINE_FIELDS = ("body", "amp", "period", "phase")
 # The record groups: Scene field, the core's prefix of its fields, the fields.
 _RECORD_GROUPS = (("contacts", "contact.", CONTACT_FIELDS), ("springs", "spring.", SPRING_FIELDS),
