@@ -10,7 +10,7 @@ module impact1d_chain
     positive_value, nonnegative_value, unit_interval, resolvable, i_m1, i_m2, i_x_left, i_r_left, i_x_right, i_r_right, &
     i_r_min, i_d_min, i_g, default_gravity, i_mu1, i_mu2, i_mus1, i_mus2, i_x1, i_x2, i_v1, i_v2, i_f1, i_f2, &
     i_f1_amp, i_f2_amp, i_f1_period, i_f2_period, i_f1_phase, i_f2_phase, i_k1, i_k2, i_x1_rest, i_x2_rest, &
-    i_c1, i_c2, i_d_max, i_r_max, i_k12, i_d_rest, i_c12, i_f1_table, i_f2_table
+    i_c1, i_c2, i_d_max, i_r_max, i_k12, i_d_rest, i_c12, i_f1_table, i_f2_table, i_x_left_v, i_x_right_v
   use impact1d_fields, only: array_value, n_arrays, array_names, array_is_link, array_is_text, alias_name, name_len, &
     record_input, a_m, a_mu, a_mus, a_x, a_f_amp, a_f_period, a_f_phase, a_k, a_x_rest, a_c, a_d_min, a_r_min, &
     a_d_max, a_r_max, a_k_link, a_d_rest, a_c_link, r_a, r_b, r_d_min, r_r_min, r_d_max, r_r_max, r_k, r_d_rest, &
@@ -287,6 +287,8 @@ contains
     if (allocated(error)) return
     if (allocated(input%chain%sines)) call check_sines(input, error)
     if (allocated(error)) return
+    call wall_motion_terms(input, error)
+    if (allocated(error)) return
     call input_records(input, records)
     call check_names(records, error)
     if (allocated(error)) return
@@ -558,16 +560,52 @@ contains
     if (rec%value(r_a) /= 0.0_wp .and. rec%value(r_b) /= 0.0_wp) then
       call raise(error, status_input, where // 'ground_v, ground_amp, ground_period and ground_phase move ' // &
         'the ground end, but this record joins two bodies (a = 0 or b = 0 is the ground)')
-    else if (rec%given(first + 1) .neqv. rec%given(first + 2)) then
-      call raise(error, status_input, where // 'ground_amp and ground_period go together: the ground''s ' // &
-        'sine is ground_amp sin(2 pi t / ground_period + ground_phase)')
-    else if (rec%given(first + 3) .and. .not. rec%given(first + 1)) then
-      call raise(error, status_input, where // 'ground_phase is given but ground_amp is not: a phase ' // &
-        'needs its sine')
-    else if (rec%given(first + 2)) then
-      call positive_value(where // 'ground_period', rec%value(first + 2), error)
+      return
     end if
+    call motion_terms(rec%given(first:first + n_ground_fields - 1), rec%value(first:first + n_ground_fields - 1), &
+      where, 'ground', error)
   end subroutine ground_motion
+
+  !> A prescribed motion's fields (<prefix>_v, _amp, _period, _phase: given, value; where:
+  !> the record, for messages): a sine has its amplitude and a positive period, a phase
+  !> needs its sine.
+  subroutine motion_terms(given, value, where, prefix, error)
+    logical, intent(in) :: given(n_ground_fields)
+    real(wp), intent(in) :: value(n_ground_fields)
+    character(len=*), intent(in) :: where, prefix
+    type(error_type), allocatable, intent(inout) :: error
+    if (given(2) .neqv. given(3)) then
+      call raise(error, status_input, where // prefix // '_amp and ' // prefix // '_period go together: the ' // &
+        'sine is ' // prefix // '_amp sin(2 pi t / ' // prefix // '_period + ' // prefix // '_phase)')
+    else if (given(4) .and. .not. given(2)) then
+      call raise(error, status_input, where // prefix // '_phase is given but ' // prefix // '_amp is not: a ' // &
+        'phase needs its sine')
+    else if (given(3)) then
+      call positive_value(where // prefix // '_period', value(3), error)
+    end if
+  end subroutine motion_terms
+
+  !> The walls' prescribed motion (x_left_v ..., x_right_v ...): each needs its wall.
+  subroutine wall_motion_terms(input, error)
+    type(scene_input), intent(in) :: input
+    type(error_type), allocatable, intent(inout) :: error
+    integer :: side, first, wall
+    character(len=7) :: prefix
+    do side = 1, 2
+      first = merge(i_x_left_v, i_x_right_v, side == 1)
+      wall = merge(i_x_left, i_x_right, side == 1)
+      prefix = merge('x_left ', 'x_right', side == 1)
+      if (.not. any(input%given(first:first + n_ground_fields - 1))) cycle
+      if (.not. input%given(wall)) then
+        call raise(error, status_input, trim(prefix) // '_v, _amp, _period, _phase move the wall ' // trim(prefix) // &
+          ', which is not given')
+        return
+      end if
+      call motion_terms(input%given(first:first + n_ground_fields - 1), input%value(first:first + n_ground_fields - 1), &
+        '', trim(prefix), error)
+      if (allocated(error)) return
+    end do
+  end subroutine wall_motion_terms
 
   !> The prescribed motion a record gives its ground end (fields first ..): v, amp, period,
   !> phase, 0 where not given.
@@ -639,6 +677,13 @@ contains
         d = x(b) - x(a)
         what = 'x' // trim(fmt(b))
         if (a > 0) what = what // ' - x' // trim(fmt(a))
+        ! A moving ground end starts at w(0) = ground_amp sin(ground_phase).
+        if (a == 0 .and. records%contact_moves(k)) then
+          if (records%contact_ground(3, k) > 0.0_wp) then
+            d = x(b) - records%contact_ground(2, k) * sin(records%contact_ground(4, k))
+            what = what // ' - w(0)'
+          end if
+        end if
         do side = 1, 2
           if (.not. records%contact_has(side, k)) cycle
           limit = records%contact_limit(side, k)
@@ -727,10 +772,25 @@ contains
     type(scene_input), intent(in) :: input
     integer, intent(in) :: n
     type(mechanism_records), intent(inout) :: records
-    if (input%given(i_x_left)) call add_contact(records, 'left', 0, 1, 1, input%value(i_x_left), &
-      value_or(input, i_r_left, 1.0_wp))
-    if (input%given(i_x_right)) call add_contact(records, 'right', 0, n, 2, input%value(i_x_right), &
-      value_or(input, i_r_right, 1.0_wp))
+    if (input%given(i_x_left)) then
+      call add_contact(records, 'left', 0, 1, 1, input%value(i_x_left), value_or(input, i_r_left, 1.0_wp))
+      call wall_motion(i_x_left_v)
+    end if
+    if (input%given(i_x_right)) then
+      call add_contact(records, 'right', 0, n, 2, input%value(i_x_right), value_or(input, i_r_right, 1.0_wp))
+      call wall_motion(i_x_right_v)
+    end if
+
+  contains
+
+    !> The wall just added moves as its fields from first (x_left_v ...) say, when any is given.
+    subroutine wall_motion(first)
+      integer, intent(in) :: first
+      associate (k => records%n_contacts, given => input%given(first:first + n_ground_fields - 1))
+        records%contact_moves(k) = any(given)
+        records%contact_ground(:, k) = merge(input%value(first:first + n_ground_fields - 1), 0.0_wp, given)
+      end associate
+    end subroutine wall_motion
   end subroutine wall_records
 
   !> Link i between bodies i and i+1, as its &link elements and the meeting make it.

@@ -122,10 +122,13 @@ contains
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
     type(error_type), allocatable, intent(inout) :: error
-    ! (The prescribed motion's work is booked with the external work: s%drive_work is 0
-    ! without moving grounds.)
-    call emit_bodies(sink, stats, s%t, s%x, s%v, scene%body_mass, r%ke0, s%work + s%drive_work, s%friction_loss, &
-      s%impact_loss, scene%springs%present, [potential(scene, s), r%pe0, s%damping_loss], error)
+    if (scene%drives%n > 0) then
+      call emit_bodies(sink, stats, s%t, s%x, s%v, scene%body_mass, r%ke0, s%work, s%friction_loss, &
+        s%impact_loss, scene%springs%present, [potential(scene, s), r%pe0, s%damping_loss], error, s%drive_work)
+    else
+      call emit_bodies(sink, stats, s%t, s%x, s%v, scene%body_mass, r%ke0, s%work, s%friction_loss, &
+        s%impact_loss, scene%springs%present, [potential(scene, s), r%pe0, s%damping_loss], error)
+    end if
     j_sample = j_sample + 1
   end subroutine emit
 

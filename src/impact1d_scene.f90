@@ -9,7 +9,8 @@ module impact1d_scene
   use impact1d_springs, only: springs_type, pair_elements, assemble, rate_bound
   use impact1d_modes, only: pair_type, pair_rows
   use impact1d_drives, only: drive_type
-  use impact1d_fields, only: chain_input, mechanism_records, r_k, r_c, r_stop_k, r_stop_c, array_value, a_m, &
+  use impact1d_fields, only: chain_input, mechanism_records, r_k, r_c, r_stop_k, r_stop_c, r_ground_v, &
+    r_spring_ground_v, n_ground_fields, array_value, a_m, &
     a_mu, a_mus, a_x, a_v, &
     a_f, a_f_amp, a_f_period, a_f_phase, a_f_table
   use impact1d_stability, only: linear_modes, stable_step, mode_error, coarse_rate
@@ -21,20 +22,23 @@ module impact1d_scene
     i_r_min, i_d_max, i_r_max, i_x1, i_v1, i_x2, i_v2, i_f1, i_f2, i_f1_amp, i_f1_period, &
     i_f1_phase, i_f2_amp, i_f2_period, i_f2_phase, i_t_end, i_dt, i_dt_out, i_mus1, i_mus2, &
     i_k1, i_x1_rest, i_c1, i_k2, i_x2_rest, i_c2, i_k12, i_d_rest, i_c12, i_max_events
-  public :: sample_time, step_length, set_text, events_kept, name_of, is_nbody, value_or, nbody_refusal
+  public :: sample_time, step_length, set_text, events_kept, name_of, is_nbody, value_or, nbody_refusal, ground_named
   public :: positive_value, nonnegative_value, unit_interval, resolvable
+  public :: i_x_left_v, i_x_right_v
   public :: i_title, i_f1_table, i_f2_table, i_method, i_substeps, i_events, default_gravity
   public :: events_all, events_impacts, events_none
   public :: name_len, set_rows, allocate_contacts, set_springs, springs_named
 
-  integer, parameter :: n_real = 44, n_text = 6
+  integer, parameter :: n_real = 52, n_text = 6
   !> Names of the real inputs, as in the namelist and in Python's Scene, in this order.
   character(len=*), parameter :: real_names(n_real) = [character(len=15) :: &
     'm1', 'm2', 'mu1', 'mu2', 'g', 'x_left', 'r_left', 'x_right', 'r_right', &
     'd_min', 'r_min', 'd_max', 'r_max', 'x1', 'v1', 'x2', 'v2', 'f1', 'f2', &
     'f1_amp', 'f1_period', 'f1_phase', 'f2_amp', 'f2_period', 'f2_phase', 't_end', 'dt', 'dt_out', &
     'zero_vel', 'max_rows', 'max_impulses', 'max_step_events', 'mus1', 'mus2', &
-    'k1', 'x1_rest', 'c1', 'k2', 'x2_rest', 'c2', 'k12', 'd_rest', 'c12', 'max_events']
+    'k1', 'x1_rest', 'c1', 'k2', 'x2_rest', 'c2', 'k12', 'd_rest', 'c12', 'max_events', &
+    'x_left_v', 'x_left_amp', 'x_left_period', 'x_left_phase', 'x_right_v', 'x_right_amp', 'x_right_period', &
+    'x_right_phase']
   character(len=*), parameter :: text_names(n_text) = [character(len=8) :: &
     'title', 'f1_table', 'f2_table', 'method', 'substeps', 'events']
   integer, parameter :: i_m1 = 1, i_m2 = 2, i_mu1 = 3, i_mu2 = 4, i_g = 5, i_x_left = 6, &
@@ -45,6 +49,8 @@ module impact1d_scene
     i_max_rows = 30, i_max_impulses = 31, i_max_step_events = 32, i_mus1 = 33, i_mus2 = 34, &
     i_k1 = 35, i_x1_rest = 36, i_c1 = 37, i_k2 = 38, i_x2_rest = 39, i_c2 = 40, i_k12 = 41, &
     i_d_rest = 42, i_c12 = 43, i_max_events = 44
+  !> The walls' prescribed motion (impact1d_chain's wall_records): v, amp, period, phase each.
+  integer, parameter :: i_x_left_v = 45, i_x_right_v = 49
   !> What only a second body can have: refused in a one-body scene (no m2).
   integer, parameter :: body2_fields(18) = [i_x2, i_v2, i_mu2, i_mus2, i_f2, i_f2_amp, i_f2_period, &
     i_f2_phase, i_k2, i_x2_rest, i_c2, i_k12, i_d_rest, i_c12, i_d_min, i_r_min, i_d_max, i_r_max]
@@ -337,6 +343,7 @@ contains
       if (.not. has_limit(input, k)) cycle
       nrm = contact_normals(input)
       gap = nrm(1, k) * input%value(i_x1) + nrm(2, k) * input%value(i_x2) + offset_of(input, k)
+      if (k <= i_right) gap = gap + offset_sign(k) * wall_start(input, k)
       scale = maxval(abs(nrm(:, k) * input%value([i_x1, i_x2])))
       if (gap < -16.0_wp * eps_wp * max(scale, abs(offset_of(input, k)))) then
         if (input%given(limit_index(k))) then
@@ -916,6 +923,24 @@ contains
     end do
   end function springs_named
 
+  !> Whether a record names its ground's motion (ground_v ...), or the walls theirs
+  !> (x_left_v ...): the drive_work column.
+  pure logical function ground_named(input)
+    type(scene_input), intent(in) :: input
+    integer :: r
+    ground_named = any(input%given(i_x_left_v:i_x_right_v + 3))
+    if (allocated(input%chain%contacts)) then
+      do r = 1, size(input%chain%contacts)
+        ground_named = ground_named .or. any(input%chain%contacts(r)%given(r_ground_v:r_ground_v + n_ground_fields - 1))
+      end do
+    end if
+    if (.not. allocated(input%chain%springs)) return
+    do r = 1, size(input%chain%springs)
+      ground_named = ground_named .or. any(input%chain%springs(r)%given(r_spring_ground_v:r_spring_ground_v + &
+        n_ground_fields - 1))
+    end do
+  end function ground_named
+
   !> The element records as the two-body kernels see them (their ends as lanes: body i is
   !> lane i, the ground 0), and the rate bound that samples their motion.
   subroutine set_springs(scene, error)
@@ -1261,6 +1286,18 @@ contains
     integer, parameter :: indices(n_limits) = [i_x_left, i_x_right, i_d_min, i_d_max]
     limit_index = indices(k)
   end function limit_index
+
+  !> Where wall k's prescribed motion puts it at t = 0 (x_left_amp sin(x_left_phase): its
+  !> sine's; 0 without one), added to its limit.
+  pure real(wp) function wall_start(input, k)
+    type(scene_input), intent(in) :: input
+    integer, intent(in) :: k
+    integer :: first
+    wall_start = 0.0_wp
+    first = merge(i_x_left_v, i_x_right_v, k == i_left)
+    if (input%given(first + 1) .and. input%given(first + 2)) wall_start = input%value(first + 1) * &
+      sin(value_or(input, first + 3, 0.0_wp))
+  end function wall_start
 
   !> gap = normal . x + offset_sign * limit (left: x1 - x_left; right: x_right - x2; ...).
   pure real(wp) function offset_sign(k)

@@ -280,6 +280,20 @@ def test_moving_wall_at_constant_speed_gains_two_u_a_hit():
     np.testing.assert_allclose(result.events["t"], [hit for _, hit, _ in expected], rtol=0, atol=1e-13)
     np.testing.assert_allclose(result.events["v1_after"], [v for _, _, v in expected], rtol=0, atol=1e-13)
     assert result.energy_residual < 1e-13
+    # The wall's work is the drive_work column: all the kinetic energy the ball gained
+    # (elastic walls, no forces), booked at each hit on the moving wall.
+    assert "drive_work" in result.columns
+    assert result.drive_work[-1] == pytest.approx((v0 + 2 * u * sum(k == "right" for k, _, _ in expected)) ** 2 / 2
+                                                  - v0**2 / 2, abs=1e-13)
+    np.testing.assert_array_equal(result.work, 0.0)
+
+
+def test_drive_work_column_only_with_a_moving_ground():
+    scene = impact1d.Scene(m1=1.0, x1=0.5, v1=1.0, t_end=1.0, dt=1e-3,
+                           contacts=[dict(a=0, b=1, d_min=0.0), dict(a=0, b=1, d_max=1.0)])
+    assert impact1d.simulate(scene).drive_work is None
+    assert "drive_work" not in impact1d.simulate(scene).columns
+    assert impact1d.simulate(moving_engine(scene)).drive_work is not None
 
 
 @pytest.mark.parametrize("record, message", [
@@ -291,6 +305,46 @@ def test_moving_wall_at_constant_speed_gains_two_u_a_hit():
 def test_bad_ground_motion_is_refused(record, message):
     scene = impact1d.Scene(m1=1.0, m2=1.0, x1=0.0, x2=1.0, t_end=1.0, dt=1e-3, contacts=[record])
     with pytest.raises(impact1d.InputError, match=message):
+        impact1d.simulate(scene)
+
+
+def test_moving_walls_are_the_records_moving():
+    """&walls x_right_amp, x_right_period (DESIGN's names) move the right wall as the same
+    &contact record's ground_amp, ground_period do: the same run, bit for bit."""
+    common = dict(m1=1.0, x1=0.5, v1=1.3, t_end=4.0, dt=1e-3, dt_out=0.01)
+    walls = impact1d.Scene(x_left=0.0, x_right=1.0, r_right=0.9, x_right_amp=0.1, x_right_period=1.0,
+                           x_right_phase=0.3, **common)
+    records = impact1d.Scene(contacts=[
+        dict(a=0, b=1, d_min=0.0, r_min=1.0, name="left"),
+        dict(a=0, b=1, d_max=1.0, r_max=0.9, ground_amp=0.1, ground_period=1.0, ground_phase=0.3, name="right")],
+        **common)
+    a, b = impact1d.simulate(walls), impact1d.simulate(records)
+    assert len(a.events) > 3
+    np.testing.assert_array_equal(a.events, b.events)
+    np.testing.assert_array_equal(a.samples, b.samples)
+    assert a.columns == b.columns and "drive_work" in a.columns
+
+
+@pytest.mark.parametrize("fields, message", [
+    (dict(x_left_v=0.1), "x_left_v, _amp, _period, _phase move the wall x_left, which is not given"),
+    (dict(x_right=2.0, x_right_amp=0.1), "x_right_amp and x_right_period go together"),
+    (dict(x_right=2.0, x_right_phase=0.1), "x_right_phase is given but x_right_amp is not"),
+    (dict(x_left=-1.0, x_left_amp=1.5, x_left_period=1.0, x_left_phase=1.0), "violates the left"),
+])
+def test_bad_wall_motion_is_refused(fields, message):
+    """Each wall's motion needs its wall and a whole sine; a wall whose motion starts it past
+    the body (w(0) = amp sin(phase)) is refused as a wall placed there would be."""
+    scene = impact1d.Scene(m1=1.0, x1=0.0, t_end=1.0, dt=1e-3, **fields)
+    with pytest.raises(impact1d.InputError, match=message):
+        impact1d.simulate(scene)
+
+
+def test_a_start_inside_a_moving_ground_is_refused():
+    """A body below a table that starts at w(0) = 0.1 sin(1.0) = 0.084 above it violates the
+    contact at t = 0 (the check counts w(0))."""
+    scene = impact1d.Scene(m1=1.0, m2=1.0, x1=0.0, x2=1.0, t_end=1.0, dt=1e-3, contacts=[
+        dict(a=0, b=1, d_min=0.0, ground_amp=0.1, ground_period=1.0, ground_phase=1.0)])
+    with pytest.raises(impact1d.InputError, match="violates the contact 'contact1': x1 - w"):
         impact1d.simulate(scene)
 
 
