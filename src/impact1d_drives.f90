@@ -18,6 +18,7 @@ module impact1d_drives
   contains
     procedure :: add
     procedure :: position
+    procedure :: displacement
     procedure :: velocity
     procedure :: acceleration
     procedure :: jerk
@@ -46,6 +47,18 @@ contains
     w = self%v(d) * t
     if (self%omega(d) /= 0.0_wp) w = w + self%amp(d) * sin(self%omega(d) * t + self%phase(d))
   end function position
+
+  !> w_d(t + h) - w_d(t), accurate however small h is against t (a difference of positions
+  !> would round a step below the clock's ulp to 0): sin(a + c) - sin(a) = 2 cos(a + c/2)
+  !> sin(c/2).
+  pure real(wp) function displacement(self, d, t, h) result(dw)
+    class(drive_type), intent(in) :: self
+    integer, intent(in) :: d
+    real(wp), intent(in) :: t, h
+    dw = self%v(d) * h
+    if (self%omega(d) /= 0.0_wp) dw = dw + 2.0_wp * self%amp(d) * cos(self%omega(d) * (t + 0.5_wp * h) + &
+      self%phase(d)) * sin(0.5_wp * self%omega(d) * h)
+  end function displacement
 
   !> w_d'(t).
   pure real(wp) function velocity(self, d, t) result(w)

@@ -118,7 +118,7 @@ contains
     call add_compensated(b%t, b%t_lo, step)
     call add_compensated(b%x, b%x_lo, (step / 6.0_wp) * (kx1 + 2.0_wp * (kx2 + kx3) + kx4))
     call add_compensated(b%v, b%v_lo, (step / 6.0_wp) * (kv1 + 2.0_wp * (kv2 + kv3) + kv4))
-    if (scene%drives%n > 0) call hold_to_drives(scene, mode, a, b)
+    if (scene%drives%n > 0) call hold_to_drives(scene, mode, a, step, b)
     v1 = b%v + b%v_lo
     f = f1
     if (scene%drives%n > 0) then
@@ -178,13 +178,14 @@ contains
     end subroutine drive_step_ledger
   end subroutine nbody_step
 
-  !> Bodies held to a moving ground move with it exactly over the step from a to b (by w(b)
-  !> - w(a), at w'(b)): RK4's quadrature of w'' would leave their held rows' normal velocity
-  !> off zero by its error, which the event points would take for impacts.
-  pure subroutine hold_to_drives(scene, mode, a, b)
+  !> Bodies held to a moving ground move with it exactly over the step from a to b (by w(t +
+  !> step) - w(t), at w'(t + step)): RK4's quadrature of w'' would leave their held rows'
+  !> normal velocity off zero by its error, which the event points would take for impacts.
+  pure subroutine hold_to_drives(scene, mode, a, step, b)
     type(scene_type), intent(in) :: scene
     type(body_mode_type), intent(in) :: mode
     type(state_type), intent(in) :: a
+    real(wp), intent(in) :: step
     type(state_type), intent(inout) :: b
     integer :: i
     do i = 1, scene%n_bodies
@@ -192,8 +193,8 @@ contains
       associate (d => mode%drive(i))
         b%x(i) = a%x(i)
         b%x_lo(i) = a%x_lo(i)
-        call add_compensated(b%x(i), b%x_lo(i), scene%drives%position(d, b%t) - scene%drives%position(d, a%t))
-        b%v(i) = scene%drives%velocity(d, b%t)
+        call add_compensated(b%x(i), b%x_lo(i), scene%drives%displacement(d, a%t, step))
+        b%v(i) = scene%drives%velocity(d, a%t + step)
         b%v_lo(i) = 0.0_wp
       end associate
     end do
@@ -323,8 +324,8 @@ contains
         else if (scene%drives%n > 0) then
           ! A moving ground end on its own cubic over the step (exact for ground_v; the
           ! step's end is checked on the exact w: gaps_hold).
-          if (scene%row_drive(k) > 0) p(1:3) = p(1:3) + hermite(ground_motion(scene, k, b%t, 0) - &
-            ground_motion(scene, k, a%t, 0), ground_motion(scene, k, a%t, 1), ground_motion(scene, k, b%t, 1), step)
+          if (scene%row_drive(k) > 0) p(1:3) = p(1:3) + hermite(-n(2) * scene%drives%displacement( &
+            scene%row_drive(k), a%t, step), ground_motion(scene, k, a%t, 1), ground_motion(scene, k, a%t + step, 1), step)
         end if
       end associate
       if (p(0) - step * (abs(p(1)) + step * (abs(p(2)) + step * abs(p(3)))) > 0.0_wp) cycle
