@@ -9,7 +9,8 @@ module impact1d_nbody_step
   use impact1d_state, only: state_type, add_compensated
   use impact1d_events, only: hermite, earliest_crossing
   use impact1d_yardsticks, only: gap_rounding, velocity_rounding, time_rounding
-  use impact1d_elements, only: add_element_forces, add_element_rates, element_damping_power, element_drive_power
+  use impact1d_elements, only: add_element_forces, add_moving_element_forces, add_element_rates, element_damping_power, &
+    element_drive_power
   use impact1d_body_mode, only: body_mode_type, mode_work_type, solve_body_mode, same_mode, mode_solved, &
     drive_accelerations, shift_to_drives
   implicit none
@@ -31,7 +32,7 @@ contains
     call scene%forcing%force_all(t, f)
     if (.not. scene%springs%present) return
     if (scene%drives%n > 0) then
-      call add_element_forces(scene, x, dx, v, f, t)
+      call add_moving_element_forces(scene, x, dx, v, f, t)
     else
       call add_element_forces(scene, x, dx, v, f)
     end if
@@ -107,13 +108,13 @@ contains
     call scene%forcing%force_all(a%t + half, fm)
     call scene%forcing%force_all(a%t + step, f1)
     kx1 = v0
-    call stage(f0, a%x_lo, kx1, kv1, a%t, power(1))
+    call stage(f0, a%x_lo, kx1, kv1, 0.0_wp, 1)
     kx2 = v0 + half * kv1
-    call stage(fm, a%x_lo + half * kx1, kx2, kv2, a%t + half, power(2))
+    call stage(fm, a%x_lo + half * kx1, kx2, kv2, half, 2)
     kx3 = v0 + half * kv2
-    call stage(fm, a%x_lo + half * kx2, kx3, kv3, a%t + half, power(3))
+    call stage(fm, a%x_lo + half * kx2, kx3, kv3, half, 3)
     kx4 = v0 + step * kv3
-    call stage(f1, a%x_lo + step * kx3, kx4, kv4, a%t + step, power(4))
+    call stage(f1, a%x_lo + step * kx3, kx4, kv4, step, 4)
     b = a
     call add_compensated(b%t, b%t_lo, step)
     call add_compensated(b%x, b%x_lo, (step / 6.0_wp) * (kx1 + 2.0_wp * (kx2 + kx3) + kx4))
@@ -144,23 +145,17 @@ contains
 
   contains
 
-    !> A stage's accelerations acc at external forces fx, positions a%x + dx', velocities v,
-    !> time t (moving grounds: and the power they put in).
-    subroutine stage(fx, dx_stage, v, acc, t, drive_power)
-      real(wp), intent(in) :: fx(:), dx_stage(:), v(:), t
-      real(wp), intent(out) :: acc(:), drive_power
-      f = fx
-      drive_power = 0.0_wp
+    !> Stage k's accelerations acc at external forces fx, positions a%x + dx', velocities v,
+    !> time a%t + tau (moving grounds apart: moving_stage).
+    subroutine stage(fx, dx_stage, v, acc, tau, k)
+      real(wp), intent(in) :: fx(:), dx_stage(:), v(:), tau
+      real(wp), intent(out) :: acc(:)
+      integer, intent(in) :: k
       if (scene%drives%n > 0) then
-        if (scene%springs%present) then
-          dx = dx_stage
-          call add_element_forces(scene, a%x, dx, v, f, t)
-          drive_power = element_drive_power(scene, a%x, dx, v, t)
-        end if
-        call mode_acceleration(scene, mode, t, f, acc)
-        drive_power = drive_power + held_drive_power(scene, mode, t, f, acc)
+        call moving_stage(fx, dx_stage, v, acc, a%t + tau, power(k))
         return
       end if
+      f = fx
       if (scene%springs%present) then
         dx = dx_stage
         call add_element_forces(scene, a%x, dx, v, f)
@@ -168,10 +163,25 @@ contains
       call mode%acceleration(f, acc)
     end subroutine stage
 
+    !> stage with moving grounds at time t: and the power they put in.
+    subroutine moving_stage(fx, dx_stage, v, acc, t, drive_power)
+      real(wp), intent(in) :: fx(:), dx_stage(:), v(:), t
+      real(wp), intent(out) :: acc(:), drive_power
+      f = fx
+      drive_power = 0.0_wp
+      if (scene%springs%present) then
+        dx = dx_stage
+        call add_moving_element_forces(scene, a%x, dx, v, f, t)
+        drive_power = element_drive_power(scene, a%x, dx, v, t)
+      end if
+      call mode_acceleration(scene, mode, t, f, acc)
+      drive_power = drive_power + held_drive_power(scene, mode, t, f, acc)
+    end subroutine moving_stage
+
     !> The step's end with moving grounds: the accelerations there, and the work the
     !> prescribed motion did, by RK4's own quadrature of the stages' power.
     subroutine drive_step_ledger()
-      if (scene%springs%present) call add_element_forces(scene, b%x, b%x_lo, v1, f, b%t)
+      if (scene%springs%present) call add_moving_element_forces(scene, b%x, b%x_lo, v1, f, b%t)
       call mode_acceleration(scene, mode, b%t, f, acc_end)
       call add_compensated(b%drive_work, b%drive_lo, step / 6.0_wp * (power(1) + 2.0_wp * (power(2) + &
         power(3)) + power(4)))
@@ -230,12 +240,13 @@ contains
       if (a > 0) then
         p = n(1) * s%x(a)
         low = n(1) * s%x_lo(a)
-      else if (scene%drives%n > 0) then
-        p = ground_motion(scene, k, s%t, 0)
       end if
       q = n(2) * s%x(b)
       low = low + n(2) * s%x_lo(b)
     end associate
+    if (scene%drives%n > 0) then
+      if (scene%row_drive(k) > 0) p = ground_motion(scene, k, s%t, 0)
+    end if
     total = p + q
     rounded = total - p
     g = (total + scene%row_offset(k)) + (((p - (total - rounded)) + (q - rounded)) + low)
