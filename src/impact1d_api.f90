@@ -64,7 +64,7 @@ contains
   !> impact1d_chain's numbering).
   subroutine input_field_names(names)
     character(len=2048), intent(out) :: names
-    character(len=16) :: words(n_ids)
+    character(len=24) :: words(n_ids)
     integer :: id
     do id = 1, n_ids
       words(id) = field_name(id)
@@ -183,13 +183,14 @@ contains
   !> of body index ('stick', 'slip' and the body's number), reporting the bodies (end a, end
   !> b) (0: none; (1, 2) with two bodies, (1, 0) with one). The run's row names fill
   !> row_name_codes(:, :n_rows) as character codes (blank-padded). has_column(k) is 1 for
-  !> the columns of the run's full row (impact1d_output's row_length(N) = 2 max(N, 2) + 8:
-  !> t, x1 v1 .. xN vN, ke, pe, work, friction_loss, impact_loss, damping_loss, residual;
-  !> for one or two bodies column_names) that the scene has (x2 and v2 only with a second
-  !> body, x and v only of the bodies of &run bodies_out, pe and damping_loss with springs
-  !> and dampers): they fill samples' first columns, in that order; n_cols (samples' and
-  !> has_column's length) must be row_length(N) at least. info = [status, n_samples,
-  !> n_events, n_rows, steps, message length, warnings length, N] and energy_residual(1)
+  !> the columns of the run's full row (impact1d_output's row_length(N) = 2 max(N, 2) + 9:
+  !> t, x1 v1 .. xN vN, ke, pe, work, friction_loss, impact_loss, damping_loss, drive_work,
+  !> residual; for one or two bodies column_names) that the scene has (x2 and v2 only with a
+  !> second body, x and v only of the bodies of &run bodies_out, pe and damping_loss with
+  !> springs and dampers, drive_work with a moving ground): they fill samples' first
+  !> columns, in that order; n_cols (samples' and has_column's length) must be row_length(N)
+  !> at least. info = [status, n_samples, n_events, n_rows, steps, message length, warnings
+  !> length, N] and energy_residual(1)
   !> come back; the message and the warnings (one per line) fill text_codes(:length, 1) and
   !> (:length, 2) as character codes. When any array needs more room than the caller gave,
   !> status is 3 and n_samples, n_events, n_rows, N are the sizes needed: call again with
@@ -493,7 +494,7 @@ contains
       ! (x1 v1 x2 v2 of the full row of one, two or N bodies, the ledger at row_ledger's)
       final = final_row(stats)
       l = row_ledger(scene%n_bodies)
-      summary(:, j) = [final([2, 3, 4, 5, l + 1]), &
+      summary(:size(summary_names), j) = [final([2, 3, 4, 5, l + 1]), &
         real(sum(stats%row_events(class_impact, :)), wp), &
         real([(impacts_on(stats, scene%row_name, event_names(k)), k = event_impact + 1, event_rest)], wp), &
         sink%rest_time(final), final([l + 5, l + 4]), &

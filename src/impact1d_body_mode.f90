@@ -26,6 +26,7 @@ module impact1d_body_mode
   private
   public :: body_mode_type, mode_work_type, new_mode, solve_body_mode, same_mode, mode_solved
   public :: mode_reserve, gathered_mode
+  public :: drive_accelerations, shift_to_drives, drive_components
 
   integer, parameter :: mode_solved = cluster_solved   !< otherwise an impact1d_lcp status
   !> The largest cluster problem solved densely (rows + 2 bodies' unknowns): its matrices take
@@ -40,6 +41,9 @@ module impact1d_body_mode
     real(wp), allocatable :: f_slide(:)      !< (N) the sliding friction forces -c_i sgn_i
     integer, allocatable :: group(:)         !< (N) the body's group (a union-find root); 0: held still
     real(wp), allocatable :: group_mass(:)   !< (0:N) mass of the group rooted at each index
+    !> (N) the drive of the moving ground whose held rows hold the body's group (group 0),
+    !> else 0 (scenes with drives only: set_groups)
+    integer, allocatable :: drive(:)
     !> Some row is held or some body stuck: conditions that forces can break.
     logical :: held = .false.
   contains
@@ -77,7 +81,8 @@ contains
     type(mode_work_type), intent(out) :: work
     integer :: i
     allocate(mode%active(n_rows), mode%stuck(n), mode%sgn(n), mode%f_slide(n), mode%group(n), &
-      mode%group_mass(0:n))
+      mode%group_mass(0:n), mode%drive(n))
+    mode%drive = 0
     mode%active = .false.
     mode%stuck = .false.
     mode%sgn = 0.0_wp
@@ -369,5 +374,76 @@ contains
     end do
     mode%f_slide = -scene%body_friction * mode%sgn
     mode%held = any(mode%active) .or. any(mode%stuck)
+    if (scene%drives%n > 0) call drive_components(scene, mode%active, mode%drive)
   end subroutine set_groups
+
+  !> drive(i): the drive of the moving ground that the rows marked (rows) join body i to,
+  !> through rows between bodies too; 0 for none (or the still ground).
+  pure subroutine drive_components(scene, rows, drive)
+    type(scene_type), intent(in) :: scene
+    logical, intent(in) :: rows(:)
+    integer, intent(out) :: drive(:)
+    integer :: k
+    logical :: grew
+    drive = 0
+    do k = 1, scene%n_rows
+      if (rows(k) .and. scene%row_body(1, k) == 0) drive(scene%row_body(2, k)) = scene%row_drive(k)
+    end do
+    grew = .true.
+    do while (grew)
+      grew = .false.
+      do k = 1, scene%n_rows
+        if (.not. rows(k) .or. scene%row_body(1, k) == 0) cycle
+        associate (a => scene%row_body(1, k), b => scene%row_body(2, k))
+          if (drive(a) == drive(b)) cycle
+          if (drive(a) > 0 .and. drive(b) == 0) then
+            drive(b) = drive(a)
+            grew = .true.
+          else if (drive(b) > 0 .and. drive(a) == 0) then
+            drive(a) = drive(b)
+            grew = .true.
+          end if
+        end associate
+      end do
+    end do
+  end subroutine drive_components
+
+  !> a(i) := w_d^(order)(t) of a body held to moving ground d (order 2: the accelerations
+  !> after acceleration, whose group 0 is the still ground; order 3: their rate, after
+  !> rate_response).
+  pure subroutine drive_accelerations(scene, mode, t, order, a)
+    type(scene_type), intent(in) :: scene
+    type(body_mode_type), intent(in) :: mode
+    real(wp), intent(in) :: t
+    integer, intent(in) :: order
+    real(wp), intent(inout) :: a(:)
+    integer :: i
+    do i = 1, scene%n_bodies
+      if (mode%drive(i) == 0) cycle
+      if (order == 2) then
+        a(i) = scene%drives%acceleration(mode%drive(i), t)
+      else
+        a(i) = scene%drives%jerk(mode%drive(i), t)
+      end if
+    end do
+  end subroutine drive_accelerations
+
+  !> The forces f and their rate df as seen from the moving ground that the candidate rows
+  !> join each body to (the inertial force -m w'' and its rate added): solved so, a cluster
+  !> pressed onto a moving ground is the cluster on a still one (the rows' acceleration
+  !> constraint n . a >= -n_ground w'' becomes n . a' >= 0). Bodies on no moving ground are
+  !> left as they are. Friction of a body at rest on a moving cluster is not relative to it.
+  pure subroutine shift_to_drives(scene, t, candidate, f, df)
+    type(scene_type), intent(in) :: scene
+    real(wp), intent(in) :: t
+    logical, intent(in) :: candidate(:)
+    real(wp), intent(inout) :: f(:), df(:)
+    integer :: drive(scene%n_bodies), i
+    call drive_components(scene, candidate, drive)
+    do i = 1, scene%n_bodies
+      if (drive(i) == 0) cycle
+      f(i) = f(i) - scene%body_mass(i) * scene%drives%acceleration(drive(i), t)
+      df(i) = df(i) - scene%body_mass(i) * scene%drives%jerk(drive(i), t)
+    end do
+  end subroutine shift_to_drives
 end module impact1d_body_mode

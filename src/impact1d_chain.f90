@@ -10,12 +10,13 @@ module impact1d_chain
     positive_value, nonnegative_value, unit_interval, resolvable, unresolved, i_m1, i_m2, i_x_left, i_r_left, i_x_right, &
     i_r_right, i_r_min, i_d_min, i_g, default_gravity, i_mu1, i_mu2, i_mus1, i_mus2, i_x1, i_x2, i_v1, i_v2, i_f1, i_f2, &
     i_f1_amp, i_f2_amp, i_f1_period, i_f2_period, i_f1_phase, i_f2_phase, i_k1, i_k2, i_x1_rest, i_x2_rest, &
-    i_c1, i_c2, i_d_max, i_r_max, i_k12, i_d_rest, i_c12, i_f1_table, i_f2_table
+    i_c1, i_c2, i_d_max, i_r_max, i_k12, i_d_rest, i_c12, i_f1_table, i_f2_table, i_x_left_v, i_x_right_v
   use impact1d_fields, only: array_value, n_arrays, array_names, array_is_link, array_is_text, alias_name, name_len, &
     record_input, a_m, a_mu, a_mus, a_x, a_f_amp, a_f_period, a_f_phase, a_k, a_x_rest, a_c, a_d_min, a_r_min, &
     a_d_max, a_r_max, a_k_link, a_d_rest, a_c_link, r_a, r_b, r_d_min, r_r_min, r_d_max, r_r_max, r_k, r_d_rest, &
     r_c, contact_fields, spring_fields, r_name, n_contact_fields, n_spring_fields, written_array, text_item, &
-    a_f_table, mechanism_records, n_sine_fields, sine_fields, r_body, r_amp, r_period, r_phase, r_stop_k, r_stop_c
+    a_f_table, mechanism_records, n_sine_fields, sine_fields, r_body, r_amp, r_period, r_phase, r_stop_k, r_stop_c, &
+    r_ground_v, r_spring_ground_v, n_ground_fields
   implicit none
   private
   public :: settle_chain, validate_chain, input_records, mechanism_records, n_bodies_of, slot_of, alias_slot
@@ -286,6 +287,8 @@ contains
     if (allocated(error)) return
     if (allocated(input%chain%sines)) call check_sines(input, error)
     if (allocated(error)) return
+    call wall_motion_terms(input, error)
+    if (allocated(error)) return
     call input_records(input, records)
     call check_names(records, error)
     if (allocated(error)) return
@@ -427,6 +430,8 @@ contains
         else if (.not. allocated(error)) then
           call spring_values(rec, where, error)
         end if
+        if (.not. allocated(error)) call ground_motion(rec, merge(r_ground_v, r_spring_ground_v, contact), &
+          where, error)
         if (allocated(error)) return
       end associate
     end do
@@ -480,7 +485,7 @@ contains
   pure function field_of(contact, f) result(name)
     logical, intent(in) :: contact
     integer, intent(in) :: f
-    character(len=8) :: name     ! blank padded: callers trim
+    character(len=13) :: name     ! blank padded: callers trim
     if (contact) then
       name = contact_fields(f)
     else
@@ -543,6 +548,74 @@ contains
       rec%value(r_stop_c), error)
   end subroutine contact_limits
 
+  !> The prescribed motion of a record's ground end (fields first .. first + 3: ground_v,
+  !> ground_amp, ground_period, ground_phase): only on a record with a ground end (a or b =
+  !> 0); a sine has its amplitude and a positive period, a phase needs its sine.
+  subroutine ground_motion(rec, first, where, error)
+    type(record_input), intent(in) :: rec
+    integer, intent(in) :: first
+    character(len=*), intent(in) :: where
+    type(error_type), allocatable, intent(inout) :: error
+    if (.not. any(rec%given(first:first + n_ground_fields - 1))) return
+    if (rec%value(r_a) /= 0.0_wp .and. rec%value(r_b) /= 0.0_wp) then
+      call raise(error, status_input, where // 'ground_v, ground_amp, ground_period and ground_phase move ' // &
+        'the ground end, but this record joins two bodies (a = 0 or b = 0 is the ground)')
+      return
+    end if
+    call motion_terms(rec%given(first:first + n_ground_fields - 1), rec%value(first:first + n_ground_fields - 1), &
+      where, 'ground', error)
+  end subroutine ground_motion
+
+  !> A prescribed motion's fields (<prefix>_v, _amp, _period, _phase: given, value; where:
+  !> the record, for messages): a sine has its amplitude and a positive period, a phase
+  !> needs its sine.
+  subroutine motion_terms(given, value, where, prefix, error)
+    logical, intent(in) :: given(n_ground_fields)
+    real(wp), intent(in) :: value(n_ground_fields)
+    character(len=*), intent(in) :: where, prefix
+    type(error_type), allocatable, intent(inout) :: error
+    if (given(2) .neqv. given(3)) then
+      call raise(error, status_input, where // prefix // '_amp and ' // prefix // '_period go together: the ' // &
+        'sine is ' // prefix // '_amp sin(2 pi t / ' // prefix // '_period + ' // prefix // '_phase)')
+    else if (given(4) .and. .not. given(2)) then
+      call raise(error, status_input, where // prefix // '_phase is given but ' // prefix // '_amp is not: a ' // &
+        'phase needs its sine')
+    else if (given(3)) then
+      call positive_value(where // prefix // '_period', value(3), error)
+    end if
+  end subroutine motion_terms
+
+  !> The walls' prescribed motion (x_left_v ..., x_right_v ...): each needs its wall.
+  subroutine wall_motion_terms(input, error)
+    type(scene_input), intent(in) :: input
+    type(error_type), allocatable, intent(inout) :: error
+    integer :: side, first, wall
+    character(len=7) :: prefix
+    do side = 1, 2
+      first = merge(i_x_left_v, i_x_right_v, side == 1)
+      wall = merge(i_x_left, i_x_right, side == 1)
+      prefix = merge('x_left ', 'x_right', side == 1)
+      if (.not. any(input%given(first:first + n_ground_fields - 1))) cycle
+      if (.not. input%given(wall)) then
+        call raise(error, status_input, trim(prefix) // '_v, _amp, _period, _phase move the wall ' // trim(prefix) // &
+          ', which is not given')
+        return
+      end if
+      call motion_terms(input%given(first:first + n_ground_fields - 1), input%value(first:first + n_ground_fields - 1), &
+        '', trim(prefix), error)
+      if (allocated(error)) return
+    end do
+  end subroutine wall_motion_terms
+
+  !> The prescribed motion a record gives its ground end (fields first ..): v, amp, period,
+  !> phase, 0 where not given.
+  pure function ground_of(rec, first) result(ground)
+    type(record_input), intent(in) :: rec
+    integer, intent(in) :: first
+    real(wp) :: ground(n_ground_fields)
+    ground = merge(rec%value(first:first + n_ground_fields - 1), 0.0_wp, rec%given(first:first + n_ground_fields - 1))
+  end function ground_of
+
   !> A spring has k or c (not negative); k and d_rest go together.
   subroutine spring_values(rec, where, error)
     type(record_input), intent(in) :: rec
@@ -586,12 +659,15 @@ contains
     end do
   end subroutine check_names
 
-  !> 'x<b> - x<a>' (or 'x<b>' against the ground), for messages (blank padded: callers trim).
-  pure function difference_name(a, b) result(text)
+  !> 'x<b> - x<a>' (or 'x<b>' against the ground, 'x<b> - w(0)' against a moving one:
+  !> shifted), for messages (blank padded: callers trim).
+  pure function difference_name(a, b, shifted) result(text)
     integer, intent(in) :: a, b
-    character(len=2 * fmt_width + 8) :: text
+    logical, intent(in) :: shifted
+    character(len=2 * fmt_width + 16) :: text
     text = 'x' // trim(fmt(b))
     if (a > 0) text = trim(text) // ' - x' // trim(fmt(a))
+    if (shifted) text = trim(text) // ' - w(0)'
   end function difference_name
 
   !> The initial positions satisfy every contact's limits (within the rounding of the
@@ -603,6 +679,7 @@ contains
     type(error_type), allocatable, intent(inout) :: error
     real(wp) :: x(0:n_bodies_of(input)), d, limit, scale, gap, width
     integer :: k, side
+    logical :: shifted
     ! (a message is made only for a contact that fails: a scene's set-up builds no strings)
     x(0) = 0.0_wp
     do k = 1, size(x) - 1
@@ -611,6 +688,14 @@ contains
     do k = 1, records%n_contacts
       associate (a => records%contact_body(1, k), b => records%contact_body(2, k))
         d = x(b) - x(a)
+        shifted = .false.
+        ! A moving ground end starts at w(0) = ground_amp sin(ground_phase).
+        if (a == 0 .and. records%contact_moves(k)) then
+          if (records%contact_ground(3, k) > 0.0_wp) then
+            d = x(b) - records%contact_ground(2, k) * sin(records%contact_ground(4, k))
+            shifted = .true.
+          end if
+        end if
         do side = 1, 2
           if (.not. records%contact_has(side, k)) cycle
           limit = records%contact_limit(side, k)
@@ -618,14 +703,14 @@ contains
           gap = merge(d - limit, limit - d, side == 1)
           if (gap < -16.0_wp * eps_wp * scale) then
             call raise(error, status_input, 'the initial state violates the contact ''' // &
-              trim(records%contact_name(k)) // ''': ' // trim(difference_name(a, b)) // ' = ' // trim(fmt(d)) // &
+              trim(records%contact_name(k)) // ''': ' // trim(difference_name(a, b, shifted)) // ' = ' // trim(fmt(d)) // &
               ' is ' // trim(merge('below', 'above', side == 1)) // ' its ' // &
               trim(merge('lower', 'upper', side == 1)) // ' limit ' // trim(fmt(limit)))
             return
           end if
           ! (within the rounding of its numbers a gap is contact, as in validate_bodies)
           if (gap > 16.0_wp * eps_wp * scale .and. unresolved(gap, scale)) call resolvable('the initial gap ' // &
-            'of the contact ''' // trim(records%contact_name(k)) // ''' (' // trim(difference_name(a, b)) // ')', &
+            'of the contact ''' // trim(records%contact_name(k)) // ''' (' // trim(difference_name(a, b, shifted)) // ')', &
             gap, scale, error)
           if (a > 0 .and. unresolved(limit, scale)) call resolvable('the contact ''' // &
             trim(records%contact_name(k)) // '''s ' // trim(merge('d_min', 'd_max', side == 1)), limit, scale, error)
@@ -657,6 +742,12 @@ contains
     allocate(records%contact_body(2, nc), records%contact_has(2, nc), records%contact_limit(2, nc), &
       records%contact_restitution(2, nc), records%contact_name(nc), records%contact_k(nc), records%contact_c(nc))
     allocate(records%element_body(2, ne), records%element_k(ne), records%element_c(ne), records%element_rest(ne))
+    allocate(records%contact_ground(n_ground_fields, nc), records%element_ground(n_ground_fields, ne), &
+      records%contact_moves(nc), records%element_moves(ne))
+    records%contact_ground = 0.0_wp
+    records%element_ground = 0.0_wp
+    records%contact_moves = .false.
+    records%element_moves = .false.
     records%contact_has = .false.
     records%contact_limit = 0.0_wp
     records%contact_restitution = 1.0_wp
@@ -694,10 +785,25 @@ contains
     type(scene_input), intent(in) :: input
     integer, intent(in) :: n
     type(mechanism_records), intent(inout) :: records
-    if (input%given(i_x_left)) call add_contact(records, 'left', 0, 1, 1, input%value(i_x_left), &
-      value_or(input, i_r_left, 1.0_wp))
-    if (input%given(i_x_right)) call add_contact(records, 'right', 0, n, 2, input%value(i_x_right), &
-      value_or(input, i_r_right, 1.0_wp))
+    if (input%given(i_x_left)) then
+      call add_contact(records, 'left', 0, 1, 1, input%value(i_x_left), value_or(input, i_r_left, 1.0_wp))
+      call wall_motion(i_x_left_v)
+    end if
+    if (input%given(i_x_right)) then
+      call add_contact(records, 'right', 0, n, 2, input%value(i_x_right), value_or(input, i_r_right, 1.0_wp))
+      call wall_motion(i_x_right_v)
+    end if
+
+  contains
+
+    !> The wall just added moves as its fields from first (x_left_v ...) say, when any is given.
+    subroutine wall_motion(first)
+      integer, intent(in) :: first
+      associate (k => records%n_contacts, given => input%given(first:first + n_ground_fields - 1))
+        records%contact_moves(k) = any(given)
+        records%contact_ground(:, k) = merge(input%value(first:first + n_ground_fields - 1), 0.0_wp, given)
+      end associate
+    end subroutine wall_motion
   end subroutine wall_records
 
   !> Link i between bodies i and i+1, as its &link elements and the meeting make it.
@@ -763,6 +869,8 @@ contains
         records%contact_restitution(:, k) = merge(rec%value([r_r_min, r_r_max]), 1.0_wp, rec%given([r_r_min, r_r_max]))
         if (rec%given(r_stop_k)) records%contact_k(k) = rec%value(r_stop_k)
         if (rec%given(r_stop_c)) records%contact_c(k) = rec%value(r_stop_c)
+        records%contact_ground(:, k) = ground_of(rec, r_ground_v)
+        records%contact_moves(k) = any(rec%given(r_ground_v:r_ground_v + n_ground_fields - 1))
         if (ends(2) == 0) then
           records%contact_body(:, k) = [0, ends(1)]
           records%contact_has(:, k) = records%contact_has([2, 1], k)
@@ -814,6 +922,9 @@ contains
         else
           call add_element(records, ends(1), ends(2), rec%value(r_k), rec%value(r_d_rest), rec%value(r_c))
         end if
+        records%element_ground(:, records%n_elements) = ground_of(rec, r_spring_ground_v)
+        records%element_moves(records%n_elements) = any(rec%given(r_spring_ground_v:r_spring_ground_v + &
+          n_ground_fields - 1))
       end associate
     end do
   end subroutine element_records
@@ -843,6 +954,10 @@ contains
       records%contact_name = records%contact_name(:nc)
       records%contact_k = records%contact_k(:nc)
       records%contact_c = records%contact_c(:nc)
+      records%contact_ground = records%contact_ground(:, :nc)
+      records%element_ground = records%element_ground(:, :ne)
+      records%contact_moves = records%contact_moves(:nc)
+      records%element_moves = records%element_moves(:ne)
       records%element_body = records%element_body(:, :ne)
       records%element_k = records%element_k(:ne)
       records%element_c = records%element_c(:ne)
@@ -854,7 +969,7 @@ contains
   !> the arrays, r_meet, the &contact and &spring record fields as 'contact.a').
   pure function field_name(id) result(name)
     integer, intent(in) :: id
-    character(len=16) :: name     ! blank padded: callers trim
+    character(len=24) :: name     ! blank padded: callers trim
     name = ''
     if (id >= 1 .and. id <= n_real) then
       name = real_names(id)

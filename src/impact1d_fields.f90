@@ -12,7 +12,7 @@ module impact1d_fields
   public :: a_d_min, a_r_min, a_d_max, a_r_max, a_k_link, a_d_rest, a_c_link, a_f_table
   public :: n_contact_fields, contact_fields, n_spring_fields, spring_fields, n_sine_fields, sine_fields
   public :: r_a, r_b, r_d_min, r_r_min, r_d_max, r_r_max, r_name, r_k, r_d_rest, r_c, r_stop_k, r_stop_c
-  public :: r_body, r_amp, r_period, r_phase
+  public :: r_body, r_amp, r_period, r_phase, r_ground_v, r_spring_ground_v, n_ground_fields
   public :: name_len, text_item, written_array, record_input, chain_input, alias_name, mechanism_records, array_value
 
   !> Longest contact name a record may carry (names of events: '<name>', 'rest_<name>', ...).
@@ -40,15 +40,20 @@ module impact1d_fields
 
   !> The fields of a &contact record (on x_b - x_a; a, b body numbers, 0 the ground; k and
   !> c make it a compliant stop: past a limit it pushes back with max(0, k p + c p')) and of
-  !> a &spring record (tension k ((x_b - x_a) - d_rest) + c (v_b - v_a)).
-  integer, parameter :: n_contact_fields = 9, n_spring_fields = 5
+  !> a &spring record (tension k ((x_b - x_a) - d_rest) + c (v_b - v_a)). Either may move
+  !> its ground end (a or b = 0): n_ground_fields from r_ground_v (contact) or
+  !> r_spring_ground_v (spring): ground_v, ground_amp, ground_period, ground_phase, the
+  !> prescribed motion w(t) = ground_v t + ground_amp sin(2 pi t / ground_period + ground_phase).
+  integer, parameter :: n_ground_fields = 4
+  integer, parameter :: n_contact_fields = 9 + n_ground_fields, n_spring_fields = 5 + n_ground_fields
   integer, parameter :: r_a = 1, r_b = 2, r_d_min = 3, r_r_min = 4, r_d_max = 5, r_r_max = 6, r_name = 7, &
-    r_stop_k = 8, r_stop_c = 9
-  integer, parameter :: r_k = 3, r_d_rest = 4, r_c = 5
-  character(len=*), parameter :: contact_fields(n_contact_fields) = [character(len=5) :: &
-    'a', 'b', 'd_min', 'r_min', 'd_max', 'r_max', 'name', 'k', 'c']
-  character(len=*), parameter :: spring_fields(n_spring_fields) = [character(len=6) :: &
-    'a', 'b', 'k', 'd_rest', 'c']
+    r_stop_k = 8, r_stop_c = 9, r_ground_v = 10
+  integer, parameter :: r_k = 3, r_d_rest = 4, r_c = 5, r_spring_ground_v = 6
+  character(len=*), parameter :: contact_fields(n_contact_fields) = [character(len=13) :: &
+    'a', 'b', 'd_min', 'r_min', 'd_max', 'r_max', 'name', 'k', 'c', 'ground_v', 'ground_amp', 'ground_period', &
+    'ground_phase']
+  character(len=*), parameter :: spring_fields(n_spring_fields) = [character(len=13) :: &
+    'a', 'b', 'k', 'd_rest', 'c', 'ground_v', 'ground_amp', 'ground_period', 'ground_phase']
   !> The fields of a &sine record: amp sin(2 pi t / period + phase) on body `body`'s force
   !> (phase optional, 0 by default).
   integer, parameter :: n_sine_fields = 4
@@ -106,6 +111,11 @@ module impact1d_fields
     integer :: n_elements = 0
     integer, allocatable :: element_body(:, :)           !< (2, ne) ends; elongation (x_b - x_a) - rest
     real(wp), allocatable :: element_k(:), element_c(:), element_rest(:)   !< (ne)
+    !> (n_ground_fields, nc), (n_ground_fields, ne): the ground end's prescribed motion
+    !> (v, amp, period, phase; period 0: no sine) when the record names any (contact_moves,
+    !> element_moves: (nc), (ne)), even all 0: a ground that moves at 0 m/s
+    real(wp), allocatable :: contact_ground(:, :), element_ground(:, :)
+    logical, allocatable :: contact_moves(:), element_moves(:)
     integer :: n_sines = 0                               !< the &sine records, in file order
     integer, allocatable :: sine_body(:)                 !< (ns) the body whose force it adds to
     real(wp), allocatable :: sine_amp(:), sine_period(:), sine_phase(:)   !< (ns) N, s, rad

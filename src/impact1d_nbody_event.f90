@@ -19,9 +19,10 @@ module impact1d_nbody_event
   use impact1d_cluster_impact, only: impact_work_type, impact_reserve, cluster_projection
   use impact1d_path_impact, only: path_impact_reserve, path_projection
   use impact1d_lcp, only: lcp_solved, lcp_too_large
-  use impact1d_body_mode, only: body_mode_type, mode_work_type, solve_body_mode, mode_solved, max_dense_unknowns
+  use impact1d_body_mode, only: body_mode_type, mode_work_type, solve_body_mode, mode_solved, max_dense_unknowns, &
+    drive_accelerations, shift_to_drives, drive_components
   use impact1d_nbody_step, only: nbody_force, nbody_rate, row_gap, row_velocity, row_gap_tolerance, &
-    found_row, found_body
+    found_row, found_body, mode_acceleration, ground_motion
   implicit none
   private
   public :: point_work_type, new_point_work, nbody_event_point
@@ -74,7 +75,7 @@ contains
     if (initial) then
       acc = f / scene%body_mass
     else
-      call mode%acceleration(f, acc)
+      call mode_acceleration(scene, mode, s%t, f, acc)
     end if
     entry_scale = abs(s%v) + abs(acc) * scene%dt
     if (same_instant(scene, s%t, work%scale_time)) entry_scale = max(entry_scale, work%scale)
@@ -98,10 +99,11 @@ contains
     end if
     do k = 1, scene%n_rows
       candidate(k) = closed(k)
-      if (candidate(k)) candidate(k) = abs(row_velocity(scene, k, s%v)) <= u_tolerance(scene, k, s%v, acc, entry_scale)
+      if (candidate(k)) candidate(k) = abs(row_velocity(scene, k, s%v, s%t)) <= &
+        u_tolerance(scene, k, s%v, acc, entry_scale)
     end do
     new = mode
-    call solve_body_mode(scene, work%mode, f, df, s%v, candidate, new, status)
+    call solve_mode_at(scene, work%mode, s%t, f, df, s%v, candidate, new, status)
     if (status == lcp_too_large) then
       call raise(error, status_simulation, 'at t = ' // trim(fmt(s%t)) // ': the bodies joined by closed ' // &
         'contacts form a cluster too large for the dense mode solve (more than ' // &
@@ -116,6 +118,26 @@ contains
     call log_mode_change(scene, initial, f, df, candidate, new, s, event_log, sink, stats)
     mode = new
   end subroutine nbody_event_point
+
+  !> solve_body_mode at time t: with moving grounds, on the forces as seen from the ground
+  !> the candidate rows hold each body to (impact1d_body_mode's shift_to_drives).
+  subroutine solve_mode_at(scene, work, t, f, df, v, candidate, mode, status)
+    type(scene_type), intent(in) :: scene
+    type(mode_work_type), intent(inout) :: work
+    real(wp), intent(in) :: t, f(:), df(:), v(:)
+    logical, intent(in) :: candidate(:)
+    type(body_mode_type), intent(inout) :: mode
+    integer, intent(out) :: status
+    real(wp), dimension(scene%n_bodies) :: f_seen, df_seen
+    if (scene%drives%n == 0) then
+      call solve_body_mode(scene, work, f, df, v, candidate, mode, status)
+      return
+    end if
+    f_seen = f
+    df_seen = df
+    call shift_to_drives(scene, t, candidate, f_seen, df_seen)
+    call solve_body_mode(scene, work, f_seen, df_seen, v, candidate, mode, status)
+  end subroutine solve_mode_at
 
   !> The closed rows (the located one, gaps within rounding; at the start, within the
   !> rounding of the user's decimals), a rigid link's two rows together, each snapped onto
@@ -164,6 +186,9 @@ contains
       associate (b => scene%row_body(2, k))
         s%x(b) = -scene%row_offset(k) / scene%row_normal(2, k)
         s%x_lo(b) = 0.0_wp
+        ! (a moving ground's w(t) added exactly: the gap is 0 to its own rounding)
+        if (scene%drives%n > 0) call add_compensated(s%x(b), s%x_lo(b), &
+          -ground_motion(scene, k, s%t, 0) / scene%row_normal(2, k))
         placed(b) = .true.
       end associate
     end do
@@ -247,7 +272,7 @@ contains
     do k = 1, scene%n_rows
       if (scene%row_partner(k) == 0) cycle
       if (.not. (closed(k) .and. closed(scene%row_partner(k)))) cycle
-      if (row_velocity(scene, k, v_before) < -u_tolerance(scene, k, v_before, spread(0.0_wp, 1, scene%n_bodies), &
+      if (row_velocity(scene, k, v_before, s%t) < -u_tolerance(scene, k, v_before, spread(0.0_wp, 1, scene%n_bodies), &
           spread(0.0_wp, 1, scene%n_bodies))) call log_event(scene, sink, stats, s%t, class_impact, k, v_before, s%v)
     end do
   end subroutine lock_rigid
@@ -300,7 +325,7 @@ contains
     n_impulses = 0
     do
       call closed_tolerances(tol)
-      k = most_approaching(scene, closed, s%v, tol)
+      k = most_approaching(scene, closed, s%t, s%v, tol)
       if (k == 0) exit
       n_impulses = n_impulses + 1
       if (n_impulses > scene%max_impulses) then
@@ -316,18 +341,22 @@ contains
       v_before = s%v
       if (joint) then
         call closed_tolerances(tol)
-        call joint_projection(scene, work%impact, group, s%v, tol, v_after, pushed, error)
+        call joint_projection(scene, work%impact, group, s%t, s%v, tol, v_after, pushed, error)
         if (allocated(error)) return
       else
-        call impulse(scene, work, k, restitution(k), s%v, v_after)
+        call impulse(scene, work, k, restitution(k), s%t, s%v, v_after)
         pushed = .false.
         pushed(k) = .true.
       end if
-      if (joint .or. restitution(k) == 0.0_wp) call join_cycle(scene%row_body, pushed .or. internal, &
-        scene%body_mass, v_after)
-      call check_dissipative(scene, s%t, v_before, v_after, error)
-      if (allocated(error)) return
-      call apply(scene, s, v_after)
+      if (joint .or. restitution(k) == 0.0_wp) call join_moving(scene, pushed .or. internal, s%t, v_after)
+      if (scene%drives%n > 0) then
+        call apply_driven(scene, group, s, v_after, error)
+        if (allocated(error)) return
+      else
+        call check_dissipative(scene, s%t, v_before, v_after, 0.0_wp, error)
+        if (allocated(error)) return
+        call apply(scene, s, v_after)
+      end if
       call share_scale(scene, pushed, entry_scale)
       hit = hit .or. pushed
       do k = 1, scene%n_rows
@@ -349,6 +378,56 @@ contains
       end do
     end subroutine closed_tolerances
   end subroutine impacts
+
+  !> New velocities from an impact among the closed rows marked (rows) in a scene with moving
+  !> grounds: the prescribed motion's work, the momentum each moving ground gave times its
+  !> velocity, goes to drive_work, the rest of the change of kinetic energy to impact loss
+  !> (which the impact, taken in the ground's frame, cannot make negative).
+  subroutine apply_driven(scene, rows, s, v_after, error)
+    type(scene_type), intent(in) :: scene
+    logical, intent(in) :: rows(:)
+    type(state_type), intent(inout) :: s
+    real(wp), intent(in) :: v_after(:)
+    type(error_type), allocatable, intent(inout) :: error
+    real(wp) :: drive
+    drive = dot_product(scene%body_mass, (v_after - s%v) * frame_velocity(scene, rows, s%t))
+    call check_dissipative(scene, s%t, s%v, v_after, drive, error)
+    if (allocated(error)) return
+    call apply(scene, s, v_after, drive)
+  end subroutine apply_driven
+
+  !> impact1d_accumulation's join_cycle (the bodies the rows marked join move as one, at rest
+  !> when joined to the ground) at t: with moving grounds, moving with the ground they are
+  !> joined to.
+  subroutine join_moving(scene, rows, t, v)
+    type(scene_type), intent(in) :: scene
+    logical, intent(in) :: rows(:)
+    real(wp), intent(in) :: t
+    real(wp), intent(inout) :: v(:)
+    real(wp) :: frame(scene%n_bodies)
+    if (scene%drives%n == 0) then
+      call join_cycle(scene%row_body, rows, scene%body_mass, v)
+      return
+    end if
+    frame = frame_velocity(scene, rows, t)
+    v = v - frame
+    call join_cycle(scene%row_body, rows, scene%body_mass, v)
+    v = v + frame
+  end subroutine join_moving
+
+  !> Each body's moving ground's velocity at t through the rows marked (0: none).
+  pure function frame_velocity(scene, rows, t) result(frame)
+    type(scene_type), intent(in) :: scene
+    logical, intent(in) :: rows(:)
+    real(wp), intent(in) :: t
+    real(wp) :: frame(scene%n_bodies)
+    integer :: drive(scene%n_bodies), i
+    call drive_components(scene, rows, drive)
+    frame = 0.0_wp
+    do i = 1, scene%n_bodies
+      if (drive(i) > 0) frame(i) = scene%drives%velocity(drive(i), t)
+    end do
+  end function frame_velocity
 
   !> The closed rows joined to row `start` through shared bodies (the ground joins nothing).
   !> Sweeps over the rows until none joins, every other one in reverse: a chain numbered
@@ -397,9 +476,10 @@ contains
     type(run_stats), intent(inout) :: stats
     real(wp) :: u(scene%n_rows), remaining, v(scene%n_bodies)
     logical :: rows(scene%n_rows), found
+    type(error_type), allocatable :: ignored
     integer :: k
     do k = 1, scene%n_rows
-      u(k) = row_velocity(scene, k, s%v)
+      u(k) = row_velocity(scene, k, s%v, s%t)
     end do
     call event_log%cycles%record(s%t, hit, u)
     call event_log%cycles%find_cycle(scene%row_body, scene%dt, time_rounding * max(abs(s%t), scene%dt), rows, remaining, found)
@@ -408,8 +488,12 @@ contains
     closed = closed .or. rows
     call snap_closed(scene, closed, s)
     v = s%v
-    call join_cycle(scene%row_body, rows, scene%body_mass, v)
-    call apply(scene, s, v)
+    call join_moving(scene, rows, s%t, v)
+    if (scene%drives%n > 0) then
+      call apply_driven(scene, rows, s, v, ignored)
+    else
+      call apply(scene, s, v)
+    end if
     do k = 1, scene%n_rows
       if (rows(k)) call event_log%begin_rest(scene, k, s%t, s%t + remaining, s%v, sink, stats)
     end do
@@ -417,17 +501,17 @@ contains
 
   !> The closed row approaching fastest beyond its tolerance (0 if none; the first in row
   !> order among equals); rows inside a rigid group never approach.
-  integer function most_approaching(scene, closed, v, tol) result(k_best)
+  integer function most_approaching(scene, closed, t, v, tol) result(k_best)
     type(scene_type), intent(in) :: scene
     logical, intent(in) :: closed(:)
-    real(wp), intent(in) :: v(:), tol(:)
+    real(wp), intent(in) :: t, v(:), tol(:)
     integer :: k
     real(wp) :: u, u_best
     k_best = 0
     u_best = 0.0_wp
     do k = 1, scene%n_rows
       if (.not. closed(k)) cycle
-      u = row_velocity(scene, k, v)
+      u = row_velocity(scene, k, v, t)
       if (u < min(u_best, -tol(k))) then
         k_best = k
         u_best = u
@@ -437,12 +521,12 @@ contains
 
   !> Velocities after an impulse on row k that leaves its normal velocity at -r times its
   !> value before, through the rigid groups of its ends (a group joined to the ground does
-  !> not move); a row inside one group takes none.
-  subroutine impulse(scene, work, k, r, v, v_after)
+  !> not move, or moves with its moving ground); a row inside one group takes none.
+  subroutine impulse(scene, work, k, r, t, v, v_after)
     type(scene_type), intent(in) :: scene
     type(point_work_type), intent(inout) :: work
     integer, intent(in) :: k
-    real(wp), intent(in) :: r, v(:)
+    real(wp), intent(in) :: r, t, v(:)
     real(wp), intent(out) :: v_after(:)
     real(wp) :: inverse(2), p
     integer :: e, i, root(2)
@@ -453,7 +537,7 @@ contains
       if (root(e) > 0) inverse(e) = 1.0_wp / work%rigid_mass(root(e))
     end do
     if (root(1) == root(2) .or. sum(inverse) == 0.0_wp) return
-    p = -(1.0_wp + r) * row_velocity(scene, k, v) / sum(inverse)
+    p = -(1.0_wp + r) * row_velocity(scene, k, v, t) / sum(inverse)
     do i = 1, scene%n_bodies
       do e = 1, 2
         if (root(e) > 0 .and. work%rigid(i) == root(e)) v_after(i) = v(i) + scene%row_normal(e, k) * p * inverse(e)
@@ -463,17 +547,18 @@ contains
 
   !> The joint perfectly inelastic impact of the closed rows (impact1d_cluster_impact), on the
   !> bodies they touch gathered into one problem: v_after, and pushed, the rows it pushed.
-  subroutine joint_projection(scene, work, closed, v, tol, v_after, pushed, error)
+  !> With moving grounds it is taken in each body's ground's frame (frame_velocity).
+  subroutine joint_projection(scene, work, closed, t, v, tol, v_after, pushed, error)
     type(scene_type), intent(in) :: scene
     type(impact_work_type), intent(inout) :: work
     logical, intent(in) :: closed(:)
-    real(wp), intent(in) :: v(:), tol(:)
+    real(wp), intent(in) :: t, v(:), tol(:)
     real(wp), intent(out) :: v_after(:)
     logical, intent(out) :: pushed(:)
     type(error_type), allocatable, intent(inout) :: error
     integer :: local(0:scene%n_bodies), body(scene%n_bodies), rows(scene%n_rows), row_local(2, scene%n_rows), nb, &
       nr, k, e, status
-    real(wp) :: v_local(scene%n_bodies), impulse_local(scene%n_rows)
+    real(wp) :: v_local(scene%n_bodies), impulse_local(scene%n_rows), frame(scene%n_bodies)
     logical :: pushed_local(scene%n_rows), fits
     local = 0
     nb = 0
@@ -495,15 +580,19 @@ contains
     v_after = v
     pushed = .false.
     if (nr == 0) return
+    ! (with moving grounds the projection is taken in their frame: frame_velocity)
+    frame = 0.0_wp
+    if (scene%drives%n > 0) frame = frame_velocity(scene, closed, t)
     row_local(:, :nr) = reshape([(local(scene%row_body(:, rows(k))), k = 1, nr)], [2, nr])
     call path_impact_reserve(work%path, nb)
-    call path_projection(work%path, scene%body_mass(body(:nb)), v(body(:nb)), row_local(:, :nr), &
+    call path_projection(work%path, scene%body_mass(body(:nb)), v(body(:nb)) - frame(body(:nb)), row_local(:, :nr), &
       scene%row_normal(:, rows(:nr)), tol(rows(:nr)), v_local(:nb), impulse_local(:nr), pushed_local(:nr), fits)
     if (.not. fits) then
       call dense_projection()
       if (allocated(error)) return
     end if
     v_after(body(:nb)) = v_local(:nb)
+    if (scene%drives%n > 0) v_after(body(:nb)) = v_local(:nb) + frame(body(:nb))
     pushed(rows(:nr)) = pushed_local(:nr)
 
   contains
@@ -516,7 +605,7 @@ contains
         return
       end if
       call impact_reserve(work, nb, nr)
-      call cluster_projection(work, scene%body_mass(body(:nb)), v(body(:nb)), row_local(:, :nr), &
+      call cluster_projection(work, scene%body_mass(body(:nb)), v(body(:nb)) - frame(body(:nb)), row_local(:, :nr), &
         scene%row_normal(:, rows(:nr)), spread(.true., 1, nr), tol(rows(:nr)), v_local(:nb), impulse_local(:nr), &
         pushed_local(:nr), status)
       if (status /= lcp_solved) then
@@ -558,15 +647,15 @@ contains
     type(error_type), allocatable :: ignored
     integer :: k, e
     call zero_stopped(scene, s, acc, entry_scale)
-    call joint_projection(scene, work%impact, closed, s%v, spread(0.0_wp, 1, scene%n_rows), v_after, pushed, &
+    call joint_projection(scene, work%impact, closed, s%t, s%v, spread(0.0_wp, 1, scene%n_rows), v_after, pushed, &
       ignored)
-    if (.not. allocated(ignored) .and. count(pushed) >= 2) call apply(scene, s, v_after)
+    if (.not. allocated(ignored) .and. count(pushed) >= 2) call settle_apply(closed)
     do k = 1, scene%n_rows
       if (.not. closed(k)) cycle
-      if (abs(row_velocity(scene, k, s%v)) <= u_tolerance(scene, k, s%v, acc, entry_scale) .and. &
-          row_velocity(scene, k, s%v) /= 0.0_wp) then
-        call impulse(scene, work, k, 0.0_wp, s%v, v_after)
-        call apply(scene, s, v_after)
+      if (abs(row_velocity(scene, k, s%v, s%t)) <= u_tolerance(scene, k, s%v, acc, entry_scale) .and. &
+          row_velocity(scene, k, s%v, s%t) /= 0.0_wp) then
+        call impulse(scene, work, k, 0.0_wp, s%t, s%v, v_after)
+        call settle_apply(closed)
       end if
     end do
     do k = 1, scene%n_rows
@@ -581,6 +670,19 @@ contains
         if (s%v(scene%row_body(e, k)) == 0.0_wp) call zero_velocity(scene, s, scene%row_body(3 - e, k))
       end do
     end do
+
+  contains
+
+    !> s%v := v_after, a rounding-level change (with moving grounds: their work booked).
+    subroutine settle_apply(rows)
+      logical, intent(in) :: rows(:)
+      type(error_type), allocatable :: unchecked
+      if (scene%drives%n > 0) then
+        call apply_driven(scene, rows, s, v_after, unchecked)
+      else
+        call apply(scene, s, v_after)
+      end if
+    end subroutine settle_apply
   end subroutine settle
 
   !> The bounce series on closed row k, if its ends separate slowly: the gap's acceleration
@@ -599,16 +701,21 @@ contains
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
     real(wp) :: u, a_up, a_down, remaining, v_bounce(scene%n_bodies)
-    u = row_velocity(scene, k, s%v)
+    type(error_type), allocatable :: unchecked
+    u = row_velocity(scene, k, s%v, s%t)
     if (u <= u_tolerance(scene, k, s%v, acc, entry_scale)) return
     a_up = free_gap_acceleration(s%v)
     if (a_up >= 0.0_wp) return
-    call impulse(scene, work, k, 1.0_wp, s%v, v_bounce)
+    call impulse(scene, work, k, 1.0_wp, s%t, s%v, v_bounce)
     a_down = free_gap_acceleration(v_bounce)
     remaining = bounce_series_time(u, a_up, a_down, scene%row_restitution(k))
     if (remaining > time_rounding * max(abs(s%t), scene%dt)) return
-    call impulse(scene, work, k, 0.0_wp, s%v, v_bounce)
-    call apply(scene, s, v_bounce)
+    call impulse(scene, work, k, 0.0_wp, s%t, s%v, v_bounce)
+    if (scene%drives%n > 0) then
+      call apply_driven(scene, closed, s, v_bounce, unchecked)
+    else
+      call apply(scene, s, v_bounce)
+    end if
     if (remaining < huge(1.0_wp)) then
       call event_log%begin_rest(scene, k, s%t, s%t + remaining, s%v, sink, stats)
     else
@@ -627,14 +734,15 @@ contains
       integer :: j, status
       do j = 1, scene%n_rows
         candidate(j) = closed(j) .and. j /= k
-        if (candidate(j)) candidate(j) = abs(row_velocity(scene, j, v)) <= u_tolerance(scene, j, v, acc, entry_scale)
+        if (candidate(j)) candidate(j) = abs(row_velocity(scene, j, v, s%t)) <= &
+          u_tolerance(scene, j, v, acc, entry_scale)
       end do
       free = mode
-      call solve_body_mode(scene, work%mode, f, df, v, candidate, free, status)
+      call solve_mode_at(scene, work%mode, s%t, f, df, v, candidate, free, status)
       a_gap = 0.0_wp
       if (status /= mode_solved) return
-      call free%acceleration(f, a)
-      a_gap = row_velocity(scene, k, a)
+      call mode_acceleration(scene, free, s%t, f, a)
+      a_gap = row_velocity(scene, k, a) + ground_motion(scene, k, s%t, 2)
     end function free_gap_acceleration
   end subroutine settle_bounce_series
 
@@ -675,25 +783,36 @@ contains
 
   !> An impact cannot raise the kinetic energy beyond its rounding: if one does, the engine
   !> is wrong, and the run says so.
-  subroutine check_dissipative(scene, t, v_before, v_after, error)
+  !> (drive: the work moving grounds did in it, which may raise the kinetic energy.)
+  subroutine check_dissipative(scene, t, v_before, v_after, drive, error)
     type(scene_type), intent(in) :: scene
-    real(wp), intent(in) :: t, v_before(:), v_after(:)
+    real(wp), intent(in) :: t, v_before(:), v_after(:), drive
     type(error_type), allocatable, intent(inout) :: error
     real(wp) :: ke_before, ke_after
     ke_before = kinetic(scene, v_before)
     ke_after = kinetic(scene, v_after)
-    if (ke_after <= ke_before * (1.0_wp + energy_rounding)) return
+    if (drive /= 0.0_wp) then
+      if (ke_after - drive <= ke_before + energy_rounding * max(ke_before, ke_after, abs(drive))) return
+    else if (ke_after <= ke_before * (1.0_wp + energy_rounding)) then
+      return
+    end if
     call raise(error, status_simulation, 'at t = ' // trim(fmt(t)) // ': internal error: an impact ' // &
       'raised the kinetic energy from ' // trim(fmt(ke_before)) // ' to ' // trim(fmt(ke_after)) // &
       ' J; please report the scene')
   end subroutine check_dissipative
 
-  !> New velocities at an instant, the kinetic energy they remove booked as impact loss.
-  pure subroutine apply(scene, s, v_new)
+  !> New velocities at an instant, the kinetic energy they remove booked as impact loss (and
+  !> the work drive of moving grounds in it, which they did not take, as drive_work).
+  pure subroutine apply(scene, s, v_new, drive)
     type(scene_type), intent(in) :: scene
     type(state_type), intent(inout) :: s
     real(wp), intent(in) :: v_new(:)
+    real(wp), intent(in), optional :: drive
     s%impact_loss = s%impact_loss + kinetic(scene, s%v) - kinetic(scene, v_new)
+    if (present(drive)) then
+      s%impact_loss = s%impact_loss + drive
+      call add_compensated(s%drive_work, s%drive_lo, drive)
+    end if
     s%v = v_new
     s%v_lo = 0.0_wp
   end subroutine apply
@@ -714,17 +833,18 @@ contains
     logical :: leaving, resting_now
     integer :: k, i
 
-    call new%acceleration(f, acc)
+    call mode_acceleration(scene, new, s%t, f, acc)
     call new%rate_response(df, acc_rate)
+    if (scene%drives%n > 0) call drive_accelerations(scene, new, s%t, 3, acc_rate)
     tol_a = 1.0e3_wp * eps_wp * force_scale(scene, f, df) / scene%body_mass
     rate_tol = 1.0e3_wp * eps_wp * sum(abs(df))
     do k = 1, scene%n_rows
       if (new%active(k) .and. .not. event_log%in_contact(k)) then
         call event_log%begin_rest(scene, k, s%t, s%t, s%v, sink, stats)
       else if (event_log%in_contact(k) .and. .not. new%active(k)) then
-        if (.not. candidate(k) .or. row_velocity(scene, k, acc) > row_abs_tol(k, tol_a) .or. &
-            (row_velocity(scene, k, acc) >= -row_abs_tol(k, tol_a) .and. &
-            row_velocity(scene, k, acc_rate) > rate_tol / minval(scene%body_mass))) then
+        if (.not. candidate(k) .or. row_acceleration(k, acc, 2) > row_abs_tol(k, tol_a) .or. &
+            (row_acceleration(k, acc, 2) >= -row_abs_tol(k, tol_a) .and. &
+            row_acceleration(k, acc_rate, 3) > rate_tol / minval(scene%body_mass))) then
           if (event_log%pending_rest(k) < huge(1.0_wp)) then
             call log_event(scene, sink, stats, s%t, class_rest, k, s%v, s%v)
             event_log%pending_rest(k) = huge(1.0_wp)
@@ -758,6 +878,15 @@ contains
     end do
 
   contains
+
+    !> Row j's gap acceleration (order 2) or its rate (3) at the bodies' a (with its moving
+    !> ground end's).
+    real(wp) function row_acceleration(j, a, order)
+      integer, intent(in) :: j, order
+      real(wp), intent(in) :: a(:)
+      row_acceleration = row_velocity(scene, j, a)
+      if (scene%drives%n > 0) row_acceleration = row_acceleration + ground_motion(scene, j, s%t, order)
+    end function row_acceleration
 
     !> Row j's |n| . tol (its ends' tolerances).
     pure real(wp) function row_abs_tol(j, tol)

@@ -108,9 +108,9 @@ contains
     call new_mode(scene%n_bodies, scene%n_rows, r%mode, r%work%mode)
     call new_point_work(scene%n_bodies, r%work)
     call r%event_log%allocate_log(scene%n_rows, scene%n_bodies)
-    r%polynomial = scene%forcing%is_polynomial() .and. .not. scene%springs%present
+    r%polynomial = scene%forcing%is_polynomial() .and. .not. scene%springs%present .and. scene%drives%polynomial
     r%ke0 = 0.5_wp * dot_product(scene%body_mass, s%v**2)
-    if (scene%springs%present) r%pe0 = element_potential(scene, s%x, s%x_lo)
+    r%pe0 = potential(scene, s)
   end subroutine start
 
   !> Sample j_sample (then the next one is due).
@@ -122,13 +122,28 @@ contains
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
     type(error_type), allocatable, intent(inout) :: error
-    real(wp) :: pe
-    pe = 0.0_wp
-    if (scene%springs%present) pe = element_potential(scene, s%x, s%x_lo)
-    call emit_bodies(sink, stats, s%t, s%x, s%v, scene%body_mass, r%ke0, s%work, s%friction_loss, &
-      s%impact_loss, scene%springs%present, [pe, r%pe0, s%damping_loss], error)
+    if (scene%drives%n > 0) then
+      call emit_bodies(sink, stats, s%t, s%x, s%v, scene%body_mass, r%ke0, s%work, s%friction_loss, &
+        s%impact_loss, scene%springs%present, [potential(scene, s), r%pe0, s%damping_loss], error, s%drive_work)
+    else
+      call emit_bodies(sink, stats, s%t, s%x, s%v, scene%body_mass, r%ke0, s%work, s%friction_loss, &
+        s%impact_loss, scene%springs%present, [potential(scene, s), r%pe0, s%damping_loss], error)
+    end if
     j_sample = j_sample + 1
   end subroutine emit
+
+  !> The springs' potential energy in state s (moving ground ends where they are at s%t).
+  pure real(wp) function potential(scene, s) result(pe)
+    type(scene_type), intent(in) :: scene
+    type(state_type), intent(in) :: s
+    pe = 0.0_wp
+    if (.not. scene%springs%present) return
+    if (scene%drives%n > 0) then
+      pe = element_potential(scene, s%x, s%x_lo, s%t)
+    else
+      pe = element_potential(scene, s%x, s%x_lo)
+    end if
+  end function potential
 
   !> One step from s toward t_stop, ended at the earliest event located in it (found, index)
   !> or at the stop (at_stop). A step whose end breaks a constraint (a root the location
@@ -143,7 +158,7 @@ contains
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
     type(error_type), allocatable, intent(inout) :: error
-    real(wp) :: h, theta
+    real(wp) :: h, theta, h_taken
     integer :: halvings
     h = step_length(scene%dt, (t_stop - s%t) - s%t_lo)
     halvings = 0
@@ -157,9 +172,10 @@ contains
       call nbody_step(scene, r%mode, s, h, trial)
       call locate_nbody(scene, r%mode, r%work%mode, r%polynomial, s, trial, h, theta, found, index)
       if (found /= found_none .and. theta <= h) then
+        h_taken = h
         h = theta
         if (h > 0.0_wp) then
-          call refine_nbody(scene, r%mode, s, h, found, index, trial)
+          call refine_nbody(scene, r%mode, s, h, found, index, trial, h_taken)
         else
           trial = s
           exit
@@ -204,7 +220,7 @@ contains
       if (row_gap(scene, k, s) > row_gap_tolerance(scene, k, s, 0.0_wp)) cycle
       speed = abs(s%v(scene%row_body(2, k)))
       if (scene%row_body(1, k) > 0) speed = speed + abs(s%v(scene%row_body(1, k)))
-      if (row_velocity(scene, k, s%v) < -velocity_rounding * speed) impact_due = .true.
+      if (row_velocity(scene, k, s%v, s%t) < -velocity_rounding * speed) impact_due = .true.
     end do
   end function impact_due
 end module impact1d_nbody_solver

@@ -9,12 +9,14 @@ module impact1d_nbody_step
   use impact1d_state, only: state_type, add_compensated
   use impact1d_events, only: hermite, earliest_crossing
   use impact1d_yardsticks, only: gap_rounding, velocity_rounding, time_rounding
-  use impact1d_elements, only: add_element_forces, add_element_rates, element_damping_power
-  use impact1d_body_mode, only: body_mode_type, mode_work_type, solve_body_mode, same_mode, mode_solved
+  use impact1d_elements, only: add_element_forces, add_moving_element_forces, add_element_rates, element_damping_power, &
+    element_drive_power
+  use impact1d_body_mode, only: body_mode_type, mode_work_type, solve_body_mode, same_mode, mode_solved, &
+    drive_accelerations, shift_to_drives
   implicit none
   private
   public :: nbody_force, nbody_rate, nbody_step, row_gap, row_velocity, row_gap_tolerance, locate_nbody, &
-    refine_nbody, gaps_hold
+    refine_nbody, gaps_hold, mode_acceleration, ground_motion
   public :: found_none, found_row, found_body, found_hold
 
   !> What a location found: a row's gap closing, a sliding body stopping, the mode failing.
@@ -28,8 +30,50 @@ contains
     real(wp), intent(in) :: t, x(:), dx(:), v(:)
     real(wp), intent(out) :: f(:)
     call scene%forcing%force_all(t, f)
-    if (scene%springs%present) call add_element_forces(scene, x, dx, v, f)
+    if (.not. scene%springs%present) return
+    if (scene%drives%n > 0) then
+      call add_moving_element_forces(scene, x, dx, v, f, t)
+    else
+      call add_element_forces(scene, x, dx, v, f)
+    end if
   end subroutine nbody_force
+
+  !> Accelerations a in the mode under applied forces f at time t: a body held to a moving
+  !> ground moves with it (impact1d_body_mode's drive_accelerations).
+  pure subroutine mode_acceleration(scene, mode, t, f, a)
+    type(scene_type), intent(in) :: scene
+    type(body_mode_type), intent(in) :: mode
+    real(wp), intent(in) :: t, f(:)
+    real(wp), intent(out) :: a(:)
+    call mode%acceleration(f, a)
+    if (scene%drives%n > 0) call drive_accelerations(scene, mode, t, 2, a)
+  end subroutine mode_acceleration
+
+  !> The part of row k's gap (order 0), its rate (1), acceleration (2) or jerk (3) at t
+  !> that its moving ground end makes (0 for a row without one): the ground end's
+  !> coefficient is -n_b, so the gap is n_b (x_b - w(t)) + offset.
+  pure real(wp) function ground_motion(scene, k, t, order) result(g)
+    type(scene_type), intent(in) :: scene
+    integer, intent(in) :: k, order
+    real(wp), intent(in) :: t
+    integer :: d
+    g = 0.0_wp
+    if (scene%drives%n == 0) return
+    d = scene%row_drive(k)
+    if (d == 0) return
+    select case (order)
+    case (0)
+      g = scene%drives%position(d, t)
+    case (1)
+      g = scene%drives%velocity(d, t)
+    case (2)
+      g = scene%drives%acceleration(d, t)
+    case default
+      g = scene%drives%jerk(d, t)
+    end select
+    g = -scene%row_normal(2, k) * g
+  end function ground_motion
+
 
   !> Right derivative df of the applied forces at time t, velocities v.
   pure subroutine nbody_rate(scene, t, v, df)
@@ -37,7 +81,12 @@ contains
     real(wp), intent(in) :: t, v(:)
     real(wp), intent(out) :: df(:)
     call scene%forcing%rate(t, df)
-    if (scene%springs%present) call add_element_rates(scene, v, df)
+    if (.not. scene%springs%present) return
+    if (scene%drives%n > 0) then
+      call add_element_rates(scene, v, df, t)
+    else
+      call add_element_rates(scene, v, df)
+    end if
   end subroutine nbody_rate
 
   !> One classical RK4 step of the mode's equations from a to b (the four stages in full: the
@@ -52,43 +101,60 @@ contains
     type(state_type), intent(inout) :: b
     real(wp), dimension(scene%n_bodies) :: v0, v1, vm, f, dx, kx1, kx2, kx3, kx4, kv1, kv2, kv3, kv4, &
       f0, fm, f1, acc_end
-    real(wp) :: half
+    real(wp) :: half, power(4)
     half = 0.5_wp * step
     v0 = a%v + a%v_lo
     call scene%forcing%force_all(a%t, f0)
     call scene%forcing%force_all(a%t + half, fm)
     call scene%forcing%force_all(a%t + step, f1)
     kx1 = v0
-    call stage(f0, a%x_lo, kx1, kv1)
+    call stage(f0, a%x_lo, kx1, kv1, 0.0_wp, 1)
     kx2 = v0 + half * kv1
-    call stage(fm, a%x_lo + half * kx1, kx2, kv2)
+    call stage(fm, a%x_lo + half * kx1, kx2, kv2, half, 2)
     kx3 = v0 + half * kv2
-    call stage(fm, a%x_lo + half * kx2, kx3, kv3)
+    call stage(fm, a%x_lo + half * kx2, kx3, kv3, half, 3)
     kx4 = v0 + step * kv3
-    call stage(f1, a%x_lo + step * kx3, kx4, kv4)
+    call stage(f1, a%x_lo + step * kx3, kx4, kv4, step, 4)
     b = a
     call add_compensated(b%t, b%t_lo, step)
     call add_compensated(b%x, b%x_lo, (step / 6.0_wp) * (kx1 + 2.0_wp * (kx2 + kx3) + kx4))
     call add_compensated(b%v, b%v_lo, (step / 6.0_wp) * (kv1 + 2.0_wp * (kv2 + kv3) + kv4))
+    if (scene%drives%n > 0) call hold_to_drives(scene, mode, a, step, b)
     v1 = b%v + b%v_lo
     f = f1
-    if (scene%springs%present) call add_element_forces(scene, b%x, b%x_lo, v1, f)
-    call mode%acceleration(f, acc_end)
+    if (scene%drives%n > 0) then
+      call drive_step_ledger()
+    else
+      if (scene%springs%present) call add_element_forces(scene, b%x, b%x_lo, v1, f)
+      call mode%acceleration(f, acc_end)
+    end if
     vm = 0.5_wp * (v0 + v1) + 0.125_wp * step * (kv1 - acc_end)
     call add_compensated(b%work, b%work_lo, step / 6.0_wp * (dot_product(f0, v0) + &
       4.0_wp * dot_product(fm, vm) + dot_product(f1, v1)))
     if (any(mode%f_slide /= 0.0_wp)) call add_compensated(b%friction_loss, b%friction_lo, step / 6.0_wp * &
       dot_product(-mode%f_slide, v0 + 4.0_wp * vm + v1))
-    if (scene%springs%present) call add_compensated(b%damping_loss, b%damping_lo, step / 6.0_wp * &
-      (element_damping_power(scene, v0) + 4.0_wp * element_damping_power(scene, vm) + &
-      element_damping_power(scene, v1)))
+    if (scene%drives%n > 0) then
+      if (scene%springs%present) call add_compensated(b%damping_loss, b%damping_lo, step / 6.0_wp * &
+        (element_damping_power(scene, v0, a%t) + 4.0_wp * element_damping_power(scene, vm, a%t + half) + &
+        element_damping_power(scene, v1, a%t + step)))
+    else if (scene%springs%present) then
+      call add_compensated(b%damping_loss, b%damping_lo, step / 6.0_wp * &
+        (element_damping_power(scene, v0) + 4.0_wp * element_damping_power(scene, vm) + &
+        element_damping_power(scene, v1)))
+    end if
 
   contains
 
-    !> A stage's accelerations acc at external forces fx, positions a%x + dx', velocities v.
-    subroutine stage(fx, dx_stage, v, acc)
-      real(wp), intent(in) :: fx(:), dx_stage(:), v(:)
+    !> Stage k's accelerations acc at external forces fx, positions a%x + dx', velocities v,
+    !> time a%t + tau (moving grounds apart: moving_stage).
+    subroutine stage(fx, dx_stage, v, acc, tau, k)
+      real(wp), intent(in) :: fx(:), dx_stage(:), v(:), tau
       real(wp), intent(out) :: acc(:)
+      integer, intent(in) :: k
+      if (scene%drives%n > 0) then
+        call moving_stage(fx, dx_stage, v, acc, a%t + tau, power(k))
+        return
+      end if
       f = fx
       if (scene%springs%present) then
         dx = dx_stage
@@ -96,7 +162,69 @@ contains
       end if
       call mode%acceleration(f, acc)
     end subroutine stage
+
+    !> stage with moving grounds at time t: and the power they put in.
+    subroutine moving_stage(fx, dx_stage, v, acc, t, drive_power)
+      real(wp), intent(in) :: fx(:), dx_stage(:), v(:), t
+      real(wp), intent(out) :: acc(:), drive_power
+      f = fx
+      drive_power = 0.0_wp
+      if (scene%springs%present) then
+        dx = dx_stage
+        call add_moving_element_forces(scene, a%x, dx, v, f, t)
+        drive_power = element_drive_power(scene, a%x, dx, v, t)
+      end if
+      call mode_acceleration(scene, mode, t, f, acc)
+      drive_power = drive_power + held_drive_power(scene, mode, t, f, acc)
+    end subroutine moving_stage
+
+    !> The step's end with moving grounds: the accelerations there, and the work the
+    !> prescribed motion did, by RK4's own quadrature of the stages' power.
+    subroutine drive_step_ledger()
+      if (scene%springs%present) call add_moving_element_forces(scene, b%x, b%x_lo, v1, f, b%t)
+      call mode_acceleration(scene, mode, b%t, f, acc_end)
+      call add_compensated(b%drive_work, b%drive_lo, step / 6.0_wp * (power(1) + 2.0_wp * (power(2) + &
+        power(3)) + power(4)))
+    end subroutine drive_step_ledger
   end subroutine nbody_step
+
+  !> Bodies held to a moving ground move with it exactly over the step from a to b (by w(t +
+  !> step) - w(t), at w'(t + step)): RK4's quadrature of w'' would leave their held rows'
+  !> normal velocity off zero by its error, which the event points would take for impacts.
+  pure subroutine hold_to_drives(scene, mode, a, step, b)
+    type(scene_type), intent(in) :: scene
+    type(body_mode_type), intent(in) :: mode
+    type(state_type), intent(in) :: a
+    real(wp), intent(in) :: step
+    type(state_type), intent(inout) :: b
+    integer :: i
+    do i = 1, scene%n_bodies
+      if (mode%drive(i) == 0) cycle
+      associate (d => mode%drive(i))
+        b%x(i) = a%x(i)
+        b%x_lo(i) = a%x_lo(i)
+        call add_compensated(b%x(i), b%x_lo(i), scene%drives%displacement(d, a%t, step))
+        b%v(i) = scene%drives%velocity(d, a%t + step)
+        b%v_lo(i) = 0.0_wp
+      end associate
+    end do
+  end subroutine hold_to_drives
+
+  !> Power a moving ground puts in through the rows that hold bodies to it: on each such body
+  !> the rows' force m a - f - f_slide, at the ground's velocity (rows between the bodies it
+  !> holds pass forces that cancel).
+  pure real(wp) function held_drive_power(scene, mode, t, f, acc) result(power)
+    type(scene_type), intent(in) :: scene
+    type(body_mode_type), intent(in) :: mode
+    real(wp), intent(in) :: t, f(:), acc(:)
+    integer :: i
+    power = 0.0_wp
+    do i = 1, scene%n_bodies
+      if (mode%drive(i) == 0) cycle
+      power = power + (scene%body_mass(i) * acc(i) - (f(i) + mode%f_slide(i))) * &
+        scene%drives%velocity(mode%drive(i), t)
+    end do
+  end function held_drive_power
 
   !> Gap of row k in state s, exact to its own size: x_b - x_a is formed without rounding
   !> (two-sum), so a limit it is close to is subtracted exactly.
@@ -116,18 +244,27 @@ contains
       q = n(2) * s%x(b)
       low = low + n(2) * s%x_lo(b)
     end associate
+    if (scene%drives%n > 0) then
+      if (scene%row_drive(k) > 0) p = ground_motion(scene, k, s%t, 0)
+    end if
     total = p + q
     rounded = total - p
     g = (total + scene%row_offset(k)) + (((p - (total - rounded)) + (q - rounded)) + low)
   end function row_gap
 
-  !> Rate of change of row k's gap at velocities v.
-  pure real(wp) function row_velocity(scene, k, v) result(u)
+  !> Rate of change of row k's gap at velocities v (at time t: with its moving ground end's
+  !> velocity; without t, of the bodies' part alone).
+  pure real(wp) function row_velocity(scene, k, v, t) result(u)
     type(scene_type), intent(in) :: scene
     integer, intent(in) :: k
     real(wp), intent(in) :: v(:)
+    real(wp), intent(in), optional :: t
     u = scene%row_normal(2, k) * v(scene%row_body(2, k))
-    if (scene%row_body(1, k) > 0) u = u + scene%row_normal(1, k) * v(scene%row_body(1, k))
+    if (scene%row_body(1, k) > 0) then
+      u = u + scene%row_normal(1, k) * v(scene%row_body(1, k))
+    else if (present(t)) then
+      if (scene%drives%n > 0) u = u + ground_motion(scene, k, t, 1)
+    end if
   end function row_velocity
 
   !> n_k . y with |n| (row k's ends' sum of |y|).
@@ -148,7 +285,9 @@ contains
     type(state_type), intent(in) :: s
     real(wp), intent(in) :: moved
     tol = gap_rounding * (moved + row_abs(scene, k, s%x_lo)) + &
-      time_rounding * max(abs(s%t), scene%dt) * max(0.0_wp, -row_velocity(scene, k, s%v))
+      time_rounding * max(abs(s%t), scene%dt) * max(0.0_wp, -row_velocity(scene, k, s%v, s%t))
+    ! A moving ground's w(t) is rounded where it is evaluated.
+    if (scene%drives%n > 0) tol = tol + gap_rounding * abs(ground_motion(scene, k, s%t, 0))
   end function row_gap_tolerance
 
   !> Hermite coefficients of each body's displacement over the step from a to b.
@@ -182,7 +321,7 @@ contains
     index = 0
     call dense_output(a, b, step, c)
     call nbody_force(scene, a%t, a%x, a%x_lo, a%v, f)
-    call mode%acceleration(f, acc0)
+    call mode_acceleration(scene, mode, a%t, f, acc0)
     acc_rounding = 1.0e3_wp * eps_wp * sum(abs(f)) / minval(scene%body_mass)
     do k = 1, scene%n_rows
       if (mode%active(k)) cycle
@@ -193,6 +332,11 @@ contains
         if (ea > 0) then
           p(1:3) = p(1:3) + n(1) * c(:, ea)
           q(1:3) = q(1:3) + gap_rounding * abs(c(:, ea))
+        else if (scene%drives%n > 0) then
+          ! A moving ground end on its own cubic over the step (exact for ground_v; the
+          ! step's end is checked on the exact w: gaps_hold).
+          if (scene%row_drive(k) > 0) p(1:3) = p(1:3) + hermite(-n(2) * scene%drives%displacement( &
+            scene%row_drive(k), a%t, step), ground_motion(scene, k, a%t, 1), ground_motion(scene, k, a%t + step, 1), step)
         end if
       end associate
       if (p(0) - step * (abs(p(1)) + step * (abs(p(2)) + step * abs(p(3)))) > 0.0_wp) cycle
@@ -201,7 +345,8 @@ contains
       ! A motion that is not a cubic is only approximated by it: the dips the cubic's wrong
       ! curvature makes at a gap just released do not count (the step's end is checked on
       ! the integrator's own state: gaps_hold).
-      if (.not. polynomial) q(2) = q(2) + abs(p(2) - 0.5_wp * row_velocity(scene, k, acc0))
+      if (.not. polynomial) q(2) = q(2) + abs(p(2) - 0.5_wp * (row_velocity(scene, k, acc0) + &
+        ground_motion(scene, k, a%t, 2)))
       candidate = earliest_crossing(p, step, q)
       if (candidate < theta) then
         theta = candidate
@@ -221,7 +366,7 @@ contains
         index = i
       end if
     end do
-    if (mode%held .and. (scene%forcing%varies .or. scene%springs%present)) &
+    if (mode%held .and. (scene%forcing%varies .or. scene%springs%present .or. .not. scene%drives%polynomial)) &
       call mode_crossing(scene, mode, work, a, c, min(theta, step), theta, found)
   end subroutine locate_nbody
 
@@ -265,6 +410,7 @@ contains
       where (mode%stuck) v = 0.0_wp
       call nbody_force(scene, a%t + tau, a%x, dx, v, f)
       call nbody_rate(scene, a%t + tau, v, df)
+      if (scene%drives%n > 0) call shift_to_drives(scene, a%t + tau, mode%active, f, df)
       probe = mode
       call solve_body_mode(scene, work, f, df, v, mode%active, probe, status)
       holds_at = status == mode_solved
@@ -273,29 +419,35 @@ contains
   end subroutine mode_crossing
 
   !> Re-take the step to the located time and polish it by Newton's method on the watched
-  !> function on the integrator's own state (exact under polynomial forcing at once).
-  subroutine refine_nbody(scene, mode, a, step, found, index, b)
+  !> function on the integrator's own state (exact under polynomial forcing at once). A row
+  !> with a moving ground end was located on its cubic, whose root may come before the
+  !> exact one: Newton may then go on up to the step taken (limit).
+  subroutine refine_nbody(scene, mode, a, step, found, index, b, limit)
     type(scene_type), intent(in) :: scene
     type(body_mode_type), intent(in) :: mode
     type(state_type), intent(in) :: a
     real(wp), intent(inout) :: step
     integer, intent(in) :: found, index
     type(state_type), intent(inout) :: b
+    real(wp), intent(in), optional :: limit
     real(wp) :: value, slope, tol, located_step, f(scene%n_bodies), acc(scene%n_bodies)
     integer :: iteration
     located_step = step
+    if (present(limit) .and. found == found_row .and. scene%drives%n > 0) then
+      if (scene%row_drive(index) > 0) located_step = limit
+    end if
     call nbody_step(scene, mode, a, step, b)
     if (found /= found_row .and. found /= found_body) return
     do iteration = 1, 8
       if (found == found_body) then
         value = b%v(index)
         call nbody_force(scene, b%t, b%x, b%x_lo, b%v, f)
-        call mode%acceleration(f, acc)
+        call mode_acceleration(scene, mode, b%t, f, acc)
         slope = acc(index)
         tol = velocity_rounding * max(abs(a%v(index)), abs(value))
       else
         value = row_gap(scene, index, b)
-        slope = row_velocity(scene, index, b%v)
+        slope = row_velocity(scene, index, b%v, b%t)
         tol = row_gap_tolerance(scene, index, b, row_abs(scene, index, (b%x - a%x) + (b%x_lo - a%x_lo)))
       end if
       if (abs(value) <= tol .or. slope == 0.0_wp) exit

@@ -9,7 +9,7 @@ module impact1d_output
   use impact1d_interrupt, only: interrupt_count
   use impact1d_scene, only: scene_input, real_names, n_real, i_title, i_method, i_g, i_dt_out, &
     events_all, events_impacts, events_none, events_kept, name_len, &
-    i_dt, default_gravity, i_m2, springs_named, is_nbody
+    i_dt, default_gravity, i_m2, springs_named, is_nbody, ground_named
   use impact1d_fields, only: n_contact_fields, contact_fields, spring_fields, sine_fields, r_name, record_input, &
     n_arrays, array_names, array_is_text
   use impact1d_files, only: output_target, make_temporary, resolve_output, lock_folders, unlock_folders, write_text, &
@@ -21,20 +21,20 @@ module impact1d_output
   public :: class_impact, class_rest, class_release, class_stick, class_slip, event_name, start_counts, &
     count_event, event_count, impacts_on
   public :: emit_sample, emit_bodies, events_path, present_columns, i_pe, i_work, i_friction_loss, i_impact_loss, &
-    i_damping_loss, row_length, row_columns, column_word, bodies_of, row_ledger, check_bodies_out, final_row
+    i_damping_loss, i_drive_work, row_length, row_columns, column_word, bodies_of, row_ledger, check_bodies_out, final_row
 
   !> Every column a run can have; a scene's output carries those it has (present_columns):
-  !> pe only with springs, damping_loss only with dampers.
-  integer, parameter :: n_columns = 12, i_pe = 7, i_work = 8, i_friction_loss = 9, i_impact_loss = 10, &
-    i_damping_loss = 11
+  !> pe only with springs, damping_loss only with dampers, drive_work only with a moving ground.
+  integer, parameter :: n_columns = 13, i_pe = 7, i_work = 8, i_friction_loss = 9, i_impact_loss = 10, &
+    i_damping_loss = 11, i_drive_work = 12
   character(len=*), parameter :: column_names = &
-    't x1 v1 x2 v2 ke pe work friction_loss impact_loss damping_loss residual'
+    't x1 v1 x2 v2 ke pe work friction_loss impact_loss damping_loss drive_work residual'
   !> A run's full row (emit_bodies' for N bodies, emit_sample's 12 for one or two) is
   !> t, x1 v1 .. xM vM (M = max(N, 2)), then these, the ledger, in this order: its length is
-  !> row_length(N), the ledger's k-th at row_ledger(N) + k. N <= 2 gives the 12 above.
-  integer, parameter :: n_ledger = 7
+  !> row_length(N), the ledger's k-th at row_ledger(N) + k. N <= 2 gives the 13 above.
+  integer, parameter :: n_ledger = 8
   character(len=*), parameter :: ledger_words(n_ledger) = [character(len=13) :: 'ke', 'pe', 'work', &
-    'friction_loss', 'impact_loss', 'damping_loss', 'residual']
+    'friction_loss', 'impact_loss', 'damping_loss', 'drive_work', 'residual']
 
   !> Events are (class, index): an impact, rest or release of row index, a stick or slip of
   !> body index; each carries the velocities of a pair of bodies (a, b; 0: none), before and
@@ -241,6 +241,7 @@ contains
       row(i_work) = work
       row(i_friction_loss) = friction_loss
       row(i_impact_loss) = impact_loss
+      row(i_drive_work) = 0.0_wp      ! (a moving ground runs on the N-body engine)
       if (with_springs) then
         row(i_pe) = springs(1)
         row(i_damping_loss) = springs(3)
@@ -265,8 +266,10 @@ contains
   !> emit_sample's formula, max_residual; the sink writes the columns it was given
   !> (row_columns: the bodies of &run bodies_out, pe and damping_loss with springs), while ke
   !> and the ledger are over every body. The row is allocated once, at the run's first sample.
+  !> drive_work: what moving grounds did on the bodies (given only with one: the residual
+  !> then counts it).
   subroutine emit_bodies(sink, stats, t, x, v, mass, ke0, work, friction_loss, impact_loss, &
-      with_springs, springs, error)
+      with_springs, springs, error, drive_work)
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
     real(wp), intent(in) :: t, ke0, work, friction_loss, impact_loss
@@ -274,6 +277,7 @@ contains
     logical, intent(in) :: with_springs
     real(wp), intent(in) :: springs(3)
     type(error_type), allocatable, intent(out) :: error
+    real(wp), intent(in), optional :: drive_work
     real(wp) :: ke
     integer :: n, i, l
     n = size(x)
@@ -296,20 +300,23 @@ contains
       row(l + 3) = work
       row(l + 4) = friction_loss
       row(l + 5) = impact_loss
+      row(l + 7) = 0.0_wp
+      if (present(drive_work)) row(l + 7) = drive_work
       if (with_springs) then
         row(l + 2) = springs(1)
         row(l + 6) = springs(3)
-        row(l + 7) = ((ke + springs(1)) - (ke0 + springs(2))) - work + friction_loss + impact_loss + springs(3)
+        row(l + 8) = ((ke + springs(1)) - (ke0 + springs(2))) - work + friction_loss + impact_loss + springs(3)
       else
         row(l + 2) = 0.0_wp
         row(l + 6) = 0.0_wp
-        row(l + 7) = ke - ke0 - work + friction_loss + impact_loss
+        row(l + 8) = ke - ke0 - work + friction_loss + impact_loss
       end if
+      if (present(drive_work)) row(l + 8) = row(l + 8) - drive_work
       if (.not. all(abs(row) <= huge(1.0_wp))) then
         call not_finite(t, ke, ke0, error)
         return
       end if
-      stats%max_residual = max(stats%max_residual, abs(row(l + 7)))
+      stats%max_residual = max(stats%max_residual, abs(row(l + 8)))
       call sink%put_sample(row)
     end associate
   end subroutine emit_bodies
@@ -341,7 +348,7 @@ contains
     row_length = row_ledger(n_bodies) + n_ledger
   end function row_length
 
-  !> Where the ledger starts in the full row: ke is at row_ledger + 1, residual at + 7.
+  !> Where the ledger starts in the full row: ke is at row_ledger + 1, residual at + 8.
   pure integer function row_ledger(n_bodies)
     integer, intent(in) :: n_bodies
     row_ledger = 2 * max(n_bodies, 2) + 1
@@ -349,10 +356,11 @@ contains
 
   !> The columns a run writes, as indices into its full row: t; x and v of the bodies named
   !> (bodies: &run bodies_out; none named: every body); ke; pe when named(1) (a spring);
-  !> work, friction_loss, impact_loss; damping_loss when named(2) (a damper); residual.
+  !> work, friction_loss, impact_loss; damping_loss when named(2) (a damper); drive_work
+  !> when named(3) (a moving ground); residual.
   pure function row_columns(n_bodies, bodies, named) result(columns)
     integer, intent(in) :: n_bodies, bodies(:)
-    logical, intent(in) :: named(2)
+    logical, intent(in) :: named(3)
     integer, allocatable :: columns(:)
     integer :: l, i
     l = row_ledger(n_bodies)
@@ -365,7 +373,8 @@ contains
     if (named(1)) columns = [columns, l + 2]
     columns = [columns, l + 3, l + 4, l + 5]
     if (named(2)) columns = [columns, l + 6]
-    columns = [columns, l + 7]
+    if (named(3)) columns = [columns, l + 7]
+    columns = [columns, l + 8]
   end function row_columns
 
   !> The name of column k of a run of n_bodies bodies ('t', 'x3', 'v3', 'ke', ...).
@@ -393,16 +402,16 @@ contains
 
   !> The columns a scene's output has, as indices into its full row (row_columns): the
   !> bodies of &run bodies_out (every body when it names none), pe and damping_loss only
-  !> when the scene names springs or dampers (a component a scene does not name is absent
+  !> when the scene names springs or dampers, drive_work only when it names a moving ground (a component a scene does not name is absent
   !> from its output too). One or two bodies: indices into emit_sample's 12.
   function present_columns(input) result(columns)
     type(scene_input), intent(in) :: input
     integer, allocatable :: columns(:)
     integer :: none(0)
     if (allocated(input%bodies_out)) then
-      columns = row_columns(bodies_of(input), input%bodies_out, springs_named(input))
+      columns = row_columns(bodies_of(input), input%bodies_out, [springs_named(input), ground_named(input)])
     else
-      columns = row_columns(bodies_of(input), none, springs_named(input))
+      columns = row_columns(bodies_of(input), none, [springs_named(input), ground_named(input)])
     end if
   end function present_columns
 

@@ -8,7 +8,9 @@ module impact1d_scene
   use impact1d_forcing, only: forcing_type, table_type, angular_frequency
   use impact1d_springs, only: springs_type, pair_elements, assemble, rate_bound
   use impact1d_modes, only: pair_type, pair_rows
-  use impact1d_fields, only: chain_input, mechanism_records, r_k, r_c, r_stop_k, r_stop_c, array_value, a_m, &
+  use impact1d_drives, only: drive_type
+  use impact1d_fields, only: chain_input, mechanism_records, r_k, r_c, r_stop_k, r_stop_c, r_ground_v, &
+    r_spring_ground_v, n_ground_fields, array_value, a_m, &
     a_mu, a_mus, a_x, a_v, &
     a_f, a_f_amp, a_f_period, a_f_phase, a_f_table
   use impact1d_stability, only: linear_modes, stable_step, mode_error, coarse_rate
@@ -20,20 +22,23 @@ module impact1d_scene
     i_r_min, i_d_max, i_r_max, i_x1, i_v1, i_x2, i_v2, i_f1, i_f2, i_f1_amp, i_f1_period, &
     i_f1_phase, i_f2_amp, i_f2_period, i_f2_phase, i_t_end, i_dt, i_dt_out, i_mus1, i_mus2, &
     i_k1, i_x1_rest, i_c1, i_k2, i_x2_rest, i_c2, i_k12, i_d_rest, i_c12, i_max_events
-  public :: sample_time, step_length, set_text, events_kept, name_of, is_nbody, value_or
+  public :: sample_time, step_length, set_text, events_kept, name_of, is_nbody, value_or, ground_named
   public :: positive_value, nonnegative_value, unit_interval, resolvable, unresolved
+  public :: i_x_left_v, i_x_right_v
   public :: i_title, i_f1_table, i_f2_table, i_method, i_substeps, i_events, default_gravity
   public :: events_all, events_impacts, events_none
   public :: name_len, set_rows, allocate_contacts, set_springs, springs_named
 
-  integer, parameter :: n_real = 44, n_text = 6
+  integer, parameter :: n_real = 52, n_text = 6
   !> Names of the real inputs, as in the namelist and in Python's Scene, in this order.
   character(len=*), parameter :: real_names(n_real) = [character(len=15) :: &
     'm1', 'm2', 'mu1', 'mu2', 'g', 'x_left', 'r_left', 'x_right', 'r_right', &
     'd_min', 'r_min', 'd_max', 'r_max', 'x1', 'v1', 'x2', 'v2', 'f1', 'f2', &
     'f1_amp', 'f1_period', 'f1_phase', 'f2_amp', 'f2_period', 'f2_phase', 't_end', 'dt', 'dt_out', &
     'zero_vel', 'max_rows', 'max_impulses', 'max_step_events', 'mus1', 'mus2', &
-    'k1', 'x1_rest', 'c1', 'k2', 'x2_rest', 'c2', 'k12', 'd_rest', 'c12', 'max_events']
+    'k1', 'x1_rest', 'c1', 'k2', 'x2_rest', 'c2', 'k12', 'd_rest', 'c12', 'max_events', &
+    'x_left_v', 'x_left_amp', 'x_left_period', 'x_left_phase', 'x_right_v', 'x_right_amp', 'x_right_period', &
+    'x_right_phase']
   character(len=*), parameter :: text_names(n_text) = [character(len=8) :: &
     'title', 'f1_table', 'f2_table', 'method', 'substeps', 'events']
   integer, parameter :: i_m1 = 1, i_m2 = 2, i_mu1 = 3, i_mu2 = 4, i_g = 5, i_x_left = 6, &
@@ -44,6 +49,8 @@ module impact1d_scene
     i_max_rows = 30, i_max_impulses = 31, i_max_step_events = 32, i_mus1 = 33, i_mus2 = 34, &
     i_k1 = 35, i_x1_rest = 36, i_c1 = 37, i_k2 = 38, i_x2_rest = 39, i_c2 = 40, i_k12 = 41, &
     i_d_rest = 42, i_c12 = 43, i_max_events = 44
+  !> The walls' prescribed motion (impact1d_chain's wall_records): v, amp, period, phase each.
+  integer, parameter :: i_x_left_v = 45, i_x_right_v = 49
   !> What only a second body can have: refused in a one-body scene (no m2).
   integer, parameter :: body2_fields(18) = [i_x2, i_v2, i_mu2, i_mus2, i_f2, i_f2_amp, i_f2_period, &
     i_f2_phase, i_k2, i_x2_rest, i_c2, i_k12, i_d_rest, i_c12, i_d_min, i_r_min, i_d_max, i_r_max]
@@ -174,6 +181,13 @@ module impact1d_scene
     integer, allocatable :: row_partner(:)              !< (nr) the other limit of a rigid link (d_min = d_max), else 0
     character(len=name_len), allocatable :: row_name(:) !< (nr) one limit: the record's name; two (and
                                                         !< always the link 'slot'): <name>_min, <name>_max
+    ! Prescribed motion of ground ends (impact1d_drives): the ground end of a record that
+    ! names it is at w_d(t) (d its drive, 0: the ground at x = 0). Only the N-body engine
+    ! runs them (impact1d_solver's run hands it every scene with a drive).
+    type(drive_type) :: drives
+    integer, allocatable :: contact_drive(:)            !< (nc) the drive of the record's ground end, else 0
+    integer, allocatable :: element_drive(:)            !< (ne) the drive of the element's ground end, else 0
+    integer, allocatable :: row_drive(:)                !< (nr) its record's drive
     !> The bodies and rows as the two-body kernels see them (impact1d_modes' pair_type: in
     !> lanes, impact1d_lanes): with one body, padded by a phantom (unit mass, at rest, no
     !> friction, on no row) in the idle lane.
@@ -326,6 +340,7 @@ contains
       if (.not. has_limit(input, k)) cycle
       nrm = contact_normals(input)
       gap = nrm(1, k) * input%value(i_x1) + nrm(2, k) * input%value(i_x2) + offset_of(input, k)
+      if (k <= i_right) gap = gap + offset_sign(k) * wall_start(input, k)
       scale = maxval(abs(nrm(:, k) * input%value([i_x1, i_x2])))
       if (gap < -16.0_wp * eps_wp * max(scale, abs(offset_of(input, k)))) then
         if (input%given(limit_index(k))) then
@@ -680,6 +695,8 @@ contains
       'method is the tutorial''s scheme, with rigid contacts only)', error)
     if (allocated(error)) return
     call set_records(input, records, scene)
+    if (scene%drives%n > 0) call refuse_drives(scene, records, error)
+    if (allocated(error)) return
     call set_rows(scene, error)
     if (allocated(error)) return
     call set_springs(scene, error)
@@ -706,6 +723,21 @@ contains
     ! (validate keeps the count within max_rows, a default integer)
     scene%n_samples = int(row_count(scene%t_end, scene%dt_out))
   end subroutine build_scene
+
+  !> A scene with a moving ground runs on the N-body engine (whatever its N), which has
+  !> neither the vissim method nor compliant stops.
+  subroutine refuse_drives(scene, records, error)
+    type(scene_type), intent(in) :: scene
+    type(mechanism_records), intent(in) :: records
+    type(error_type), allocatable, intent(inout) :: error
+    if (scene%method == 'vissim') then
+      call raise(error, status_input, "method = 'vissim' is the tutorial's fixed-step scheme: a scene " // &
+        'with a moving ground (ground_v, ground_amp) runs with method = ''event''')
+      return
+    end if
+    call refuse_stops(records, 'cannot be combined with a moving ground (ground_v, ground_amp) yet: ' // &
+      'such scenes run on the N-body engine, which has rigid contacts only', error)
+  end subroutine refuse_drives
 
   !> A scene whose engine has no compliant stops: the first &contact record with k named
   !> in the message (why: what the engine lacks).
@@ -840,10 +872,43 @@ contains
     scene%element_k = records%element_k
     scene%element_c = records%element_c
     scene%element_rest = records%element_rest
+    call set_drives(records, scene)
     named = springs_named(input)
     scene%springs%has_spring = named(1)
     scene%springs%has_damper = named(2)
   end subroutine set_records
+
+  !> The records' moving grounds as drives (contacts', then elements', in record order): a
+  !> record that names any ground_* field has one, even if all are 0 (a ground that moves
+  !> at 0 m/s: the same motion on the N-body engine, which tests compare).
+  subroutine set_drives(records, scene)
+    type(mechanism_records), intent(in) :: records
+    type(scene_type), intent(inout) :: scene
+    integer :: j
+    allocate(scene%contact_drive(records%n_contacts), scene%element_drive(records%n_elements))
+    scene%contact_drive = 0
+    scene%element_drive = 0
+    if (.not. allocated(records%contact_ground)) return
+    do j = 1, records%n_contacts
+      if (records%contact_moves(j)) call add_drive(records%contact_ground(:, j), scene%contact_drive(j))
+    end do
+    do j = 1, records%n_elements
+      if (records%element_moves(j)) call add_drive(records%element_ground(:, j), scene%element_drive(j))
+    end do
+
+  contains
+
+    !> ground = (v, amp, period, phase): drive d.
+    subroutine add_drive(ground, d)
+      real(wp), intent(in) :: ground(:)
+      integer, intent(out) :: d
+      real(wp) :: omega
+      omega = 0.0_wp
+      if (ground(3) > 0.0_wp .and. ground(2) /= 0.0_wp) omega = angular_frequency(ground(3))
+      call scene%drives%add(ground(1), ground(2), omega, ground(4))
+      d = scene%drives%n
+    end subroutine add_drive
+  end subroutine set_drives
 
   !> Whether the scene names a stiffness, and a damping: the tutorial's k1, k2, k12 (c1, c2,
   !> c12), a &spring record's k (c) or a compliant &contact's k (c). They decide the pe and damping_loss columns.
@@ -863,6 +928,24 @@ contains
       named = named .or. input%chain%springs(r)%given([r_k, r_c])
     end do
   end function springs_named
+
+  !> Whether a record names its ground's motion (ground_v ...), or the walls theirs
+  !> (x_left_v ...): the drive_work column.
+  pure logical function ground_named(input)
+    type(scene_input), intent(in) :: input
+    integer :: r
+    ground_named = any(input%given(i_x_left_v:i_x_right_v + 3))
+    if (allocated(input%chain%contacts)) then
+      do r = 1, size(input%chain%contacts)
+        ground_named = ground_named .or. any(input%chain%contacts(r)%given(r_ground_v:r_ground_v + n_ground_fields - 1))
+      end do
+    end if
+    if (.not. allocated(input%chain%springs)) return
+    do r = 1, size(input%chain%springs)
+      ground_named = ground_named .or. any(input%chain%springs(r)%given(r_spring_ground_v:r_spring_ground_v + &
+        n_ground_fields - 1))
+    end do
+  end function ground_named
 
   !> The element records as the two-body kernels see them (their ends as lanes: body i is
   !> lane i, the ground 0), and the rate bound that samples their motion.
@@ -944,8 +1027,10 @@ contains
     scene%n_stops = count(scene%contact_has .and. spread(scene%contact_k > 0.0_wp, 1, 2))
     scene%n_rows = nr - scene%n_stops
     allocate(scene%row_contact(nr), scene%row_body(2, nr), scene%row_normal(2, nr), scene%row_offset(nr), &
-      scene%row_restitution(nr), scene%row_partner(nr), scene%row_name(nr), scene%row_k(nr), scene%row_c(nr))
+      scene%row_restitution(nr), scene%row_partner(nr), scene%row_name(nr), scene%row_k(nr), scene%row_c(nr), &
+      scene%row_drive(nr))
     scene%row_partner = 0
+    scene%row_drive = 0
     r = 0
     ! The rigid records' rows, then the compliant stops' (pass 2), each in record order.
     do pass = 1, 2
@@ -964,6 +1049,7 @@ contains
           scene%row_k(r) = scene%contact_k(j)
           scene%row_c(r) = scene%contact_c(j)
           scene%row_name(r) = scene%contact_name(j)
+          if (allocated(scene%contact_drive)) scene%row_drive(r) = scene%contact_drive(j)
           if (suffix) scene%row_name(r) = trim(scene%contact_name(j)) // trim(merge('_min', '_max', e == 1))
         end do
         if (all(scene%contact_has(:, j)) .and. pass == 1) then
@@ -1206,6 +1292,18 @@ contains
     integer, parameter :: indices(n_limits) = [i_x_left, i_x_right, i_d_min, i_d_max]
     limit_index = indices(k)
   end function limit_index
+
+  !> Where wall k's prescribed motion puts it at t = 0 (x_left_amp sin(x_left_phase): its
+  !> sine's; 0 without one), added to its limit.
+  pure real(wp) function wall_start(input, k)
+    type(scene_input), intent(in) :: input
+    integer, intent(in) :: k
+    integer :: first
+    wall_start = 0.0_wp
+    first = merge(i_x_left_v, i_x_right_v, k == i_left)
+    if (input%given(first + 1) .and. input%given(first + 2)) wall_start = input%value(first + 1) * &
+      sin(value_or(input, first + 3, 0.0_wp))
+  end function wall_start
 
   !> gap = normal . x + offset_sign * limit (left: x1 - x_left; right: x_right - x2; ...).
   pure real(wp) function offset_sign(k)

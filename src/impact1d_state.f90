@@ -20,6 +20,8 @@ module impact1d_state
     real(wp) :: impact_loss = 0.0_wp
     !> What the dampers dissipated (scenes with dampers only).
     real(wp) :: damping_loss = 0.0_wp, damping_lo = 0.0_wp
+    !> What the prescribed motion of moving grounds did on the bodies (scenes with one only).
+    real(wp) :: drive_work = 0.0_wp, drive_lo = 0.0_wp
   end type state_type
 
   !> A state in lanes (impact1d_lanes' max_lanes; a lane past N idle at 0): what a step and

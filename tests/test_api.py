@@ -123,9 +123,10 @@ def test_result_arrays_and_scene():
     scene = impact1d.load_scene(INPUT / "case3.nml")
     res = impact1d.simulate(scene, t_end=0.5, dt_out=0.01)
     n = 51
-    # A scene without springs or dampers has no pe and no damping_loss columns.
-    assert res.columns == tuple(c for c in impact1d.COLUMNS if c not in ("pe", "damping_loss"))
-    assert res.pe is None and res.damping_loss is None
+    # A scene without springs, dampers or a moving ground has no pe, damping_loss and
+    # drive_work columns.
+    assert res.columns == tuple(c for c in impact1d.COLUMNS if c not in ("pe", "damping_loss", "drive_work"))
+    assert res.pe is None and res.damping_loss is None and res.drive_work is None
     for name in res.columns:
         column = getattr(res, name)
         assert isinstance(column, np.ndarray) and column.dtype == np.float64, name

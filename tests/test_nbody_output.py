@@ -226,16 +226,16 @@ def test_python_bodies_out():
 def test_flat_api_output_of_five_bodies_becomes_a_result():
     """What simulate() does with the flat API's arrays of a run of five bodies (the engine
     is not merged: the arrays are made here as the core fills them, api.f90's simulate):
-    has_column over the full row of 2 N + 8 columns, info(8) = N, events with their pair.
+    has_column over the full row of 2 N + 9 columns, info(8) = N, events with their pair.
     The Result has x, v (samples, 5) with x1 .. x5 views, and NBODY_EVENT_DTYPE events
     named from the run's rows."""
     from types import SimpleNamespace
     from impact1d._simulate import _column_layout, _fill_result, _fill_events, row_length, row_names
     n, rows = 5, 4
-    assert row_length(n) == 18 and row_names(n)[:3] == ("t", "x1", "v1") and row_names(n)[11:] == \
-        ("ke", "pe", "work", "friction_loss", "impact_loss", "damping_loss", "residual")
+    assert row_length(n) == 19 and row_names(n)[:3] == ("t", "x1", "v1") and row_names(n)[11:] == \
+        ("ke", "pe", "work", "friction_loss", "impact_loss", "damping_loss", "drive_work", "residual")
     has_column = np.ones(row_length(n), dtype=np.int32)
-    has_column[[12, 16]] = 0                                    # no pe, no damping_loss
+    has_column[[12, 16, 17]] = 0                                # no pe, no damping_loss, no drive_work
     names = _column_layout(has_column.tobytes(), n)
     samples = np.asfortranarray(_rows(rows, row_length(n)))    # (the core's room: all columns)
     result = object.__new__(Result)

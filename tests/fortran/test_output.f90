@@ -49,7 +49,7 @@ contains
     call emit_bodies(sink, stats, 0.5_wp, x, v, mass, 1.0_wp, 2.0_wp, 0.25_wp, 0.125_wp, .false., &
       [0.0_wp, 0.0_wp, 0.0_wp], error)
     call check(.not. allocated(error), 'emit_bodies: no error')
-    call check(size(stats%row) == row_length(n) .and. row_length(n) == 2 * n + 8, 'the full row is 2 N + 8 long')
+    call check(size(stats%row) == row_length(n) .and. row_length(n) == 2 * n + 9, 'the full row is 2 N + 9 long')
     if (allocated(input%bodies_out)) then
       expected = [0.5_wp, x(2), v(2), x(5), v(5)]
     else

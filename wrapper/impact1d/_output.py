@@ -142,8 +142,8 @@ def _check_names(path, names, header) -> int:
             ledger != tuple(name for name in LEDGER if name in ledger) or \
             not {"ke", "work", "friction_loss", "impact_loss", "residual"} <= set(ledger):
         raise InputError(f"{path}: the last header line must name the columns 't x1 v1 [x2 v2 ...] ke "
-                         f"work friction_loss impact_loss residual' (with pe after ke and damping_loss "
-                         f"after impact_loss when the scene has them), got {' '.join(names)!r}")
+                         f"work friction_loss impact_loss residual' (with pe after ke, damping_loss "
+                         f"after impact_loss and drive_work before residual when the scene has them), got {' '.join(names)!r}")
     n_bodies = int(header["bodies"]) if header.get("bodies", "").isdigit() else \
         2 if "m2" in header or 2 in bodies else 1
     if bodies[-1] > max(n_bodies, 1):

@@ -48,6 +48,8 @@ REAL_FIELDS = (
     "t_end", "dt", "dt_out", "zero_vel", "max_rows", "max_impulses", "max_step_events",
     "mus1", "mus2", "k1", "x1_rest", "c1", "k2", "x2_rest", "c2", "k12", "d_rest", "c12",
     "max_events",
+    "x_left_v", "x_left_amp", "x_left_period", "x_left_phase",
+    "x_right_v", "x_right_amp", "x_right_period", "x_right_phase",
 )
 TEXT_FIELDS = ("title", "f1_table", "f2_table", "method", "substeps", "events")
 # The N-body scene (DESIGN "Mechanisms as data"): arrays (body i's value at i; the &link
@@ -55,8 +57,10 @@ TEXT_FIELDS = ("title", "f1_table", "f2_table", "method", "substeps", "events")
 # the &contact, &spring and &sine records. Checked against _api.input_field_names() at import.
 ARRAY_FIELDS = ("m", "mu", "mus", "x", "v", "f", "f_amp", "f_period", "f_phase", "k", "x_rest", "c",
                 "d_min", "r_min", "d_max", "r_max", "k_link", "d_rest", "c_link", "f_table")
-CONTACT_FIELDS = ("a", "b", "d_min", "r_min", "d_max", "r_max", "name", "k", "c")
-SPRING_FIELDS = ("a", "b", "k", "d_rest", "c")
+# A record with a ground end (a or b = 0) may move it: GROUND_FIELDS (DESIGN "Laws added").
+GROUND_FIELDS = ("ground_v", "ground_amp", "ground_period", "ground_phase")
+CONTACT_FIELDS = ("a", "b", "d_min", "r_min", "d_max", "r_max", "name", "k", "c") + GROUND_FIELDS
+SPRING_FIELDS = ("a", "b", "k", "d_rest", "c") + GROUND_FIELDS
 SINE_FIELDS = ("body", "amp", "period", "phase")
 # The record groups: Scene field, the core's prefix of its fields, the fields.
 _RECORD_GROUPS = (("contacts", "contact.", CONTACT_FIELDS), ("springs", "spring.", SPRING_FIELDS),
@@ -129,6 +133,16 @@ class Scene:
     d_rest: Optional[float] = None
     c12: Optional[float] = None
     max_events: Optional[float] = None   # events the log keeps (default 10^7); counts stay exact
+    # The walls' prescribed motion, added to x_left / x_right (docs/formats.md): v t +
+    # amp sin(2 pi t / period + phase).
+    x_left_v: Optional[float] = None
+    x_left_amp: Optional[float] = None
+    x_left_period: Optional[float] = None
+    x_left_phase: Optional[float] = None
+    x_right_v: Optional[float] = None
+    x_right_amp: Optional[float] = None
+    x_right_period: Optional[float] = None
+    x_right_phase: Optional[float] = None
     title: Optional[str] = None
     f1_table: Optional[str] = None
     f2_table: Optional[str] = None

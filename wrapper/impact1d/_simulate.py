@@ -20,13 +20,14 @@ __all__ = ["Result", "simulate", "COLUMNS", "EVENT_DTYPE", "ONE_BODY_EVENT_DTYPE
 
 # Every sample column the api (and the CLI output) can have, checked against the core
 # below. A run has those its scene has: pe only with springs, damping_loss only with
-# dampers (Result.columns); the others always.
+# dampers, drive_work only with a moving ground (Result.columns); the others always.
 COLUMNS = ("t", "x1", "v1", "x2", "v2", "ke", "pe", "work", "friction_loss",
-           "impact_loss", "damping_loss", "residual")
-OPTIONAL_COLUMNS = ("x2", "v2", "pe", "damping_loss")
-# After the bodies' x and v, every run's row ends with these (pe and damping_loss optional):
-# an N-body run's columns are t x1 v1 .. xN vN, then LEDGER (the core's full row).
-LEDGER = ("ke", "pe", "work", "friction_loss", "impact_loss", "damping_loss", "residual")
+           "impact_loss", "damping_loss", "drive_work", "residual")
+OPTIONAL_COLUMNS = ("x2", "v2", "pe", "damping_loss", "drive_work")
+# After the bodies' x and v, every run's row ends with these (pe, damping_loss and
+# drive_work optional): an N-body run's columns are t x1 v1 .. xN vN, then LEDGER (the
+# core's full row).
+LEDGER = ("ke", "pe", "work", "friction_loss", "impact_loss", "damping_loss", "drive_work", "residual")
 
 # Longest event kind is "release_slot_min" (16 characters).
 EVENT_DTYPE = np.dtype([("t", "f8"), ("kind", "U20"), ("v1_before", "f8"),
@@ -270,7 +271,8 @@ class Result:
     """One run: the samples as float64 arrays (one entry per output time), the event
     log, the run's accuracy monitor and the scene actually run. pe (the springs' potential
     energy) and damping_loss (what the dampers dissipated) are None for a scene without
-    springs or dampers, and x2 and v2 for a one-body scene (no m2; its events then have no
+    springs or dampers, drive_work (what a moving ground's prescribed motion did on the
+    bodies) for a scene without one, and x2 and v2 for a one-body scene (no m2; its events then have no
     v2 fields either): `columns` names the columns the run has.
 
     `x` and `v` are (samples, len(bodies)) arrays of the positions and velocities of the
@@ -290,6 +292,7 @@ class Result:
     friction_loss: np.ndarray = field(default_factory=_empty)
     impact_loss: np.ndarray = field(default_factory=_empty)
     damping_loss: Optional[np.ndarray] = None
+    drive_work: Optional[np.ndarray] = None
     residual: np.ndarray = field(default_factory=_empty)
     events: np.ndarray = field(default_factory=lambda: np.empty(0, dtype=EVENT_DTYPE))
     energy_residual: float = 0.0       # max |residual| over the samples
@@ -333,7 +336,7 @@ class Result:
     def columns(self) -> tuple:
         """The names of the columns this run has, in the core's order: t, x and v of each
         body written, then ke, [pe,] work, friction_loss, impact_loss, [damping_loss,]
-        residual (COLUMNS' order for one or two bodies)."""
+        [drive_work,] residual (COLUMNS' order for one or two bodies)."""
         if not self.bodies:
             return tuple(name for name in COLUMNS if getattr(self, name) is not None)
         return ("t", *(f"{c}{i}" for i in self.bodies for c in "xv"),

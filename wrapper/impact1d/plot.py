@@ -243,7 +243,7 @@ def _subtitle(window, events):
 
 # Every sample column a result may have (impact1d.COLUMNS, without importing the core).
 _SAMPLES = ("t", "x1", "v1", "x2", "v2", "ke", "pe", "work", "friction_loss", "impact_loss",
-            "damping_loss", "residual")
+            "damping_loss", "drive_work", "residual")
 
 
 class _Window:
@@ -622,6 +622,12 @@ def _draw_ledger(ax, result, events):
             gid="impact_loss", label="impact loss Q")
     names = ["work", "friction_loss", "impact_loss"]
     losses = "D \u2212 Q"
+    gains = "W"
+    if getattr(result, "drive_work", None) is not None:
+        ax.plot(t, np.asarray(result.drive_work, dtype=float), color="tab:purple", linewidth=1.3,
+                gid="drive_work", label="moving ground's work M")
+        names.append("drive_work")
+        gains = "W + M"
     if getattr(result, "damping_loss", None) is not None:
         ax.plot(t, np.asarray(result.damping_loss, dtype=float), color="tab:brown", linewidth=1.3,
                 gid="damping_loss", label="damping loss C")
@@ -632,7 +638,7 @@ def _draw_ledger(ax, result, events):
         energy, what = ke + np.asarray(result.pe, dtype=float), "(KE + PE)"
     if ke.size:
         ax.plot(t, energy - result.energy0, color="black", linewidth=1.0, linestyle="--", gid="ke_change",
-                label=f"{what} \u2212 {what}(0) = W \u2212 {losses}")
+                label=f"{what} \u2212 {what}(0) = {gains} \u2212 {losses}")
     # On the scale of the run's energy: a ledger that stays at rounding level
     # (no forces, no losses: case 3) reads as flat zero lines, not as noise.
     series = [np.asarray(getattr(result, n), dtype=float)
@@ -654,6 +660,8 @@ def _draw_residual(ax, result, events):
     label = "KE \u2212 KE(0) \u2212 W + D + Q"
     if getattr(result, "pe", None) is not None:
         label = "(KE + PE) \u2212 (KE + PE)(0) \u2212 W + D + Q"
+    if getattr(result, "drive_work", None) is not None:
+        label = label.replace(" \u2212 W", " \u2212 W \u2212 M")
     if getattr(result, "damping_loss", None) is not None:
         label += " + C"
     ax.plot(t, residual, color="tab:gray", linewidth=1.0, gid="residual", label=label)

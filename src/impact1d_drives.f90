@@ -1,0 +1,89 @@
+!> Prescribed motion of the ground end of a contact or element (docs/method.md section 11):
+!> w(t) = v t + amp sin(omega t + phase), each term present only when named. The gap of a row
+!> with a moving ground end is x_b - w(t) - limit, a spring to a moving anchor stretches by
+!> x_b - w(t) - rest; w and its derivatives are evaluated exactly here (never interpolated),
+!> so that the engine's gaps, impacts and held rows see the motion the user wrote.
+module impact1d_drives
+  use impact1d_kinds, only: wp
+  implicit none
+  private
+  public :: drive_type
+
+  !> The scene's moving grounds, one per record that moves its ground end (nd of them).
+  type :: drive_type
+    integer :: n = 0                             !< nd (0: every ground stays still)
+    real(wp), allocatable :: v(:)                !< (nd) constant velocity, m/s
+    real(wp), allocatable :: amp(:), omega(:), phase(:)   !< (nd) the sine: m, rad/s (0: none), rad
+    logical :: polynomial = .true.               !< no drive has a sine: w is linear in t
+  contains
+    procedure :: add
+    procedure :: position
+    procedure :: displacement
+    procedure :: velocity
+    procedure :: acceleration
+    procedure :: jerk
+  end type drive_type
+
+contains
+
+  !> One more drive (v, amp, omega, phase); its index is self%n after.
+  pure subroutine add(self, v, amp, omega, phase)
+    class(drive_type), intent(inout) :: self
+    real(wp), intent(in) :: v, amp, omega, phase
+    if (.not. allocated(self%v)) allocate(self%v(0), self%amp(0), self%omega(0), self%phase(0))
+    self%v = [self%v, v]
+    self%amp = [self%amp, amp]
+    self%omega = [self%omega, omega]
+    self%phase = [self%phase, phase]
+    self%n = self%n + 1
+    self%polynomial = self%polynomial .and. omega == 0.0_wp
+  end subroutine add
+
+  !> w_d(t).
+  pure real(wp) function position(self, d, t) result(w)
+    class(drive_type), intent(in) :: self
+    integer, intent(in) :: d
+    real(wp), intent(in) :: t
+    w = self%v(d) * t
+    if (self%omega(d) /= 0.0_wp) w = w + self%amp(d) * sin(self%omega(d) * t + self%phase(d))
+  end function position
+
+  !> w_d(t + h) - w_d(t), accurate however small h is against t (a difference of positions
+  !> would round a step below the clock's ulp to 0): sin(a + c) - sin(a) = 2 cos(a + c/2)
+  !> sin(c/2).
+  pure real(wp) function displacement(self, d, t, h) result(dw)
+    class(drive_type), intent(in) :: self
+    integer, intent(in) :: d
+    real(wp), intent(in) :: t, h
+    dw = self%v(d) * h
+    if (self%omega(d) /= 0.0_wp) dw = dw + 2.0_wp * self%amp(d) * cos(self%omega(d) * (t + 0.5_wp * h) + &
+      self%phase(d)) * sin(0.5_wp * self%omega(d) * h)
+  end function displacement
+
+  !> w_d'(t).
+  pure real(wp) function velocity(self, d, t) result(w)
+    class(drive_type), intent(in) :: self
+    integer, intent(in) :: d
+    real(wp), intent(in) :: t
+    w = self%v(d)
+    if (self%omega(d) /= 0.0_wp) w = w + self%amp(d) * self%omega(d) * cos(self%omega(d) * t + self%phase(d))
+  end function velocity
+
+  !> w_d''(t).
+  pure real(wp) function acceleration(self, d, t) result(w)
+    class(drive_type), intent(in) :: self
+    integer, intent(in) :: d
+    real(wp), intent(in) :: t
+    w = 0.0_wp
+    if (self%omega(d) /= 0.0_wp) w = -self%amp(d) * self%omega(d)**2 * sin(self%omega(d) * t + self%phase(d))
+  end function acceleration
+
+  !> w_d'''(t): which way the acceleration goes (a held row's force exactly at zero).
+  pure real(wp) function jerk(self, d, t) result(w)
+    class(drive_type), intent(in) :: self
+    integer, intent(in) :: d
+    real(wp), intent(in) :: t
+    w = 0.0_wp
+    if (self%omega(d) /= 0.0_wp) w = -self%amp(d) * self%omega(d)**3 * cos(self%omega(d) * t + self%phase(d))
+  end function jerk
+end module impact1d_drives
