@@ -270,8 +270,11 @@ contains
   !> a block pressed onto a wall that its static friction can hold), the one that leaves a
   !> held row without load when friction alone keeps the same motion: each held row in turn
   !> is let go, and stays so when the cluster then moves as before without closing into it
-  !> (the choice of impact1d_modes, "more bodies stuck, then more contacts held", and of
-  !> tests/exact_nbody.py, the least contact force).
+  !> and its ends stay joined through the other held rows and stuck bodies (the ground
+  !> joining its own): a frictionless body resting on a stuck one keeps its row, which
+  !> friction does not carry (the choice of impact1d_modes, "more bodies stuck, then more
+  !> contacts held", and of tests/exact_nbody.py: the least contact force, and a force-free
+  !> row held while its ends are not otherwise joined).
   subroutine prefer_friction(work, nb, nr, status)
     type(mode_work_type), intent(inout) :: work
     integer, intent(in) :: nb, nr
@@ -294,12 +297,31 @@ contains
         if (work%row_body(e, j) > 0) rate = rate + work%row_normal(e, j) * work%acc(work%row_body(e, j))
       end do
       if (status == cluster_solved .and. all(work%acc(1:nb) == acc) .and. all(work%stuck(1:nb) .eqv. stuck) &
-          .and. all(work%sgn(1:nb) == sgn) .and. rate >= 0.0_wp) cycle
+          .and. all(work%sgn(1:nb) == sgn) .and. rate >= 0.0_wp) then
+        if (ends_joined(j)) cycle
+      end if
       ! Friction cannot carry it alone: the row stays held, the solve as it was.
       work%candidate(j) = .true.
       call solve_gathered(work, nb, nr, status)
       if (status /= cluster_solved) return
     end do
+
+  contains
+
+    !> Whether row j's ends are joined by the held rows and stuck bodies of the last solve.
+    logical function ends_joined(j)
+      integer, intent(in) :: j
+      integer :: root(0:nb), i, k
+      logical :: joined
+      root = [(i, i = 0, nb)]
+      do i = 1, nb
+        if (work%stuck(i)) root(i) = 0
+      end do
+      do k = 1, nr
+        if (work%active(k)) joined = uf_join(root, work%row_body(1, k), work%row_body(2, k))
+      end do
+      ends_joined = uf_find(root, work%row_body(1, j)) == uf_find(root, work%row_body(2, j))
+    end function ends_joined
   end subroutine prefer_friction
 
   !> Room for a cluster of nb bodies and nr rows (grown, never shrunk).

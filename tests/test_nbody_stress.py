@@ -15,7 +15,10 @@ Each check here once failed (the commit that added it says what it found):
 - a break-away was located where the mode solve first called the force a tie with the static
   bound (within rounding, decided by the rate), ~1e-12 s before the force reached it: 12 of
   the two-body scenes as three bodies chattered into `max_step_events`, and the friction
-  chain under a ramp logged contacts loading out of order.
+  chain under a ramp logged contacts loading out of order;
+- a frictionless body resting on a stuck one (random_scene seed 82) lost its force-free
+  contact: a held row was let go whenever the cluster moved as before without it, though
+  then nothing joined its ends (seed 59: a row whose ends the other held rows join is let go).
 """
 
 from __future__ import annotations
@@ -73,8 +76,8 @@ def assert_matches_reference(res, sol):
 
 
 # (seed, n): random_scene's own N (None) or a given one; each reference solve < 2 s.
-RANDOM_SEEDS = ((0, None), (3, None), (49, None), (20, None), (54, None), (2, None), (13, None),
-                (19, None), (22, None), (28, None), (31, None), (46, None), (57, None))
+RANDOM_SEEDS = ((0, None), (3, None), (49, None), (82, None), (59, None), (20, None), (54, None), (2, None),
+                (13, None), (19, None), (22, None), (28, None), (31, None), (46, None), (57, None))
 
 
 @pytest.fixture(scope="module")
@@ -102,6 +105,24 @@ def test_chain_pressed_on_a_wall_keeps_its_gaps_closed():
                            dict(a=0, b=3, d_max=0.859375, r_max=0.0, name="right")])
     with mp.workdps(nb.DPS):
         sol = nb.solve(scene)
+        for dt in (te.DT, COARSE_DT):
+            assert_matches_reference(impact1d.simulate(te.engine_scene(scene, dt=dt)), sol)
+
+
+def test_frictionless_body_resting_on_a_stuck_one_is_held():
+    """Body 2 (no friction) rests against body 3, stuck by static friction, nothing pushing:
+    their closed contact carries no force, and since nothing else joins body 2 to body 3 it
+    is held (tests/exact_nbody.py's rule: a force-free contact is let go only while its ends
+    stay joined through the other held contacts and stuck bodies), rest_n23 at t = 0; then
+    body 1 (r = 0.5) strikes body 2 (random_scene(82)'s end, where the reference logs
+    rest_n45 after an impact series and the engine logged none)."""
+    scene = dict(m=[1.0, 1.0, 2.0], x=[-1.0, 0.0, 0.5], v=[1.0, 0.0, 0.0], mu=[0.0, 0.0, 0.5],
+                 f=[0.0, 0.0, 0.0], t_end=1.5,
+                 contacts=[dict(a=1, b=2, d_min=0.25, r_min=0.5, name="n12"),
+                           dict(a=2, b=3, d_min=0.5, r_min=0.0, name="n23")])
+    with mp.workdps(nb.DPS):
+        sol = nb.solve(scene)
+        assert [(float(e.t), e.kind) for e in sol.events][:1] == [(0.0, "rest_n23")]
         for dt in (te.DT, COARSE_DT):
             assert_matches_reference(impact1d.simulate(te.engine_scene(scene, dt=dt)), sol)
 
