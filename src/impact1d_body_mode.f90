@@ -33,6 +33,8 @@ module impact1d_body_mode
   !> about 24 n^2 bytes, 2.4 GB here. A cluster whose rows form a path (a train) is solved
   !> in O(n) by impact1d_path_mode, whatever its size.
   integer, parameter, public :: max_dense_unknowns = 10000
+  !> Bodies past which a cluster whose rows form a path takes impact1d_path_mode (gathered_mode).
+  integer, parameter :: path_from = 64
 
   type :: body_mode_type
     logical, allocatable :: active(:)        !< (nr) rows held closed
@@ -269,7 +271,11 @@ contains
     integer, intent(in) :: nb, nr
     integer, intent(out) :: status
     work%candidate(1:nr) = .true.
-    if (.not. work%dense_only) then
+    ! Small paths go to the dense solve too: impact1d_path_mode does not have two of its
+    ! rules yet (a mu = 0 < mus body breaking away takes the direction it accelerates in,
+    ! cluster_mode's mode_of; a force-free held row stays held unless its ends are otherwise
+    ! joined, prefer_friction), so it takes only the clusters the dense solve would make slow.
+    if (.not. work%dense_only .and. nb > path_from) then
       if (path_order(work%path, nb, work%row_body(:, 1:nr), work%row_normal(:, 1:nr))) then
         call path_mode(work%path, work%mass(1:nb), work%force(1:nb), work%rate(1:nb), work%friction(1:nb), &
           work%static(1:nb), work%velocity(1:nb), work%row_body(:, 1:nr), work%row_normal(:, 1:nr), &
@@ -301,9 +307,12 @@ contains
   !> a block pressed onto a wall that its static friction can hold), the one that leaves a
   !> held row without load when friction alone keeps the same motion: each held row in turn
   !> is let go, and stays so when the cluster then moves as before, accelerations and their
-  !> rates, so that it does not close into the row even at the rate (the choice of
-  !> impact1d_modes, "more bodies stuck, then more contacts held", and of
-  !> tests/exact_nbody.py, the least contact force).
+  !> rates (so that it does not close into the row even at the rate), and its ends stay
+  !> joined through the other held rows and stuck bodies (the ground joining its own): a
+  !> frictionless body resting on a stuck one keeps its row, which friction does not carry
+  !> (the choice of impact1d_modes, "more bodies stuck, then more contacts held", and of
+  !> tests/exact_nbody.py: the least contact force, and a force-free row held while its ends
+  !> are not otherwise joined).
   subroutine prefer_friction(work, nb, nr, status)
     type(mode_work_type), intent(inout) :: work
     integer, intent(in) :: nb, nr
@@ -327,12 +336,31 @@ contains
       call solve_gathered(work, nb, nr, status)
       if (status == cluster_solved .and. all(work%stuck(1:nb) .eqv. stuck) .and. all(work%sgn(1:nb) == sgn) &
           .and. all(abs(work%mass(1:nb) * (work%acc(1:nb) - acc)) <= tol_f) &
-          .and. all(abs(work%mass(1:nb) * (work%cluster%da(1:nb) - da)) <= tol_rate)) cycle
+          .and. all(abs(work%mass(1:nb) * (work%cluster%da(1:nb) - da)) <= tol_rate)) then
+        if (ends_joined(j)) cycle
+      end if
       ! Friction cannot carry it alone: the row stays held, the solve as it was.
       work%candidate(j) = .true.
       call solve_gathered(work, nb, nr, status)
       if (status /= cluster_solved) return
     end do
+
+  contains
+
+    !> Whether row j's ends are joined by the held rows and stuck bodies of the last solve.
+    logical function ends_joined(j)
+      integer, intent(in) :: j
+      integer :: root(0:nb), i, k
+      logical :: joined
+      root = [(i, i = 0, nb)]
+      do i = 1, nb
+        if (work%stuck(i)) root(i) = 0
+      end do
+      do k = 1, nr
+        if (work%active(k)) joined = uf_join(root, work%row_body(1, k), work%row_body(2, k))
+      end do
+      ends_joined = uf_find(root, work%row_body(1, j)) == uf_find(root, work%row_body(2, j))
+    end function ends_joined
   end subroutine prefer_friction
 
   !> Room for a cluster of nb bodies and nr rows (grown, never shrunk); the dense solve's

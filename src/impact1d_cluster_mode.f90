@@ -276,6 +276,12 @@ contains
         end if
         sgn(i) = sign(1.0_wp, acceleration(i))
         if (abs(mass(i) * acceleration(i)) <= tol_f) sgn(i) = sign(1.0_wp, work%da(i))
+      else if (work%broken(i) .and. .not. still(mass(i), acceleration(i), work%da(i), tol_f, tol_rate)) then
+        ! Broken away with no sliding friction (mu = 0 < mus): the way it leaves, as once it
+        ! moves (and as the two-body engine's modes give it), so that its stop is watched and
+        ! the mode just after the instant is this one, not one whose direction differs.
+        sgn(i) = sign(1.0_wp, acceleration(i))
+        if (abs(mass(i) * acceleration(i)) <= tol_f) sgn(i) = sign(1.0_wp, work%da(i))
       end if
       friction_force(i) = -friction(i) * sgn(i)
     end do

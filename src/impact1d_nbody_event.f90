@@ -63,7 +63,7 @@ contains
     type(run_stats), intent(inout) :: stats
     type(error_type), allocatable, intent(inout) :: error
     real(wp), dimension(scene%n_bodies) :: f, df, acc, entry_scale
-    logical :: closed(scene%n_rows), candidate(scene%n_rows), hit(scene%n_rows)
+    logical :: closed(scene%n_rows), candidate(scene%n_rows), hit(scene%n_rows), stopped(scene%n_bodies)
     type(body_mode_type) :: new
     integer :: k, i, status
 
@@ -80,11 +80,11 @@ contains
     entry_scale = abs(s%v) + abs(acc) * scene%dt
     if (same_instant(scene, s%t, work%scale_time)) entry_scale = max(entry_scale, work%scale)
     do i = 1, scene%n_bodies
-      if (scene%body_static(i) == 0.0_wp) cycle
-      if ((found == found_body .and. index == i) .or. abs(s%v(i)) <= velocity_rounding * abs(acc(i)) * scene%dt) &
-        call zero_velocity(scene, s, i)
+      stopped(i) = scene%body_static(i) > 0.0_wp .and. s%v(i) /= 0.0_wp .and. ((found == found_body .and. &
+        index == i) .or. abs(s%v(i)) <= velocity_rounding * abs(acc(i)) * scene%dt)
+      if (stopped(i)) call zero_velocity(scene, s, i)
     end do
-    call lock_rigid(scene, closed, s, work, sink, stats)
+    call lock_rigid(scene, closed, stopped, s, work, sink, stats)
     call impacts(scene, closed, entry_scale, acc, s, work, hit, sink, stats, error)
     if (allocated(error)) return
     if (any(hit)) call cut_cycle(scene, hit, closed, s, event_log, sink, stats)
@@ -233,22 +233,31 @@ contains
   !> groups (work%rigid, 0 the ground for a link to it) and their masses; each group moves
   !> with its centre of mass (a relative velocity the link cannot have is absorbed, as by a
   !> plastic impact, booked as impact loss and logged as an impact of the link's row that
-  !> approached, as the two-body engine and tests/exact_nbody.py log it).
-  subroutine lock_rigid(scene, closed, s, work, sink, stats)
+  !> approached, as the two-body engine and tests/exact_nbody.py log it). stopped: the
+  !> bodies friction has just stopped (their rounding-level speed zeroed); the groups they
+  !> move with stop with them, silently: the speed the others kept was that rounding.
+  subroutine lock_rigid(scene, closed, stopped, s, work, sink, stats)
     type(scene_type), intent(in) :: scene
-    logical, intent(in) :: closed(:)
+    logical, intent(in) :: closed(:), stopped(:)
     type(state_type), intent(inout) :: s
     type(point_work_type), intent(inout) :: work
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
     real(wp) :: momentum(0:scene%n_bodies), v_new(scene%n_bodies), v_before(scene%n_bodies)
     integer :: i, k, r
-    logical :: joined
+    logical :: joined, halt(0:scene%n_bodies)
     work%rigid = [(i, i = 0, scene%n_bodies)]
     do k = 1, scene%n_rows
       if (scene%row_partner(k) == 0) cycle
       if (closed(k) .and. closed(scene%row_partner(k))) joined = uf_join(work%rigid, scene%row_body(1, k), &
         scene%row_body(2, k))
+    end do
+    halt = .false.
+    do i = 1, scene%n_bodies
+      if (stopped(i)) halt(uf_find(work%rigid, i)) = .true.
+    end do
+    do i = 1, scene%n_bodies
+      if (halt(uf_find(work%rigid, i))) call zero_velocity(scene, s, i)
     end do
     work%rigid_mass = 0.0_wp
     momentum = 0.0_wp

@@ -414,8 +414,45 @@ contains
       probe = mode
       call solve_body_mode(scene, work, f, df, v, mode%active, probe, status)
       holds_at = status == mode_solved
-      if (holds_at) holds_at = same_mode(probe, mode)
+      if (holds_at) holds_at = same_mode(probe, mode) .or. .not. begun(probe, f)
     end function holds_at
+
+    !> Whether the probe's motion has begun. The mode solve calls a force within rounding of
+    !> its bound a tie and decides it by the rate, some 1e-12 s before the force reaches the
+    !> bound; the mode fails where it reaches it, as the two-body engine's hold conditions
+    !> turn negative: a body that breaks away, with its group in the probe (the bodies that
+    !> break away with it at their static bounds, the others at their sliding ones), has
+    !> force beyond those bounds the way it slides; a held row that the probe lets go does
+    !> not move back into its gap. Any other change counts at once.
+    logical function begun(probe, f)
+      type(body_mode_type), intent(in) :: probe
+      real(wp), intent(in) :: f(:)
+      real(wp) :: acc(scene%n_bodies), way(scene%n_bodies), lead(0:scene%n_bodies)
+      logical :: against
+      integer :: i, k
+      call probe%acceleration(f, acc)
+      begun = any(probe%active .and. .not. mode%active) .or. any(probe%stuck .and. .not. mode%stuck)
+      lead = 0.0_wp
+      do i = 1, scene%n_bodies
+        way(i) = probe%sgn(i)
+        if (way(i) == 0.0_wp) way(i) = sign(1.0_wp, acc(i))
+        if (mode%stuck(i) .and. .not. probe%stuck(i)) then
+          lead(probe%group(i)) = lead(probe%group(i)) + (f(i) - scene%body_static(i) * way(i))
+        else
+          lead(probe%group(i)) = lead(probe%group(i)) + (f(i) + probe%f_slide(i))
+          if (mode%sgn(i) /= probe%sgn(i)) begun = .true.
+        end if
+      end do
+      against = .false.
+      do i = 1, scene%n_bodies
+        if (mode%stuck(i) .and. .not. probe%stuck(i) .and. probe%group(i) > 0) &
+          against = against .or. way(i) * lead(probe%group(i)) < 0.0_wp
+      end do
+      do k = 1, scene%n_rows
+        if (mode%active(k) .and. .not. probe%active(k)) against = against .or. row_velocity(scene, k, acc) < 0.0_wp
+      end do
+      begun = begun .or. .not. against
+    end function begun
   end subroutine mode_crossing
 
   !> Re-take the step to the located time and polish it by Newton's method on the watched
