@@ -547,8 +547,8 @@ def test_engine_train_start_up(friction):
 # --- the N-body scenes of input/ ------------------------------------------------------------------
 
 NBODY_FILES = ("newtons_cradle.nml", "train.nml", "ball_stack.nml", "gear_train.nml")
-# Held to its closed form in tests/test_example_scenes.py (its springs and table are beyond
-# exact_nbody).
+# Held to its closed form in tests/test_example_scenes.py (its springs and moving driver are
+# beyond exact_nbody).
 EXAMPLE_FILES = ("burridge_knopoff.nml",)
 
 
