@@ -132,10 +132,11 @@ def _body_values(result, words, window=slice(None)) -> dict:
     'end' the last sample, 'p2p' and 'rms' over the samples in window (NaN for a body the
     output does not have, &run bodies_out)."""
     row = {}
-    bodies = result.bodies or ()
+    # (a column per body written: a look-up, not a search of the tuple per body, O(N^2))
+    column = {body: j for j, body in enumerate(result.bodies or ())}
     for i in range(3, _bodies(result.scene) + 1):
         for q in ("x", "v"):
-            values = getattr(result, q)[window, bodies.index(i)] if i in bodies else None
+            values = getattr(result, q)[window, column[i]] if i in column else None
             for word in words:
                 row[f"{q}{i}_{word}"] = math.nan if values is None else _measure(values, word)
     return row
