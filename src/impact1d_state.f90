@@ -22,6 +22,13 @@ module impact1d_state
     real(wp) :: damping_loss = 0.0_wp, damping_lo = 0.0_wp
     !> What the prescribed motion of moving grounds did on the bodies (scenes with one only).
     real(wp) :: drive_work = 0.0_wp, drive_lo = 0.0_wp
+  contains
+    !> A state assigned to another of the same size is copied into its arrays: the intrinsic
+    !> assignment of a type with allocatable components frees and allocates every one of
+    !> them, which a step (b = a) and a trial step did each time (type-bound, so every user
+    !> of the type has it).
+    procedure, private :: copy_state
+    generic :: assignment(=) => copy_state
   end type state_type
 
   !> A state in lanes (impact1d_lanes' max_lanes; a lane past N idle at 0): what a step and
@@ -49,6 +56,36 @@ contains
     s%v = 0.0_wp
     s%v_lo = 0.0_wp
   end subroutine new_state
+
+  !> to = from, into to's arrays when they have from's size (the run's one allocation kept).
+  pure subroutine copy_state(to, from)
+    class(state_type), intent(inout) :: to
+    type(state_type), intent(in) :: from
+    if (.not. allocated(from%x)) then
+      if (allocated(to%x)) deallocate(to%x, to%x_lo, to%v, to%v_lo)
+    else
+      if (allocated(to%x)) then
+        if (size(to%x) /= size(from%x)) deallocate(to%x, to%x_lo, to%v, to%v_lo)
+      end if
+      if (.not. allocated(to%x)) allocate(to%x(size(from%x)), to%x_lo(size(from%x)), &
+        to%v(size(from%x)), to%v_lo(size(from%x)))
+      to%x(:) = from%x
+      to%x_lo(:) = from%x_lo
+      to%v(:) = from%v
+      to%v_lo(:) = from%v_lo
+    end if
+    to%t = from%t
+    to%t_lo = from%t_lo
+    to%work = from%work
+    to%work_lo = from%work_lo
+    to%friction_loss = from%friction_loss
+    to%friction_lo = from%friction_lo
+    to%impact_loss = from%impact_loss
+    to%damping_loss = from%damping_loss
+    to%damping_lo = from%damping_lo
+    to%drive_work = from%drive_work
+    to%drive_lo = from%drive_lo
+  end subroutine copy_state
 
   !> hi + lo += increment: the exact rounding error of hi + increment (Knuth's two-sum, valid
   !> whichever is larger) goes into lo; then hi takes what of lo it can hold (Fast2Sum), so
