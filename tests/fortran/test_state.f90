@@ -1,10 +1,12 @@
 !> The compensated state: a clock advanced by 10^6 steps of 1e-5 s keeps its digits, and
-!> the bulk constant-force steps of the glide give the bits of the step-by-step path.
+!> the bulk constant-force steps of the glide give the bits of the step-by-step path, and a
+!> state assigned to another is copied whole, into the arrays it has when their size fits.
 program test_state
   use, intrinsic :: iso_fortran_env, only: int64
+  use, intrinsic :: iso_c_binding, only: c_ptr, c_loc, c_associated
   use impact1d_kinds, only: wp
   use impact1d_lanes, only: max_lanes
-  use impact1d_state, only: lane_state_type, add_compensated, renormalise, constant_step, constant_steps
+  use impact1d_state, only: state_type, new_state, lane_state_type, add_compensated, renormalise, constant_step, constant_steps
   use testing, only: check, finish
   implicit none
   integer, parameter :: n_steps = 1000000
@@ -29,9 +31,43 @@ program test_state
   ! body and two.
   call bulk_against_steps(1)
   call bulk_against_steps(2)
+  call assignment_copies()
   call finish('test_state')
 
 contains
+
+  !> b = a (state_type's own assignment): every field copied; b's arrays kept when they have
+  !> a's size (the same address), made anew when not, freed when a has none.
+  subroutine assignment_copies()
+    type(state_type), target :: a, b, none
+    type(c_ptr) :: where_before
+    call new_state(3, a)
+    call new_state(3, b)
+    a%x = [1.0_wp, 2.0_wp, 3.0_wp]
+    a%x_lo = [1.0e-17_wp, 0.0_wp, -2.0e-17_wp]
+    a%v = [-1.0_wp, 0.5_wp, 0.25_wp]
+    a%v_lo = [0.0_wp, 3.0e-18_wp, 0.0_wp]
+    a%t = 0.7_wp
+    a%t_lo = 1.0e-17_wp
+    a%work = 2.5_wp
+    a%friction_loss = 0.125_wp
+    a%impact_loss = 0.375_wp
+    a%damping_loss = 0.0625_wp
+    a%drive_work = -1.5_wp
+    where_before = c_loc(b%x(1))
+    b = a
+    call check(c_associated(c_loc(b%x(1)), where_before), 'state assignment: the same size keeps the arrays')
+    call check(all(b%x == a%x) .and. all(b%x_lo == a%x_lo) .and. all(b%v == a%v) .and. all(b%v_lo == a%v_lo), &
+      'state assignment: the arrays copied')
+    call check(b%t == a%t .and. b%t_lo == a%t_lo .and. b%work == a%work .and. b%friction_loss == a%friction_loss &
+      .and. b%impact_loss == a%impact_loss .and. b%damping_loss == a%damping_loss .and. b%drive_work == a%drive_work, &
+      'state assignment: the clock and the ledger copied')
+    call new_state(5, b)
+    b = a
+    call check(size(b%x) == 3 .and. size(b%v_lo) == 3 .and. all(b%v == a%v), 'state assignment: another size made anew')
+    b = none
+    call check(.not. allocated(b%x) .and. .not. allocated(b%v), 'state assignment: a state of no bodies frees them')
+  end subroutine assignment_copies
 
   !> n bodies in lanes (the other lane idle): 1000 steps of constant_step against one call
   !> of constant_steps, renormalised.
