@@ -136,11 +136,10 @@ contains
     if (scene%drives%n > 0) call hold_to_drives(scene, mode, a, step, b)
     v1 = b%v + b%v_lo
     f = f1
-    if (scene%drives%n > 0) then
+    if (scene%stage_powers) then
       call drive_step_ledger()
     else
       if (scene%springs%present) call add_element_forces(scene, b%x, b%x_lo, v1, f)
-      if (scene%stribeck) call add_stribeck_forces(scene, mode%sgn, v1, f)
       call mode%acceleration(f, acc_end)
     end if
     vm = 0.5_wp * (v0 + v1) + 0.125_wp * step * (kv1 - acc_end)
@@ -170,7 +169,7 @@ contains
       real(wp), intent(in) :: fx(:), dx_stage(:), v(:), tau
       real(wp), intent(out) :: acc(:)
       integer, intent(in) :: k
-      if (scene%drives%n > 0) then
+      if (scene%stage_powers) then
         call moving_stage(fx, dx_stage, v, acc, a%t + tau, power(k), k)
         return
       end if
@@ -179,15 +178,12 @@ contains
         dx = dx_stage
         call add_element_forces(scene, a%x, dx, v, f)
       end if
-      if (scene%belts .or. scene%stribeck) then
-        call law_acceleration(scene, mode, a%t + tau, v, f, acc)
-        call law_powers(scene, mode%f_slide, mode%sgn, mode%group, mode%drive, f, v, loss(k), belt(k))
-        return
-      end if
       call mode%acceleration(f, acc)
     end subroutine stage
 
-    !> stage with moving grounds at time t: and the power they put in.
+    !> stage with moving grounds at time t: and the power they put in; with a friction law
+    !> (with or without moving grounds: their procedures take none too), friction's loss and
+    !> the belts' power (loss(k), belt(k)).
     subroutine moving_stage(fx, dx_stage, v, acc, t, drive_power, k)
       real(wp), intent(in) :: fx(:), dx_stage(:), v(:), t
       real(wp), intent(out) :: acc(:), drive_power
@@ -214,8 +210,9 @@ contains
         2.0_wp * (belt(2) + belt(3)) + belt(4)))
     end subroutine law_ledger
 
-    !> The step's end with moving grounds: the accelerations there, and the work the
-    !> prescribed motion did, by RK4's own quadrature of the stages' power.
+    !> The step's end with moving grounds (or a friction law: moving_stage): the accelerations
+    !> there, and the work the prescribed motion did, by RK4's own quadrature of the stages'
+    !> power.
     subroutine drive_step_ledger()
       if (scene%springs%present) call add_moving_element_forces(scene, b%x, b%x_lo, v1, f, b%t)
       call law_acceleration(scene, mode, b%t, v1, f, acc_end)
@@ -357,7 +354,8 @@ contains
     index = 0
     call dense_output(a, b, step, c)
     call nbody_force(scene, a%t, a%x, a%x_lo, a%v, f)
-    call law_acceleration(scene, mode, a%t, a%v, f, acc0)
+    if (scene%stribeck) call add_stribeck_forces(scene, mode%sgn, a%v, f)
+    call mode_acceleration(scene, mode, a%t, f, acc0)
     acc_rounding = 1.0e3_wp * eps_wp * sum(abs(f)) / minval(scene%body_mass)
     do k = 1, scene%n_rows
       if (mode%active(k)) cycle

@@ -150,6 +150,9 @@ module impact1d_scene
     real(wp), allocatable :: body_belt(:)            !< (N) its friction surface's velocity, m/s
     real(wp), allocatable :: body_v_s(:)             !< (N) Stribeck velocity, m/s (0: none)
     real(wp), allocatable :: body_viscous(:)         !< (N) viscous friction c_v m g, N s/m
+    !> The N-body engine's RK4 stages book powers (moving grounds or a friction law: its
+    !> nbody_step's moving_stage), set by build_scene: one test in the stage's hot path.
+    logical :: stage_powers = .false.
     ! elements: springs and dampers, each pulling its ends together with tension
     ! k ((x_b - x_a) - rest) + c (v_b - v_a) (a ground end at x = 0)
     integer :: n_elements = 0
@@ -714,6 +717,7 @@ contains
     if (allocated(error)) return
     call set_springs(scene, error)
     if (allocated(error)) return
+    scene%stage_powers = scene%drives%n > 0 .or. scene%belts .or. scene%stribeck
 
     scene%t_end = input%value(i_t_end)
     scene%dt = input%value(i_dt)
