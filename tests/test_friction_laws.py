@@ -31,12 +31,14 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import subprocess
 
 import mpmath as mp
 import numpy as np
 import pytest
 
 import impact1d
+import tools
 
 M, K, V, MU, MUS, G = 1.0, 100.0, 0.1, 0.3, 0.5, 9.81
 F, S = MU * M * G, MUS * M * G
@@ -196,8 +198,62 @@ def test_stribeck_break_away_is_continuous():
     ({"c_v": [-1.0]}, "c_v(1)"),
     ({"belt_v": [math.inf]}, "belt_v(1)"),
     ({"method": "vissim"}, "belt_v"),
+    ({"contacts": [{"a": 0, "b": 1, "d_min": -1.0, "k": 1.0e4, "name": "soft"}]}, "belt_v, v_s or c_v"),
 ])
 def test_friction_law_inputs_are_checked(fields, words):
+    """Refused, each message naming the field: values not finite, v_s not positive, c_v
+    negative; the vissim method and compliant stops with a law (the N-body engine has
+    neither)."""
     scene = dataclasses.replace(block_on_belt(1e-3, 1.0), **fields)
     with pytest.raises(impact1d.InputError, match=words.replace("(", r"\(").replace(")", r"\)")):
         impact1d.simulate(scene)
+
+
+# (RK4's error on the slip with the steps cut at the samples: the periods measured within
+# 1e-8 s of each other at dt = 1e-3)
+@pytest.mark.parametrize("dt, tol", [(1e-3, 5e-8), (0.02, 1e-4)])
+def test_drill_string_example_settles_on_one_stick_slip_cycle(dt, tol):
+    """input/drill_string.nml: the bit at rest first breaks away where the spring's torque k
+    Omega t reaches S, t = S / (k Omega) (exact: the stick is polynomial); every later cycle
+    repeats the one that starts at the first stick (the same state there, each stick at rest
+    with the same twist), so stick and slip phases keep their lengths; over a cycle the
+    drive's work all goes to friction (drive_work and friction_loss grow by the same
+    amount, the state repeating)."""
+    scene = dataclasses.replace(impact1d.load_scene("input/drill_string.nml"), dt=dt, t_end=16.0)
+    spring = scene.springs[0]
+    result = impact1d.simulate(scene)
+    slips, sticks = times_of(result, "slip1"), times_of(result, "stick1")
+    s_bound = scene.mus1 * scene.m1 * scene.g
+    assert slips[0] == pytest.approx(s_bound / (spring["k"] * spring["ground_v"]), abs=1e-12)
+    assert len(sticks) >= 5
+    np.testing.assert_allclose(np.diff(sticks), sticks[1] - sticks[0], rtol=0, atol=tol)
+    np.testing.assert_allclose(sticks - slips[:len(sticks)], sticks[0] - slips[0], rtol=0, atol=tol)
+    frame = result.to_dataframe()
+    # Samples within the stick phases (at rest: friction_loss constant, the spring winding up):
+    # each cycle loses the same, and the drive's work less the spring's energy gained matches.
+    at = np.searchsorted(frame["t"], sticks[:4] + 0.05)
+    loss = frame["friction_loss"].to_numpy()[at]
+    drive = (frame["drive_work"] - frame["pe"] - frame["ke"]).to_numpy()[at]
+    np.testing.assert_allclose(np.diff(loss), loss[1] - loss[0], rtol=1e-7 if dt < 0.01 else 1e-3)
+    np.testing.assert_allclose(np.diff(drive), np.diff(loss), rtol=1e-9 if dt < 0.01 else 1e-4)
+    assert abs(result.energy_residual) < (1e-9 if dt < 0.01 else 1e-4)
+
+
+def test_cli_reads_and_writes_the_laws_of_one_body(tmp_path):
+    """A one-body namelist with `&bodies belt_v = ..., v_s = ...` (arrays, no numbered
+    names): the CLI runs it as Python does, its header writes the laws (`# belt_v = 0.1`)
+    with the drive_work column, and read_output rebuilds the scene with them."""
+    nml = tmp_path / "belt.nml"
+    nml.write_text("&bodies m1 = 1.0, mu1 = 0.3, mus1 = 0.5, g = 9.81, belt_v = 0.1, v_s = 0.5 /\n"
+                   "&initial x1 = 0.0, v1 = 0.1 /\n&springs k1 = 100.0, x1_rest = 0.0 /\n"
+                   "&run t_end = 2.0, dt = 1.0e-3 /\n")
+    out = tmp_path / "belt.dat"
+    subprocess.run([tools.find_tool("impact1d"), str(nml), "-o", str(out)], check=True, capture_output=True)
+    text = out.read_text()
+    assert "# belt_v = 0.1" in text and "# v_s = 0.5" in text
+    back = impact1d.read_output(out)
+    assert back.scene.belt_v == [0.1] and back.scene.v_s == [0.5]
+    assert "drive_work" in back.to_dataframe().columns
+    again = impact1d.simulate(back.scene)
+    assert list(again.events["kind"]) == list(back.events["kind"]) and len(again.events) >= 2
+    np.testing.assert_allclose(again.events["t"], back.events["t"], rtol=0, atol=1e-12)
