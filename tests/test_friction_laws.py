@@ -257,3 +257,31 @@ def test_cli_reads_and_writes_the_laws_of_one_body(tmp_path):
     again = impact1d.simulate(back.scene)
     assert list(again.events["kind"]) == list(back.events["kind"]) and len(again.events) >= 2
     np.testing.assert_allclose(again.events["t"], back.events["t"], rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("dt", [1e-3, 0.1])
+def test_block_carried_by_a_belt_onto_a_wall(dt):
+    """A block at rest (x = 0) on a belt moving at V = 0.5 toward a plastic wall at x = 0.2,
+    no spring: it slips (u = -V), friction F forward accelerates it at F / m until it moves
+    with the belt at t1 = m V / F, having gone V t1 / 2 (stick1 logged at v = V); it rides
+    the belt to the wall, hits it at t2 = t1 + (0.2 - V t1 / 2) / V, losing m V^2 / 2, and
+    then rests against it while the belt slides under it: friction's loss and the belt's work
+    both grow at F V. Until the stick the belt's work is F V t (friction's loss F V t -
+    m (F t / m)^2 / 2), while stuck it does no work (no force on the block). The motion is
+    polynomial: exact at any dt, the ledger to rounding."""
+    v_belt, wall = 0.5, 0.2
+    scene = impact1d.Scene(m1=M, mu1=MU, mus1=MUS, g=G, x1=0.0, v1=0.0, x_right=wall, r_right=0.0, t_end=2.0,
+                           dt=dt, dt_out=0.1, belt_v=[v_belt])
+    result = impact1d.simulate(scene)
+    t1 = M * v_belt / F
+    t2 = t1 + (wall - v_belt * t1 / 2) / v_belt
+    assert [e["kind"] for e in result.events] == ["stick1", "right", "rest_right"]
+    assert result.events["t"] == pytest.approx([t1, t2, t2], abs=1e-12)
+    frame = result.to_dataframe()
+    end = frame.iloc[-1]
+    assert end["x1"] == wall and end["v1"] == 0.0
+    assert end["impact_loss"] == pytest.approx(M * v_belt**2 / 2, rel=1e-12)
+    assert end["drive_work"] == pytest.approx(F * v_belt * t1 + F * v_belt * (2.0 - t2), rel=1e-12)
+    assert end["friction_loss"] == pytest.approx(F * v_belt * t1 - M * v_belt**2 / 2 + F * v_belt * (2.0 - t2),
+                                                 rel=1e-12)
+    assert abs(result.energy_residual) < 1e-14
