@@ -336,7 +336,7 @@ contains
     text = text // ' J' // nl // '  ledger    work =' // es(final(l + 3)) // '  friction loss =' // &
       es(final(l + 4)) // '  impact loss =' // es(final(l + 5))
     if (scene%springs%has_damper) text = text // '  damping loss =' // es(final(l + 6))
-    if (scene%drives%n > 0) text = text // '  drive work =' // es(final(l + 7))
+    if (scene%drives%n > 0 .or. scene%belts) text = text // '  drive work =' // es(final(l + 7))
     write(number, '(es10.2e3)') stats%max_residual
     text = text // '  |residual| <=' // trim(number) // ' J' // nl
     text = text // '  steps     ' // trim(fmt(stats%steps)) // ' RK4 steps' // nl

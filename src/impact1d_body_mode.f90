@@ -22,6 +22,7 @@ module impact1d_body_mode
   use impact1d_cluster_mode, only: cluster_work_type, cluster_reserve, cluster_mode, cluster_solved
   use impact1d_lcp, only: lcp_too_large
   use impact1d_path_mode, only: path_work_type, path_reserve, path_order, path_mode
+  use impact1d_friction_laws, only: slip, sliding_bound
   implicit none
   private
   public :: body_mode_type, mode_work_type, new_mode, solve_body_mode, same_mode, mode_solved
@@ -136,8 +137,9 @@ contains
   end function same_mode
 
   !> The mode at an instant: forces f and their rate df, velocities v, candidate rows (closed,
-  !> zero normal velocity); bodies with static friction and v = 0 are at rest. status:
-  !> mode_solved, else the failing cluster's LCP status (mode is then not a mode).
+  !> zero normal velocity); bodies with static friction and no slip (v = belt_v, 0 without a
+  !> belt: impact1d_friction_laws) are at rest. status: mode_solved, else the failing
+  !> cluster's LCP status (mode is then not a mode).
   subroutine solve_body_mode(scene, work, f, df, v, candidate, mode, status)
     type(scene_type), intent(in) :: scene
     type(mode_work_type), intent(inout) :: work
@@ -149,10 +151,11 @@ contains
     status = mode_solved
     mode%active = .false.
     do i = 1, scene%n_bodies
-      ! A body alone: stuck never (a body at rest is in a cluster of its own), sliding on v.
+      ! A body alone: stuck never (a body at rest is in a cluster of its own), sliding on its slip.
       mode%stuck(i) = .false.
       mode%sgn(i) = 0.0_wp
-      if (v(i) /= 0.0_wp .and. scene%body_friction(i) > 0.0_wp) mode%sgn(i) = sign(1.0_wp, v(i))
+      if (slip(scene, i, v(i)) /= 0.0_wp .and. scene%body_friction(i) > 0.0_wp) &
+        mode%sgn(i) = sign(1.0_wp, slip(scene, i, v(i)))
     end do
     call partition(scene, work, v, candidate)
     do c = 1, scene%n_bodies
@@ -164,8 +167,8 @@ contains
     ! direction too, as in the two-body engine (impact1d_event_point's moving_sign): its stop
     ! is watched, where static friction may hold it (its sliding force -0 sgn stays 0).
     do i = 1, scene%n_bodies
-      if (mode%sgn(i) == 0.0_wp .and. v(i) /= 0.0_wp .and. scene%body_static(i) > 0.0_wp) &
-        mode%sgn(i) = sign(1.0_wp, v(i))
+      if (mode%sgn(i) == 0.0_wp .and. slip(scene, i, v(i)) /= 0.0_wp .and. scene%body_static(i) > 0.0_wp) &
+        mode%sgn(i) = sign(1.0_wp, slip(scene, i, v(i)))
     end do
     call set_groups(scene, mode, work%root)
   end subroutine solve_body_mode
@@ -190,7 +193,7 @@ contains
     do i = 1, n
       r = uf_find(work%root, i)
       work%first(r + 1) = work%first(r + 1) + 1
-      if (scene%body_static(i) > 0.0_wp .and. v(i) == 0.0_wp) work%needs_solve(r) = .true.
+      if (scene%body_static(i) > 0.0_wp .and. slip(scene, i, v(i)) == 0.0_wp) work%needs_solve(r) = .true.
     end do
     call bucket(work%first, work%member, [(uf_find(work%root, i), i = 1, n)])
     work%first_row = 0
@@ -241,9 +244,10 @@ contains
       work%mass(j) = scene%body_mass(i)
       work%force(j) = f(i)
       work%rate(j) = df(i)
-      work%friction(j) = scene%body_friction(i)
+      ! Friction acts on the slip (impact1d_friction_laws), with its bound there.
+      work%friction(j) = sliding_bound(scene, i, slip(scene, i, v(i)))
       work%static(j) = scene%body_static(i)
-      work%velocity(j) = v(i)
+      work%velocity(j) = slip(scene, i, v(i))
     end do
     do j = 1, nr
       k = work%row(work%first_row(c) + j - 1)

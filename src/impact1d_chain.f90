@@ -16,7 +16,7 @@ module impact1d_chain
     a_d_max, a_r_max, a_k_link, a_d_rest, a_c_link, r_a, r_b, r_d_min, r_r_min, r_d_max, r_r_max, r_k, r_d_rest, &
     r_c, contact_fields, spring_fields, r_name, n_contact_fields, n_spring_fields, written_array, text_item, &
     a_f_table, mechanism_records, n_sine_fields, sine_fields, r_body, r_amp, r_period, r_phase, r_stop_k, r_stop_c, &
-    r_ground_v, r_spring_ground_v, n_ground_fields
+    r_ground_v, r_spring_ground_v, n_ground_fields, a_belt_v, a_v_s, a_c_v
   implicit none
   private
   public :: settle_chain, validate_chain, input_records, mechanism_records, n_bodies_of, slot_of, alias_slot
@@ -39,7 +39,7 @@ module impact1d_chain
   integer, parameter :: alias_slots(2, n_arrays) = reshape([i_m1, i_m2, i_mu1, i_mu2, i_mus1, i_mus2, &
     i_x1, i_x2, i_v1, i_v2, i_f1, i_f2, i_f1_amp, i_f2_amp, i_f1_period, i_f2_period, i_f1_phase, i_f2_phase, &
     i_k1, i_k2, i_x1_rest, i_x2_rest, i_c1, i_c2, i_d_min, 0, i_r_min, 0, i_d_max, 0, i_r_max, 0, i_k12, 0, &
-    i_d_rest, 0, i_c12, 0, n_real + i_f1_table, n_real + i_f2_table], [2, n_arrays])
+    i_d_rest, 0, i_c12, 0, n_real + i_f1_table, n_real + i_f2_table, 0, 0, 0, 0, 0, 0], [2, n_arrays])
 
   !> Arrays whose elements must not be negative.
   integer, parameter :: nonnegative_arrays(6) = [a_mu, a_mus, a_k, a_c, a_k_link, a_c_link]
@@ -125,13 +125,15 @@ contains
   end subroutine refuse_two_body_names
 
   !> Array j of a one- or two-body chain into the tutorial's scalars, element i spelled
-  !> '<name>(i)'; refused when the scalar is given too.
+  !> '<name>(i)'; refused when the scalar is given too. An array without a tutorial name
+  !> (the friction laws': belt_v, v_s, c_v) stays an array.
   subroutine fold(input, j, error)
     type(scene_input), intent(inout) :: input
     integer, intent(in) :: j
     type(error_type), allocatable, intent(inout) :: error
     integer :: i, slot
     character(len=16) :: spelled
+    if (alias_slot(j, 1) == 0) return
     do i = 1, input%chain%array(j)%n
       slot = alias_slot(j, i)
       write(spelled, '(a, "(", i0, ")")') trim(array_names(j)), i
@@ -281,6 +283,8 @@ contains
     type(error_type), allocatable, intent(out) :: error
     if (input%chain%n_bodies > 2) call check_arrays(input, error)
     if (allocated(error)) return
+    call check_laws(input, error)
+    if (allocated(error)) return
     if (allocated(input%chain%contacts)) call check_records(input, input%chain%contacts, .true., error)
     if (allocated(error)) return
     if (allocated(input%chain%springs)) call check_records(input, input%chain%springs, .false., error)
@@ -336,6 +340,30 @@ contains
     if (allocated(error)) return
     call check_link_arrays(input, n, error)
   end subroutine check_arrays
+
+  !> The friction laws' arrays (kept as arrays for any N: fold): belt_v finite, v_s positive,
+  !> c_v not negative (docs/formats.md, "Friction laws").
+  subroutine check_laws(input, error)
+    type(scene_input), intent(in) :: input
+    type(error_type), allocatable, intent(inout) :: error
+    integer :: j, i
+    character(len=16) :: name
+    do j = a_belt_v, a_c_v
+      do i = 1, input%chain%array(j)%n
+        write(name, '(a, "(", i0, ")")') trim(array_names(j)), i
+        associate (value => input%chain%array(j)%v(i))
+          if (.not. ieee_is_finite(value)) then
+            call raise(error, status_input, trim(name) // ' = ' // trim(fmt(value)) // ' is not a finite number')
+          else if (j == a_v_s) then
+            call positive_value(trim(name), value, error)
+          else if (j == a_c_v) then
+            call nonnegative_value(trim(name), value, error)
+          end if
+        end associate
+        if (allocated(error)) return
+      end do
+    end do
+  end subroutine check_laws
 
   !> Array j1 (say k) needs j2 (x_rest); and j2 needs j1 when both_ways.
   subroutine together(input, j1, j2, both_ways, why, error)

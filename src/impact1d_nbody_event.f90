@@ -14,6 +14,7 @@ module impact1d_nbody_event
     force_scale
   use impact1d_event_log, only: event_log_type, log_event
   use impact1d_event_point, only: bounce_series_time
+  use impact1d_friction_laws, only: slip
   use impact1d_clusters, only: uf_join, uf_find
   use impact1d_accumulation, only: join_cycle
   use impact1d_cluster_impact, only: impact_work_type, impact_reserve, cluster_projection
@@ -80,8 +81,8 @@ contains
     entry_scale = abs(s%v) + abs(acc) * scene%dt
     if (same_instant(scene, s%t, work%scale_time)) entry_scale = max(entry_scale, work%scale)
     do i = 1, scene%n_bodies
-      stopped(i) = scene%body_static(i) > 0.0_wp .and. s%v(i) /= 0.0_wp .and. ((found == found_body .and. &
-        index == i) .or. abs(s%v(i)) <= velocity_rounding * abs(acc(i)) * scene%dt)
+      stopped(i) = scene%body_static(i) > 0.0_wp .and. slip(scene, i, s%v(i)) /= 0.0_wp .and. ((found == found_body &
+        .and. index == i) .or. abs(slip(scene, i, s%v(i))) <= velocity_rounding * abs(acc(i)) * scene%dt)
       if (stopped(i)) call zero_velocity(scene, s, i)
     end do
     call lock_rigid(scene, closed, stopped, s, work, sink, stats)
@@ -676,7 +677,9 @@ contains
       if (.not. closed(k) .or. scene%row_body(1, k) == 0) cycle
       if (abs(row_velocity(scene, k, s%v)) > u_tolerance(scene, k, s%v, acc, entry_scale)) cycle
       do e = 1, 2
-        if (s%v(scene%row_body(e, k)) == 0.0_wp) call zero_velocity(scene, s, scene%row_body(3 - e, k))
+        if (s%v(scene%row_body(e, k)) == rest_velocity(scene, scene%row_body(e, k)) .and. &
+          rest_velocity(scene, scene%row_body(e, k)) == rest_velocity(scene, scene%row_body(3 - e, k))) &
+          call zero_velocity(scene, s, scene%row_body(3 - e, k))
       end do
     end do
 
@@ -763,23 +766,35 @@ contains
     real(wp), intent(in) :: acc(:), entry_scale(:)
     integer :: i
     do i = 1, scene%n_bodies
-      if (s%v(i) /= 0.0_wp .and. abs(s%v(i)) <= velocity_rounding * max(abs(acc(i)) * scene%dt, &
-          entry_scale(i))) call zero_velocity(scene, s, i)
+      if (s%v(i) /= rest_velocity(scene, i) .and. abs(s%v(i) - rest_velocity(scene, i)) <= velocity_rounding * &
+          max(abs(acc(i)) * scene%dt, entry_scale(i))) call zero_velocity(scene, s, i)
     end do
   end subroutine zero_stopped
 
-  !> Body i is at rest; the rounding-level energy it had goes to friction where friction
-  !> stopped it, else to impacts.
+  !> The velocity at which body i rests: its belt's when it has one and friction to hold it
+  !> there (impact1d_friction_laws), else 0.
+  pure real(wp) function rest_velocity(scene, i)
+    type(scene_type), intent(in) :: scene
+    integer, intent(in) :: i
+    rest_velocity = 0.0_wp
+    if (scene%belts .and. scene%body_static(i) > 0.0_wp) rest_velocity = scene%body_belt(i)
+  end function rest_velocity
+
+  !> Body i is at rest (rest_velocity); the rounding-level energy it had beyond that goes to
+  !> friction where friction stopped it, else to impacts.
   pure subroutine zero_velocity(scene, s, i)
     type(scene_type), intent(in) :: scene
     type(state_type), intent(inout) :: s
     integer, intent(in) :: i
-    if (scene%body_static(i) > 0.0_wp) then
+    if (scene%body_static(i) > 0.0_wp .and. scene%belts) then
+      call add_compensated(s%friction_loss, s%friction_lo, 0.5_wp * scene%body_mass(i) * &
+        (s%v(i)**2 - rest_velocity(scene, i)**2))
+    else if (scene%body_static(i) > 0.0_wp) then
       call add_compensated(s%friction_loss, s%friction_lo, 0.5_wp * scene%body_mass(i) * s%v(i)**2)
     else
       s%impact_loss = s%impact_loss + 0.5_wp * scene%body_mass(i) * s%v(i)**2
     end if
-    s%v(i) = 0.0_wp
+    s%v(i) = rest_velocity(scene, i)
     s%v_lo(i) = 0.0_wp
   end subroutine zero_velocity
 
@@ -872,12 +887,12 @@ contains
       if (direction == 0.0_wp) direction = sign(1.0_wp, merge(acc(i), acc_rate(i), acc(i) /= 0.0_wp))
       leaving = direction * acc(i) > tol_a(i) .or. (direction * acc(i) >= -tol_a(i) .and. &
         direction * acc_rate(i) > rate_tol / scene%body_mass(i))
-      resting_now = s%v(i) == 0.0_wp .and. .not. leaving
+      resting_now = slip(scene, i, s%v(i)) == 0.0_wp .and. .not. leaving
       if (resting_now .and. .not. event_log%at_rest(i) .and. .not. initial .and. &
           .not. same_instant(scene, s%t, event_log%rest_lost_time(i))) &
         call log_event(scene, sink, stats, s%t, class_stick, i, s%v, s%v)
       if (.not. resting_now .and. event_log%at_rest(i)) then
-        if (s%v(i) == 0.0_wp) then
+        if (slip(scene, i, s%v(i)) == 0.0_wp) then
           call log_event(scene, sink, stats, s%t, class_slip, i, s%v, s%v)
         else
           event_log%rest_lost_time(i) = s%t

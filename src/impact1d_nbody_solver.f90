@@ -108,7 +108,8 @@ contains
     call new_mode(scene%n_bodies, scene%n_rows, r%mode, r%work%mode)
     call new_point_work(scene%n_bodies, r%work)
     call r%event_log%allocate_log(scene%n_rows, scene%n_bodies)
-    r%polynomial = scene%forcing%is_polynomial() .and. .not. scene%springs%present .and. scene%drives%polynomial
+    r%polynomial = scene%forcing%is_polynomial() .and. .not. scene%springs%present .and. scene%drives%polynomial &
+      .and. .not. scene%stribeck
     r%ke0 = 0.5_wp * dot_product(scene%body_mass, s%v**2)
     r%pe0 = potential(scene, s)
   end subroutine start
@@ -122,7 +123,7 @@ contains
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
     type(error_type), allocatable, intent(inout) :: error
-    if (scene%drives%n > 0) then
+    if (scene%drives%n > 0 .or. scene%belts) then
       call emit_bodies(sink, stats, s%t, s%x, s%v, scene%body_mass, r%ke0, s%work, s%friction_loss, &
         s%impact_loss, scene%springs%present, [potential(scene, s), r%pe0, s%damping_loss], error, s%drive_work)
     else

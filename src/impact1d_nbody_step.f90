@@ -13,6 +13,7 @@ module impact1d_nbody_step
     element_drive_power
   use impact1d_body_mode, only: body_mode_type, mode_work_type, solve_body_mode, same_mode, mode_solved, &
     drive_accelerations, shift_to_drives
+  use impact1d_friction_laws, only: slip, add_stribeck_forces, law_powers
   implicit none
   private
   public :: nbody_force, nbody_rate, nbody_step, row_gap, row_velocity, row_gap_tolerance, locate_nbody, &
@@ -89,10 +90,23 @@ contains
     end if
   end subroutine nbody_rate
 
+  !> Accelerations a in the mode under applied forces f at time t and velocities v, with
+  !> Stribeck's part of sliding friction (impact1d_friction_laws) when the scene names it.
+  pure subroutine law_acceleration(scene, mode, t, v, f, a)
+    type(scene_type), intent(in) :: scene
+    type(body_mode_type), intent(in) :: mode
+    real(wp), intent(in) :: t, v(:)
+    real(wp), intent(inout) :: f(:)
+    real(wp), intent(out) :: a(:)
+    if (scene%stribeck) call add_stribeck_forces(scene, mode%sgn, v, f)
+    call mode_acceleration(scene, mode, t, f, a)
+  end subroutine law_acceleration
+
   !> One classical RK4 step of the mode's equations from a to b (the four stages in full: the
   !> forces may depend on the state); the ledger by Simpson's rule on the step's Hermite
   !> velocity (external work, sliding friction's loss, dampers' dissipation), exact where
-  !> RK4 is.
+  !> RK4 is. With a friction law (belt_v, v_s, c_v) friction's loss and the belts' work are
+  !> RK4's own quadrature of their power at the stages (law_ledger).
   subroutine nbody_step(scene, mode, a, step, b)
     type(scene_type), intent(in) :: scene
     type(body_mode_type), intent(in) :: mode
@@ -101,7 +115,7 @@ contains
     type(state_type), intent(inout) :: b
     real(wp), dimension(scene%n_bodies) :: v0, v1, vm, f, dx, kx1, kx2, kx3, kx4, kv1, kv2, kv3, kv4, &
       f0, fm, f1, acc_end
-    real(wp) :: half, power(4)
+    real(wp) :: half, power(4), loss(4), belt(4)
     half = 0.5_wp * step
     v0 = a%v + a%v_lo
     call scene%forcing%force_all(a%t, f0)
@@ -122,7 +136,7 @@ contains
     if (scene%drives%n > 0) call hold_to_drives(scene, mode, a, step, b)
     v1 = b%v + b%v_lo
     f = f1
-    if (scene%drives%n > 0) then
+    if (scene%stage_powers) then
       call drive_step_ledger()
     else
       if (scene%springs%present) call add_element_forces(scene, b%x, b%x_lo, v1, f)
@@ -131,8 +145,12 @@ contains
     vm = 0.5_wp * (v0 + v1) + 0.125_wp * step * (kv1 - acc_end)
     call add_compensated(b%work, b%work_lo, step / 6.0_wp * (dot_product(f0, v0) + &
       4.0_wp * dot_product(fm, vm) + dot_product(f1, v1)))
-    if (any(mode%f_slide /= 0.0_wp)) call add_compensated(b%friction_loss, b%friction_lo, step / 6.0_wp * &
-      dot_product(-mode%f_slide, v0 + 4.0_wp * vm + v1))
+    if (scene%belts .or. scene%stribeck) then
+      call law_ledger()
+    else if (any(mode%f_slide /= 0.0_wp)) then
+      call add_compensated(b%friction_loss, b%friction_lo, step / 6.0_wp * &
+        dot_product(-mode%f_slide, v0 + 4.0_wp * vm + v1))
+    end if
     if (scene%drives%n > 0) then
       if (scene%springs%present) call add_compensated(b%damping_loss, b%damping_lo, step / 6.0_wp * &
         (element_damping_power(scene, v0, a%t) + 4.0_wp * element_damping_power(scene, vm, a%t + half) + &
@@ -151,8 +169,8 @@ contains
       real(wp), intent(in) :: fx(:), dx_stage(:), v(:), tau
       real(wp), intent(out) :: acc(:)
       integer, intent(in) :: k
-      if (scene%drives%n > 0) then
-        call moving_stage(fx, dx_stage, v, acc, a%t + tau, power(k))
+      if (scene%stage_powers) then
+        call moving_stage(fx, dx_stage, v, acc, a%t + tau, power(k), k)
         return
       end if
       f = fx
@@ -163,10 +181,13 @@ contains
       call mode%acceleration(f, acc)
     end subroutine stage
 
-    !> stage with moving grounds at time t: and the power they put in.
-    subroutine moving_stage(fx, dx_stage, v, acc, t, drive_power)
+    !> stage with moving grounds at time t: and the power they put in; with a friction law
+    !> (with or without moving grounds: their procedures take none too), friction's loss and
+    !> the belts' power (loss(k), belt(k)).
+    subroutine moving_stage(fx, dx_stage, v, acc, t, drive_power, k)
       real(wp), intent(in) :: fx(:), dx_stage(:), v(:), t
       real(wp), intent(out) :: acc(:), drive_power
+      integer, intent(in) :: k
       f = fx
       drive_power = 0.0_wp
       if (scene%springs%present) then
@@ -174,15 +195,27 @@ contains
         call add_moving_element_forces(scene, a%x, dx, v, f, t)
         drive_power = element_drive_power(scene, a%x, dx, v, t)
       end if
-      call mode_acceleration(scene, mode, t, f, acc)
+      call law_acceleration(scene, mode, t, v, f, acc)
       drive_power = drive_power + held_drive_power(scene, mode, t, f, acc)
+      if (scene%belts .or. scene%stribeck) call law_powers(scene, mode%f_slide, mode%sgn, mode%group, &
+        mode%drive, f, v, loss(k), belt(k))
     end subroutine moving_stage
 
-    !> The step's end with moving grounds: the accelerations there, and the work the
-    !> prescribed motion did, by RK4's own quadrature of the stages' power.
+    !> Friction's loss and the belts' work over the step, by RK4's quadrature of the stages'
+    !> powers (impact1d_friction_laws' law_powers).
+    subroutine law_ledger()
+      call add_compensated(b%friction_loss, b%friction_lo, step / 6.0_wp * (loss(1) + 2.0_wp * (loss(2) + &
+        loss(3)) + loss(4)))
+      if (scene%belts) call add_compensated(b%drive_work, b%drive_lo, step / 6.0_wp * (belt(1) + &
+        2.0_wp * (belt(2) + belt(3)) + belt(4)))
+    end subroutine law_ledger
+
+    !> The step's end with moving grounds (or a friction law: moving_stage): the accelerations
+    !> there, and the work the prescribed motion did, by RK4's own quadrature of the stages'
+    !> power.
     subroutine drive_step_ledger()
       if (scene%springs%present) call add_moving_element_forces(scene, b%x, b%x_lo, v1, f, b%t)
-      call mode_acceleration(scene, mode, b%t, f, acc_end)
+      call law_acceleration(scene, mode, b%t, v1, f, acc_end)
       call add_compensated(b%drive_work, b%drive_lo, step / 6.0_wp * (power(1) + 2.0_wp * (power(2) + &
         power(3)) + power(4)))
     end subroutine drive_step_ledger
@@ -321,6 +354,7 @@ contains
     index = 0
     call dense_output(a, b, step, c)
     call nbody_force(scene, a%t, a%x, a%x_lo, a%v, f)
+    if (scene%stribeck) call add_stribeck_forces(scene, mode%sgn, a%v, f)
     call mode_acceleration(scene, mode, a%t, f, acc0)
     acc_rounding = 1.0e3_wp * eps_wp * sum(abs(f)) / minval(scene%body_mass)
     do k = 1, scene%n_rows
@@ -356,7 +390,8 @@ contains
     end do
     do i = 1, scene%n_bodies
       if (scene%body_static(i) == 0.0_wp .or. mode%sgn(i) == 0.0_wp .or. mode%group(i) == 0) cycle
-      p = mode%sgn(i) * [c(1, i), 2.0_wp * c(2, i), 3.0_wp * c(3, i), 0.0_wp]
+      ! (the slip: velocity relative to the body's friction surface)
+      p = mode%sgn(i) * [slip(scene, i, c(1, i)), 2.0_wp * c(2, i), 3.0_wp * c(3, i), 0.0_wp]
       q = [velocity_rounding * max(abs(a%v(i)), abs(b%v(i)), abs(b%v(i) - a%v(i))), 0.0_wp, 0.0_wp, 0.0_wp]
       if (.not. polynomial) q(1) = q(1) + abs(p(1) - mode%sgn(i) * acc0(i))
       candidate = earliest_crossing(p, step, q)
@@ -366,7 +401,8 @@ contains
         index = i
       end if
     end do
-    if (mode%held .and. (scene%forcing%varies .or. scene%springs%present .or. .not. scene%drives%polynomial)) &
+    if (mode%held .and. (scene%forcing%varies .or. scene%springs%present .or. .not. scene%drives%polynomial &
+        .or. scene%stribeck)) &
       call mode_crossing(scene, mode, work, a, c, min(theta, step), theta, found)
   end subroutine locate_nbody
 
@@ -406,8 +442,11 @@ contains
       integer :: status
       dx = a%x_lo + tau * (c(1, :) + tau * (c(2, :) + tau * c(3, :)))
       v = c(1, :) + tau * (2.0_wp * c(2, :) + 3.0_wp * tau * c(3, :))
-      ! A body held still stays exactly still; one that slides keeps its direction.
+      ! A body held still stays exactly still (on its belt); one that slides keeps its direction.
       where (mode%stuck) v = 0.0_wp
+      if (scene%belts) then
+        where (mode%stuck) v = scene%body_belt
+      end if
       call nbody_force(scene, a%t + tau, a%x, dx, v, f)
       call nbody_rate(scene, a%t + tau, v, df)
       if (scene%drives%n > 0) call shift_to_drives(scene, a%t + tau, mode%active, f, df)
@@ -477,9 +516,9 @@ contains
     if (found /= found_row .and. found /= found_body) return
     do iteration = 1, 8
       if (found == found_body) then
-        value = b%v(index)
+        value = slip(scene, index, b%v(index))
         call nbody_force(scene, b%t, b%x, b%x_lo, b%v, f)
-        call mode_acceleration(scene, mode, b%t, f, acc)
+        call law_acceleration(scene, mode, b%t, b%v, f, acc)
         slope = acc(index)
         tol = velocity_rounding * max(abs(a%v(index)), abs(value))
       else
@@ -511,7 +550,7 @@ contains
     end do
     do i = 1, scene%n_bodies
       if (scene%body_static(i) == 0.0_wp .or. mode%sgn(i) == 0.0_wp) cycle
-      if (mode%sgn(i) * b%v(i) < -velocity_rounding * max(abs(s%v(i)), abs(b%v(i)), &
+      if (mode%sgn(i) * slip(scene, i, b%v(i)) < -velocity_rounding * max(abs(s%v(i)), abs(b%v(i)), &
           abs(b%v(i) - s%v(i)))) gaps_hold = .false.
     end do
   end function gaps_hold

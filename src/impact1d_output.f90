@@ -784,7 +784,9 @@ contains
         call self%put_line(self%unit, '# dt_out = ' // trim(fmt(input%value(i_dt))))
       end if
     end do
-    if (self%n_bodies > 2) call put_arrays(self, input)
+    ! (one or two bodies: their arrays are folded into the names above, but for the friction
+    ! laws', which have no such names: impact1d_chain's fold)
+    call put_arrays(self, input)
     call put_records(self, input)
     if (self%n_bodies > 2) call self%put_line(self%unit, '# bodies = ' // trim(fmt(self%n_bodies)))
     call names_of(self%columns, self%n_bodies, header)
@@ -852,8 +854,9 @@ contains
     call self%put_line(self%event_unit, trim(line))
   end subroutine put_pair_event
 
-  !> The number arrays of a scene of more than two bodies in the header, a line each with
-  !> its values ('# m = 1.0 2.0 5.0'), so that a reader rebuilds the scene (read_output);
+  !> The number arrays of a scene in the header (of one or two bodies only the friction
+  !> laws': belt_v, v_s, c_v), a line each with its values ('# m = 1.0 2.0 5.0'), so that a
+  !> reader rebuilds the scene (read_output);
   !> like the tutorial's table names, the force tables' names are not written.
   subroutine put_arrays(self, input)
     class(file_sink), intent(inout) :: self

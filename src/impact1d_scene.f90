@@ -11,7 +11,7 @@ module impact1d_scene
   use impact1d_drives, only: drive_type
   use impact1d_fields, only: chain_input, mechanism_records, r_k, r_c, r_stop_k, r_stop_c, r_ground_v, &
     r_spring_ground_v, n_ground_fields, array_value, a_m, &
-    a_mu, a_mus, a_x, a_v, &
+    a_mu, a_mus, a_x, a_v, a_belt_v, a_v_s, a_c_v, &
     a_f, a_f_amp, a_f_period, a_f_phase, a_f_table
   use impact1d_stability, only: linear_modes, stable_step, mode_error, coarse_rate
   implicit none
@@ -142,6 +142,17 @@ module impact1d_scene
     real(wp), allocatable :: body_static(:)          !< (N) static friction bound (mus_i m_i) g >= c_i, N
     real(wp), allocatable :: body_x0(:), body_v0(:)  !< (N) initial position (m) and velocity (m/s)
     type(forcing_type) :: forcing                    !< the external forces f_i(t), per body (N)
+    ! friction laws (impact1d_friction_laws; docs/method.md section 12), allocated only in
+    ! a scene that names them: a friction surface moving under each body (belt_v), Stribeck's
+    ! sliding friction (v_s, c_v). Only the N-body engine runs them.
+    logical :: belts = .false.                       !< some body names belt_v
+    logical :: stribeck = .false.                    !< some body names v_s or c_v
+    real(wp), allocatable :: body_belt(:)            !< (N) its friction surface's velocity, m/s
+    real(wp), allocatable :: body_v_s(:)             !< (N) Stribeck velocity, m/s (0: none)
+    real(wp), allocatable :: body_viscous(:)         !< (N) viscous friction c_v m g, N s/m
+    !> The N-body engine's RK4 stages book powers (moving grounds or a friction law: its
+    !> nbody_step's moving_stage), set by build_scene: one test in the stage's hot path.
+    logical :: stage_powers = .false.
     ! elements: springs and dampers, each pulling its ends together with tension
     ! k ((x_b - x_a) - rest) + c (v_b - v_a) (a ground end at x = 0)
     integer :: n_elements = 0
@@ -694,6 +705,11 @@ contains
     if (scene%method == 'vissim') call refuse_stops(records, 'need method = ''event'' (the vissim ' // &
       'method is the tutorial''s scheme, with rigid contacts only)', error)
     if (allocated(error)) return
+    call set_laws(input, scene, error)
+    if (allocated(error)) return
+    if (scene%belts .or. scene%stribeck) call refuse_stops(records, 'cannot be combined with belt_v, v_s ' // &
+      'or c_v yet: such scenes run on the N-body engine, which has rigid contacts only', error)
+    if (allocated(error)) return
     call set_records(input, records, scene)
     if (scene%drives%n > 0) call refuse_drives(scene, records, error)
     if (allocated(error)) return
@@ -701,6 +717,7 @@ contains
     if (allocated(error)) return
     call set_springs(scene, error)
     if (allocated(error)) return
+    scene%stage_powers = scene%drives%n > 0 .or. scene%belts .or. scene%stribeck
 
     scene%t_end = input%value(i_t_end)
     scene%dt = input%value(i_dt)
@@ -723,6 +740,31 @@ contains
     ! (validate keeps the count within max_rows, a default integer)
     scene%n_samples = int(row_count(scene%t_end, scene%dt_out))
   end subroutine build_scene
+
+  !> The friction laws the arrays belt_v, v_s, c_v name (kept as arrays for any N), each
+  !> allocated only when named; the vissim method has none of them.
+  subroutine set_laws(input, scene, error)
+    type(scene_input), intent(in) :: input
+    type(scene_type), intent(inout) :: scene
+    type(error_type), allocatable, intent(inout) :: error
+    integer :: i, n
+    real(wp) :: g
+    n = scene%n_bodies
+    scene%belts = input%chain%array(a_belt_v)%n > 0
+    scene%stribeck = input%chain%array(a_v_s)%n > 0 .or. input%chain%array(a_c_v)%n > 0
+    if (.not. (scene%belts .or. scene%stribeck)) return
+    if (scene%method == 'vissim') then
+      call raise(error, status_input, "method = 'vissim' is the tutorial's fixed-step scheme: a scene " // &
+        'with a moving friction surface (belt_v) or Stribeck friction (v_s, c_v) runs with method = ''event''')
+      return
+    end if
+    g = value_or(input, i_g, default_gravity)
+    if (scene%belts) scene%body_belt = [(array_value(input%chain, a_belt_v, i, 0.0_wp) + 0.0_wp, i = 1, n)]
+    if (scene%stribeck) then
+      scene%body_v_s = [(array_value(input%chain, a_v_s, i, 0.0_wp), i = 1, n)]
+      scene%body_viscous = [(array_value(input%chain, a_c_v, i, 0.0_wp) * scene%body_mass(i) * g, i = 1, n)]
+    end if
+  end subroutine set_laws
 
   !> A scene with a moving ground runs on the N-body engine (whatever its N), which has
   !> neither the vissim method nor compliant stops.
@@ -930,11 +972,11 @@ contains
   end function springs_named
 
   !> Whether a record names its ground's motion (ground_v ...), or the walls theirs
-  !> (x_left_v ...): the drive_work column.
+  !> (x_left_v ...), or the bodies a moving friction surface (belt_v): the drive_work column.
   pure logical function ground_named(input)
     type(scene_input), intent(in) :: input
     integer :: r
-    ground_named = any(input%given(i_x_left_v:i_x_right_v + 3))
+    ground_named = any(input%given(i_x_left_v:i_x_right_v + 3)) .or. input%chain%array(a_belt_v)%n > 0
     if (allocated(input%chain%contacts)) then
       do r = 1, size(input%chain%contacts)
         ground_named = ground_named .or. any(input%chain%contacts(r)%given(r_ground_v:r_ground_v + n_ground_fields - 1))

@@ -7,7 +7,7 @@ import os
 
 import numpy as np
 
-from ._scene import (REAL_FIELDS, TEXT_FIELDS, ARRAY_FIELDS, Scene, InputError, load_scene, is_nbody_form, from_core, to_core,
+from ._scene import (REAL_FIELDS, TEXT_FIELDS, ARRAY_FIELDS, LAW_FIELDS, Scene, InputError, load_scene, is_nbody_form, from_core, to_core,
                      _put)
 from ._files import check_input
 from ._simulate import LEDGER, Result, event_dtype, result_from_columns
@@ -103,6 +103,11 @@ def read_output(path, scene=None) -> Result:
         # texts, are not written).
         for name in ARRAY_FIELDS:
             if name in header and name != "f_table":
+                kwargs[name] = [float(value) for value in header[name].split()]
+    else:
+        # (the friction laws' arrays, which one or two bodies keep as arrays)
+        for name in LAW_FIELDS:
+            if name in header:
                 kwargs[name] = [float(value) for value in header[name].split()]
     # The records: '# contact.2.d_min = 0.5', '# spring.1.k = 40.0', '# sine.1.amp = 2.0'
     # (in record order).

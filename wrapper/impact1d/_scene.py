@@ -56,7 +56,11 @@ TEXT_FIELDS = ("title", "f1_table", "f2_table", "method", "substeps", "events")
 # ones and k_link, d_rest, c_link one per neighbour pair), &link r_meet, and the fields of
 # the &contact, &spring and &sine records. Checked against _api.input_field_names() at import.
 ARRAY_FIELDS = ("m", "mu", "mus", "x", "v", "f", "f_amp", "f_period", "f_phase", "k", "x_rest", "c",
-                "d_min", "r_min", "d_max", "r_max", "k_link", "d_rest", "c_link", "f_table")
+                "d_min", "r_min", "d_max", "r_max", "k_link", "d_rest", "c_link", "f_table",
+                "belt_v", "v_s", "c_v")
+# The friction laws' arrays (DESIGN "Laws added on the records"): arrays for any N, with no
+# tutorial name; they go to the core with the records (record_fields).
+LAW_FIELDS = ("belt_v", "v_s", "c_v")
 # A record with a ground end (a or b = 0) may move it: GROUND_FIELDS (DESIGN "Laws added").
 GROUND_FIELDS = ("ground_v", "ground_amp", "ground_period", "ground_phase")
 CONTACT_FIELDS = ("a", "b", "d_min", "r_min", "d_max", "r_max", "name", "k", "c") + GROUND_FIELDS
@@ -165,6 +169,9 @@ class Scene:
     k_link: Optional[Sequence[float]] = None
     c_link: Optional[Sequence[float]] = None
     f_table: Optional[Sequence[Optional[str]]] = None
+    belt_v: Optional[Sequence[float]] = None  # each body's friction surface velocity (m/s; any N)
+    v_s: Optional[Sequence[float]] = None     # Stribeck velocity (m/s): mu(u) = mu + (mus - mu) exp(-(u/v_s)^2) + c_v |u|
+    c_v: Optional[Sequence[float]] = None     # viscous friction coefficient (s/m)
     r_meet: Optional[float] = None
     contacts: Optional[Sequence[dict]] = None
     springs: Optional[Sequence[dict]] = None
@@ -414,10 +421,11 @@ _NO_RECORDS = _packed([], [])
 
 
 def record_fields(scene: Scene) -> dict:
-    """The scene's record lists that are given ({"contacts": [...], ...}; {} for none), and
-    its bodies_out (which goes to the core with them, whatever the scene's form)."""
+    """The scene's record lists that are given ({"contacts": [...], ...}; {} for none), its
+    bodies_out, and the friction laws' arrays (which go to the core with them, whatever the
+    scene's form: they have no tutorial name)."""
     fields = vars(scene)
-    return {name: fields[name] for name in _RECORD_NAMES + _OUTPUT_FIELDS if fields[name] is not None}
+    return {name: fields[name] for name in _RECORD_NAMES + _OUTPUT_FIELDS + LAW_FIELDS if fields[name] is not None}
 
 
 def _settled(scene: Scene):
