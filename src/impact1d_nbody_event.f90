@@ -67,7 +67,15 @@ contains
     type(body_mode_type) :: new
     integer :: k, i, status
 
-    if (scene%n_stops > 0) call switch_stops(scene, found, index, s, mode%engaged, sink, stats)
+    if (scene%n_stops > 0) then
+      call nbody_force(scene, s%t, s%x, s%x_lo, s%v, f, mode%engaged)
+      if (initial) then
+        acc = f / scene%body_mass
+      else
+        call mode_acceleration(scene, mode, s%t, f, acc)
+      end if
+      call switch_stops(scene, found, index, s, acc, mode%engaged, sink, stats)
+    end if
     call nbody_force(scene, s%t, s%x, s%x_lo, s%v, f, mode%engaged)
     call nbody_rate(scene, s%t, s%v, df, mode%engaged)
     call close_rows(scene, initial, merge(index, 0, found == found_row), s, closed)
@@ -125,11 +133,14 @@ contains
   !> within its rounding) engages when its ends approach, logged as an impact on its row (no
   !> velocity changes); an engaged one releases when its force F = -(k gap + c gap') has
   !> fallen to zero (located, or within rounding), logged as release_<row>; one released
-  !> inside (gap < 0) engages again when F has risen to zero.
-  subroutine switch_stops(scene, found, index, s, engaged, sink, stats)
+  !> inside (gap < 0) engages again when F has risen to zero. acc: the accelerations in the
+  !> mode so far (a stop at its limit with its ends at rest relative to each other engages
+  !> when they accelerate into it).
+  subroutine switch_stops(scene, found, index, s, acc, engaged, sink, stats)
     type(scene_type), intent(in) :: scene
     integer, intent(in) :: found, index
     type(state_type), intent(in) :: s
+    real(wp), intent(in) :: acc(:)
     logical, intent(inout) :: engaged(:)
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
@@ -155,11 +166,14 @@ contains
       end if
       if (g > stop_gap_band(scene, r, s)) cycle
       ! At the limit (gap within rounding) the stop engages when its ends approach (relative
-      ! to a moving ground end); inside it, when its force has risen to zero.
+      ! to a moving ground end), or, at rest relative to each other (a body set down on a
+      ! compliant floor), accelerate into it (else the gap closing is located at once again
+      ! and again); inside it, when its force has risen to zero.
       if (g >= -stop_gap_band(scene, r, s)) then
         speed = maxval(abs(s%v))
         if (scene%drives%n > 0) speed = max(speed, abs(ground_motion(scene, r, s%t, 1)))
-        engage = u < -velocity_rounding * speed
+        engage = u < -velocity_rounding * speed .or. (u <= velocity_rounding * speed .and. &
+          row_velocity(scene, r, acc) + ground_motion(scene, r, s%t, 2) < 0.0_wp)
       else
         engage = force > tol .or. (located .and. force >= -tol)
       end if

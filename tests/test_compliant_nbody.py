@@ -12,6 +12,7 @@ ground, which run on the N-body engine.
     spring under gravity (the stack cannot part: the floor never pulls).
 (e) input/ball_stack.nml's elastic balls on a compliant floor against an event-driven
     reference at 40 digits (closed forms per phase, events found by mpmath).
+(f) A body, and a stack, set down at rest on a damped compliant floor (both engines).
 
 Each closed form is derived in its test's docstring and evaluated with mpmath at 50 digits.
 """
@@ -346,3 +347,37 @@ def test_ball_stack_on_a_compliant_floor_against_the_reference(dt, tol):
     assert len(reference) == 16
     assert list(res.events["kind"]) == [name for _, name in reference]
     assert np.max(np.abs(res.events["t"] - [t for t, _ in reference])) < tol
+
+
+# ---------------------------------------------------------------------------------------
+# (f) Set down at rest on a compliant floor.
+@pytest.mark.parametrize("bodies, ground_v", [(1, None), (1, 0.0), (3, None)])
+def test_set_down_at_rest_on_a_compliant_floor(bodies, ground_v):
+    """A body (or a stack of three touching, 6 kg in all) at rest exactly at a damped
+    floor's limit (k = 1000, c = 20), under its weight: the stop engages at t = 0 (its ends
+    at rest, accelerating into it; before, the gap closing was located at t = 0 again and
+    again, and the run ended at the work limit) and the stack sinks to p_eq = M g / k as
+    the damped oscillator from rest: p = p_eq (1 - e^(-zeta wn t) (cos(wd t) + zeta wn / wd
+    sin(wd t))), wn = sqrt(k / M), zeta = c / (2 sqrt(k M)), wd = wn sqrt(1 - zeta^2). One
+    body on the two-body engine and on the N-body one (ground_v = 0), three on the N-body
+    one; the samples within 1e-9 m of the closed form at dt = 1e-3, no other floor event."""
+    masses = [6.0] if bodies == 1 else [1.0, 2.0, 3.0]
+    k, c = 1000.0, 20.0
+    floor = dict(a=0, b=1, d_min=0.0, k=k, c=c, name="floor")
+    if ground_v is not None:
+        floor["ground_v"] = ground_v
+    links = [dict(a=i, b=i + 1, d_min=0.25, r_min=0.0, name=f"b{i}{i + 1}") for i in range(1, bodies)]
+    res = impact1d.simulate(impact1d.Scene(m=masses, x=[0.25 * i for i in range(bodies)], v=[0.0] * bodies,
+                                           f=[-G * m for m in masses], t_end=2.0, dt=1e-3, dt_out=1e-2,
+                                           contacts=[floor] + links))
+    assert list(events(res, "floor")) == [0.0] and len(events(res, "release_floor")) == 0
+    M = mpmath.mpf(sum(masses))
+    wn = mpmath.sqrt(k / M)
+    zeta = c / (2 * mpmath.sqrt(k * M))
+    wd = wn * mpmath.sqrt(1 - zeta ** 2)
+    p_eq = M * G / k
+    closed = [float(-p_eq * (1 - mpmath.exp(-zeta * wn * t) * (mpmath.cos(wd * t) + zeta * wn / wd *
+                                                               mpmath.sin(wd * t)))) for t in res.t]
+    assert np.max(np.abs(res.x[:, 0] - closed)) < 1e-9
+    if bodies > 1:
+        assert np.max(np.abs(np.diff(res.x, axis=1) - 0.25)) < 1e-12
