@@ -47,6 +47,10 @@ module impact1d_body_mode
     !> (N) the drive of the moving ground whose held rows hold the body's group (group 0),
     !> else 0 (scenes with drives only: set_groups)
     integer, allocatable :: drive(:)
+    !> (n_stops) the compliant stops engaged (docs/method.md section 10), switched at event
+    !> points only (impact1d_nbody_event's switch_stops); allocated by the run (unallocated:
+    !> a scene without stops)
+    logical, allocatable :: engaged(:)
     !> Some row is held or some body stuck: conditions that forces can break.
     logical :: held = .false.
   contains

@@ -5,6 +5,12 @@
 !> ends are looked up by index, so a chain's cost is its number of elements, not N^2.
 !> An element whose ground end moves (scene%element_drive) acts on x_b - w(t) and v_b - w'(t)
 !> when the time t is passed (every N-body engine call passes it when the scene has drives).
+!> The compliant stops (docs/method.md section 10) are elements of the same kind on their
+!> rows (scene%row_*, n_rows + 1 .. n_rows + n_stops): while engaged, a stop pushes its ends
+!> apart along the row's normal with F = k p + c p' >= 0 (p = -gap, its penetration; a
+!> moving ground end at w(t) as for the rows: gap = n_b (x_b - w) + offset). Which are
+!> engaged is the event point's to switch (impact1d_nbody_event), so F stays a smooth
+!> function of the state over a step.
 module impact1d_elements
   use impact1d_kinds, only: wp
   use impact1d_scene, only: scene_type
@@ -12,6 +18,8 @@ module impact1d_elements
   private
   public :: add_element_forces, add_moving_element_forces, add_element_rates, element_potential, &
     element_damping_power, element_drive_power
+  public :: stop_gap, stop_rate, add_stop_forces, add_stop_rates, stop_potential, stop_damping_power, &
+    stop_release_loss, stop_drive_power
 
 contains
 
@@ -30,13 +38,22 @@ contains
     real(wp), intent(in), optional :: t
     anchor = 0.0_wp
     if (.not. present(t) .or. scene%drives%n == 0) return
-    if (scene%element_drive(j) == 0) return
-    if (order == 0) then
-      anchor = scene%drives%position(scene%element_drive(j), t)
-    else
-      anchor = scene%drives%velocity(scene%element_drive(j), t)
-    end if
+    anchor = drive_at(scene, scene%element_drive(j), order, t)
   end function anchor
+
+  !> Drive d's position (order 0) or velocity (1) at t; 0 for d = 0 (a still ground).
+  pure real(wp) function drive_at(scene, d, order, t)
+    type(scene_type), intent(in) :: scene
+    integer, intent(in) :: d, order
+    real(wp), intent(in) :: t
+    drive_at = 0.0_wp
+    if (d == 0) return
+    if (order == 0) then
+      drive_at = scene%drives%position(d, t)
+    else
+      drive_at = scene%drives%velocity(d, t)
+    end if
+  end function drive_at
 
   !> Element j's elongation at positions x + dx (dx: low parts and stage displacements,
   !> added after the large terms cancel).
@@ -185,4 +202,157 @@ contains
       power = power - tension_of(scene, j, x, dx, v, t) * anchor(scene, j, 1, t)
     end do
   end function element_drive_power
+
+  !> Row r's ground end's position (order 0) or velocity (1) at t when it moves, else 0.
+  pure real(wp) function row_anchor(scene, r, order, t)
+    type(scene_type), intent(in) :: scene
+    integer, intent(in) :: r, order
+    real(wp), intent(in), optional :: t
+    row_anchor = 0.0_wp
+    if (.not. present(t) .or. scene%drives%n == 0) return
+    row_anchor = drive_at(scene, scene%row_drive(r), order, t)
+  end function row_anchor
+
+  !> Compliant stop row r's gap at positions x + dx (at time t: a moving ground end where it
+  !> is then); negative past its limit (the penetration p = -gap). The two-body engine's
+  !> impact1d_loads stop_gap in the same order of operations.
+  pure real(wp) function stop_gap(scene, r, x, dx, t)
+    type(scene_type), intent(in) :: scene
+    integer, intent(in) :: r
+    real(wp), intent(in) :: x(:), dx(:)
+    real(wp), intent(in), optional :: t
+    associate (a => scene%row_body(1, r), b => scene%row_body(2, r), n => scene%row_normal(:, r))
+      stop_gap = ((n(1) * at_end(x, a) + n(2) * (x(b) - row_anchor(scene, r, 0, t))) + scene%row_offset(r)) + &
+        (n(1) * at_end(dx, a) + n(2) * dx(b))
+    end associate
+  end function stop_gap
+
+  !> The rate gap' of stop row r's gap at velocities v (at time t: relative to a moving
+  !> ground end).
+  pure real(wp) function stop_rate(scene, r, v, t)
+    type(scene_type), intent(in) :: scene
+    integer, intent(in) :: r
+    real(wp), intent(in) :: v(:)
+    real(wp), intent(in), optional :: t
+    associate (a => scene%row_body(1, r), b => scene%row_body(2, r), n => scene%row_normal(:, r))
+      stop_rate = n(1) * at_end(v, a) + n(2) * (v(b) - row_anchor(scene, r, 1, t))
+    end associate
+  end function stop_rate
+
+  !> Engaged stop j's push F = k p + c p' = -(k gap + c gap') at positions x + dx,
+  !> velocities v (time t). DESIGN's max(0, F) is kept by the switching: the location cuts
+  !> the step where F falls to 0 and the event point releases the stop there, so F >= 0 at
+  !> every state the run accepts. Clipped inside the step too, the trial step past the
+  !> release would interpolate a kink, and the release be found less well (the damped
+  !> thrown mass of tests/test_compliant_nbody.py at dt = 0.02: 2e-10 s from the two-body
+  !> engine, which does not clip; unclipped, the same bits).
+  pure real(wp) function stop_push(scene, j, x, dx, v, t)
+    type(scene_type), intent(in) :: scene
+    integer, intent(in) :: j
+    real(wp), intent(in) :: x(:), dx(:), v(:)
+    real(wp), intent(in), optional :: t
+    integer :: r
+    r = scene%n_rows + j
+    stop_push = -(scene%row_k(r) * stop_gap(scene, r, x, dx, t) + scene%row_c(r) * stop_rate(scene, r, v, t))
+  end function stop_push
+
+  !> f += the engaged stops' pushes along their rows' normals.
+  pure subroutine add_stop_forces(scene, engaged, x, dx, v, f, t)
+    type(scene_type), intent(in) :: scene
+    logical, intent(in) :: engaged(:)
+    real(wp), intent(in) :: x(:), dx(:), v(:)
+    real(wp), intent(inout) :: f(:)
+    real(wp), intent(in), optional :: t
+    real(wp) :: push
+    integer :: j, r
+    do j = 1, scene%n_stops
+      if (.not. engaged(j)) cycle
+      r = scene%n_rows + j
+      push = stop_push(scene, j, x, dx, v, t)
+      if (scene%row_body(1, r) > 0) f(scene%row_body(1, r)) = f(scene%row_body(1, r)) + scene%row_normal(1, r) * push
+      f(scene%row_body(2, r)) = f(scene%row_body(2, r)) + scene%row_normal(2, r) * push
+    end do
+  end subroutine add_stop_forces
+
+  !> df += the rate of the engaged stops' spring parts, -k gap' along the normal (the
+  !> dampers' part needs the accelerations: left out, as for the elements).
+  pure subroutine add_stop_rates(scene, engaged, v, df, t)
+    type(scene_type), intent(in) :: scene
+    logical, intent(in) :: engaged(:)
+    real(wp), intent(in) :: v(:)
+    real(wp), intent(inout) :: df(:)
+    real(wp), intent(in), optional :: t
+    real(wp) :: rate
+    integer :: j, r
+    do j = 1, scene%n_stops
+      if (.not. engaged(j)) cycle
+      r = scene%n_rows + j
+      rate = -scene%row_k(r) * stop_rate(scene, r, v, t)
+      if (scene%row_body(1, r) > 0) df(scene%row_body(1, r)) = df(scene%row_body(1, r)) + scene%row_normal(1, r) * rate
+      df(scene%row_body(2, r)) = df(scene%row_body(2, r)) + scene%row_normal(2, r) * rate
+    end do
+  end subroutine add_stop_rates
+
+  !> The stops' stored energy at positions x + dx (time t): k p^2 / 2 wherever p > 0,
+  !> engaged or not (a function of the positions, as a spring's is).
+  pure real(wp) function stop_potential(scene, x, dx, t) result(pe)
+    type(scene_type), intent(in) :: scene
+    real(wp), intent(in) :: x(:), dx(:)
+    real(wp), intent(in), optional :: t
+    integer :: r
+    pe = 0.0_wp
+    do r = scene%n_rows + 1, scene%n_rows + scene%n_stops
+      pe = pe + 0.5_wp * scene%row_k(r) * min(0.0_wp, stop_gap(scene, r, x, dx, t))**2
+    end do
+  end function stop_potential
+
+  !> Power the engaged stops' dampers dissipate at velocities v (time t): c gap'^2.
+  pure real(wp) function stop_damping_power(scene, engaged, v, t) result(power)
+    type(scene_type), intent(in) :: scene
+    logical, intent(in) :: engaged(:)
+    real(wp), intent(in) :: v(:)
+    real(wp), intent(in), optional :: t
+    integer :: j, r
+    power = 0.0_wp
+    do j = 1, scene%n_stops
+      if (.not. engaged(j)) cycle
+      r = scene%n_rows + j
+      power = power + scene%row_c(r) * stop_rate(scene, r, v, t)**2
+    end do
+  end function stop_damping_power
+
+  !> What the stops not engaged lost from positions x_a + dx_a (time t_a) to x_b + dx_b
+  !> (t_b): released inside (p > 0, k p + c p' < 0) a stop pushes on nothing while its
+  !> stored k p^2 / 2 falls, so that fall is its damping's loss, exactly (impact1d_loads'
+  !> stop_release_loss).
+  pure real(wp) function stop_release_loss(scene, engaged, x_a, dx_a, x_b, dx_b, t_a, t_b) result(loss)
+    type(scene_type), intent(in) :: scene
+    logical, intent(in) :: engaged(:)
+    real(wp), intent(in) :: x_a(:), dx_a(:), x_b(:), dx_b(:)
+    real(wp), intent(in), optional :: t_a, t_b
+    integer :: j, r
+    loss = 0.0_wp
+    do j = 1, scene%n_stops
+      if (engaged(j)) cycle
+      r = scene%n_rows + j
+      loss = loss + 0.5_wp * scene%row_k(r) * (min(0.0_wp, stop_gap(scene, r, x_a, dx_a, t_a))**2 - &
+        min(0.0_wp, stop_gap(scene, r, x_b, dx_b, t_b))**2)
+    end do
+  end function stop_release_loss
+
+  !> Power the moving ground ends put in through the engaged stops at positions x + dx,
+  !> velocities v, time t: the stop pushes its ground end (coefficient -n_b) with -n_b F, so
+  !> the ground, moving at w', does n_b F w' on it.
+  pure real(wp) function stop_drive_power(scene, engaged, x, dx, v, t) result(power)
+    type(scene_type), intent(in) :: scene
+    logical, intent(in) :: engaged(:)
+    real(wp), intent(in) :: x(:), dx(:), v(:), t
+    integer :: j, r
+    power = 0.0_wp
+    do j = 1, scene%n_stops
+      r = scene%n_rows + j
+      if (.not. engaged(j) .or. scene%row_drive(r) == 0) cycle
+      power = power + scene%row_normal(2, r) * stop_push(scene, j, x, dx, v, t) * row_anchor(scene, r, 1, t)
+    end do
+  end function stop_drive_power
 end module impact1d_elements

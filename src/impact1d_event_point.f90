@@ -57,7 +57,10 @@ contains
     logical :: switched
 
     if (scene%n_stops > 0) then
-      call switch_stops(scene, which, s, mode%engaged, sink, stats, switched)
+      call state_force(scene, s, f, mode%engaged)
+      call mode%acceleration(f, acc)
+      if (initial) acc = f / scene%pair%mass
+      call switch_stops(scene, which, s, acc, mode%engaged, sink, stats, switched)
       if (switched .or. initial) call rk%set_springs(scene, mode%engaged)
     end if
     call state_force(scene, s, f, mode%engaged)
@@ -203,10 +206,13 @@ contains
   !> an impact on its row (no velocity changes); an engaged one releases when its force
   !> F = -(k gap + c gap') has fallen to zero (located, or within rounding), logged as
   !> release_<row>; one released inside (gap < 0) engages again when F has risen to zero.
-  subroutine switch_stops(scene, which, s, engaged, sink, stats, switched)
+  !> acc: the accelerations in the mode so far (a stop at its limit with its ends at rest
+  !> relative to each other engages when they accelerate into it).
+  subroutine switch_stops(scene, which, s, acc, engaged, sink, stats, switched)
     type(scene_type), intent(in) :: scene
     type(located_type), intent(in) :: which
     type(lane_state_type), intent(in) :: s
+    real(wp), intent(in) :: acc(max_lanes)
     integer, intent(inout) :: engaged   !< the stops engaged (bits)
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
@@ -233,10 +239,13 @@ contains
         cycle
       end if
       if (g > stop_gap_band(scene, r, s)) cycle
-      ! At the limit (gap within rounding) the stop engages when its ends approach; inside
-      ! it, when its force has risen to zero.
+      ! At the limit (gap within rounding) the stop engages when its ends approach, or, at
+      ! rest relative to each other (a body set down on a compliant floor), accelerate into
+      ! it (else the gap closing is located at once again and again); inside it, when its
+      ! force has risen to zero.
       if (g >= -stop_gap_band(scene, r, s)) then
-        engage = u < -velocity_rounding * maxval(abs(s%v))
+        engage = u < -velocity_rounding * maxval(abs(s%v)) .or. (u <= velocity_rounding * maxval(abs(s%v)) &
+          .and. dot_product(scene%pair%normal(:, r), acc) < 0.0_wp)
       else
         engage = force > tol .or. (located .and. force >= -tol)
       end if

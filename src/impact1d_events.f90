@@ -6,7 +6,7 @@ module impact1d_events
   use impact1d_kinds, only: wp
   implicit none
   private
-  public :: hermite, earliest_crossing, poly_value
+  public :: hermite, earliest_crossing, poly_value, stop_force_cubic
 
 contains
 
@@ -21,6 +21,16 @@ contains
     c(2) = (3.0_wp * dx / h - 2.0_wp * v0 - v1) / h
     c(3) = (v0 + v1 - 2.0_wp * dx / h) / h**2
   end function hermite
+
+  !> A compliant stop's force F = -(k g + c g') (stiffness k, damping c) on a gap cubic
+  !> g(theta) (docs/method.md section 10), a cubic too, and its tolerance: the gap's q
+  !> carried through the same combination (both engines' stop location).
+  pure subroutine stop_force_cubic(k, c, g, q, force, tol)
+    real(wp), intent(in) :: k, c, g(0:3), q(0:3)
+    real(wp), intent(out) :: force(0:3), tol(0:3)
+    force = -[k * g(0) + c * g(1), k * g(1) + 2.0_wp * c * g(2), k * g(2) + 3.0_wp * c * g(3), k * g(3)]
+    tol = k * q + c * [q(1), 2.0_wp * q(2), 3.0_wp * q(3), 0.0_wp]
+  end subroutine stop_force_cubic
 
   pure real(wp) function poly_value(p, theta)
     real(wp), intent(in) :: p(0:3), theta

@@ -5,7 +5,7 @@ module impact1d_location
   use impact1d_kinds, only: wp, eps_wp
   use impact1d_scene, only: scene_type
   use impact1d_modes, only: mode_type, max_holds, pair_rows
-  use impact1d_events, only: earliest_crossing
+  use impact1d_events, only: earliest_crossing, stop_force_cubic
   use impact1d_impacts, only: normal_velocity
   use impact1d_state, only: lane_state_type
   use impact1d_lanes, only: max_lanes
@@ -193,10 +193,7 @@ contains
           located_type(located_row, r), theta, which)
         cycle
       end if
-      associate (k => scene%row_k(r), d => scene%row_c(r))
-        force = -[k * g(0) + d * g(1), k * g(1) + 2.0_wp * d * g(2), k * g(2) + 3.0_wp * d * g(3), k * g(3)]
-        tol = k * q + d * [q(1), 2.0_wp * q(2), 3.0_wp * q(3), 0.0_wp]
-      end associate
+      call stop_force_cubic(scene%row_k(r), scene%row_c(r), g, q, force, tol)
       tol(0) = max(tol(0), stop_force_band(scene, r, a))
       ! Engaged: F >= 0 until it falls through zero. Released inside: F < 0 until it rises.
       if (.not. engaged) force = -force

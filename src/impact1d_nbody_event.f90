@@ -9,7 +9,7 @@ module impact1d_nbody_event
   use impact1d_error, only: error_type, raise, status_simulation, fmt
   use impact1d_scene, only: scene_type
   use impact1d_state, only: state_type, add_compensated
-  use impact1d_output, only: sink_type, run_stats, class_impact, class_rest, class_stick, class_slip
+  use impact1d_output, only: sink_type, run_stats, class_impact, class_rest, class_stick, class_slip, class_release
   use impact1d_yardsticks, only: gap_rounding, velocity_rounding, time_rounding, energy_rounding, same_instant, &
     force_scale
   use impact1d_event_log, only: event_log_type, log_event
@@ -23,7 +23,7 @@ module impact1d_nbody_event
   use impact1d_body_mode, only: body_mode_type, mode_work_type, solve_body_mode, mode_solved, max_dense_unknowns, &
     drive_accelerations, shift_to_drives, drive_components
   use impact1d_nbody_step, only: nbody_force, nbody_rate, row_gap, row_velocity, row_gap_tolerance, &
-    found_row, found_body, mode_acceleration, ground_motion
+    found_row, found_body, found_stop, mode_acceleration, ground_motion, stop_gap_band, stop_force_band
   implicit none
   private
   public :: point_work_type, new_point_work, nbody_event_point
@@ -68,8 +68,17 @@ contains
     type(body_mode_type) :: new
     integer :: k, i, status
 
-    call nbody_force(scene, s%t, s%x, s%x_lo, s%v, f)
-    call nbody_rate(scene, s%t, s%v, df)
+    if (scene%n_stops > 0) then
+      call nbody_force(scene, s%t, s%x, s%x_lo, s%v, f, mode%engaged)
+      if (initial) then
+        acc = f / scene%body_mass
+      else
+        call mode_acceleration(scene, mode, s%t, f, acc)
+      end if
+      call switch_stops(scene, found, index, s, acc, mode%engaged, sink, stats)
+    end if
+    call nbody_force(scene, s%t, s%x, s%x_lo, s%v, f, mode%engaged)
+    call nbody_rate(scene, s%t, s%v, df, mode%engaged)
     call close_rows(scene, initial, merge(index, 0, found == found_row), s, closed)
     ! Velocity scale of each body entering this event point: impulses redistribute velocity
     ! but cannot create precision, so what is below its rounding is zero.
@@ -95,8 +104,8 @@ contains
 
     ! Dampers pull with the velocities the impacts left.
     if (scene%springs%present) then
-      call nbody_force(scene, s%t, s%x, s%x_lo, s%v, f)
-      call nbody_rate(scene, s%t, s%v, df)
+      call nbody_force(scene, s%t, s%x, s%x_lo, s%v, f, mode%engaged)
+      call nbody_rate(scene, s%t, s%v, df, mode%engaged)
     end if
     do k = 1, scene%n_rows
       candidate(k) = closed(k)
@@ -119,6 +128,62 @@ contains
     call log_mode_change(scene, initial, f, df, candidate, new, s, event_log, sink, stats)
     mode = new
   end subroutine nbody_event_point
+
+  !> The compliant stops at this instant (docs/method.md section 10; impact1d_event_point's
+  !> switch_stops for the two-body engine): an open stop whose gap has closed (located, or
+  !> within its rounding) engages when its ends approach, logged as an impact on its row (no
+  !> velocity changes); an engaged one releases when its force F = -(k gap + c gap') has
+  !> fallen to zero (located, or within rounding), logged as release_<row>; one released
+  !> inside (gap < 0) engages again when F has risen to zero. acc: the accelerations in the
+  !> mode so far (a stop at its limit with its ends at rest relative to each other engages
+  !> when they accelerate into it).
+  subroutine switch_stops(scene, found, index, s, acc, engaged, sink, stats)
+    type(scene_type), intent(in) :: scene
+    integer, intent(in) :: found, index
+    type(state_type), intent(in) :: s
+    real(wp), intent(in) :: acc(:)
+    logical, intent(inout) :: engaged(:)
+    class(sink_type), intent(inout) :: sink
+    type(run_stats), intent(inout) :: stats
+    real(wp) :: g, u, force, tol, speed
+    integer :: j, r
+    logical :: located, engage
+    do j = 1, scene%n_stops
+      r = scene%n_rows + j
+      g = row_gap(scene, r, s)
+      u = row_velocity(scene, r, s%v, s%t)
+      force = -(scene%row_k(r) * g + scene%row_c(r) * u)
+      tol = stop_force_band(scene, r, s)
+      located = (found == found_row .or. found == found_stop) .and. index == r
+      ! A located crossing switches where the force is zero within rounding (refine's
+      ! Newton may stop short of it: the next step finds it again); one the location missed
+      ! switches where the force is past zero.
+      if (engaged(j)) then
+        if (force < -tol .or. (located .and. force <= tol)) then
+          engaged(j) = .false.
+          call log_event(scene, sink, stats, s%t, class_release, r, s%v, s%v)
+        end if
+        cycle
+      end if
+      if (g > stop_gap_band(scene, r, s)) cycle
+      ! At the limit (gap within rounding) the stop engages when its ends approach (relative
+      ! to a moving ground end), or, at rest relative to each other (a body set down on a
+      ! compliant floor), accelerate into it (else the gap closing is located at once again
+      ! and again); inside it, when its force has risen to zero.
+      if (g >= -stop_gap_band(scene, r, s)) then
+        speed = maxval(abs(s%v))
+        if (scene%drives%n > 0) speed = max(speed, abs(ground_motion(scene, r, s%t, 1)))
+        engage = u < -velocity_rounding * speed .or. (u <= velocity_rounding * speed .and. &
+          row_velocity(scene, r, acc) + ground_motion(scene, r, s%t, 2) < 0.0_wp)
+      else
+        engage = force > tol .or. (located .and. force >= -tol)
+      end if
+      if (engage) then
+        engaged(j) = .true.
+        call log_event(scene, sink, stats, s%t, class_impact, r, s%v, s%v)
+      end if
+    end do
+  end subroutine switch_stops
 
   !> solve_body_mode at time t: with moving grounds, on the forces as seen from the ground
   !> the candidate rows hold each body to (impact1d_body_mode's shift_to_drives).

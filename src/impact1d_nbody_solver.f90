@@ -13,7 +13,7 @@ module impact1d_nbody_solver
   use impact1d_output, only: sink_type, run_stats, emit_bodies, checkpoint
   use impact1d_event_log, only: event_log_type
   use impact1d_yardsticks, only: velocity_rounding
-  use impact1d_elements, only: element_potential
+  use impact1d_elements, only: element_potential, stop_potential
   use impact1d_body_mode, only: body_mode_type, new_mode
   use impact1d_nbody_step, only: nbody_step, nbody_force, locate_nbody, refine_nbody, gaps_hold, row_gap, &
     row_velocity, row_gap_tolerance, found_none, found_row
@@ -106,6 +106,11 @@ contains
     s%x = scene%body_x0
     s%v = scene%body_v0
     call new_mode(scene%n_bodies, scene%n_rows, r%mode, r%work%mode)
+    ! The compliant stops, none engaged (a scene starts outside every limit).
+    if (scene%n_stops > 0) then
+      allocate(r%mode%engaged(scene%n_stops))
+      r%mode%engaged = .false.
+    end if
     call new_point_work(scene%n_bodies, r%work)
     call r%event_log%allocate_log(scene%n_rows, scene%n_bodies)
     r%polynomial = scene%forcing%is_polynomial() .and. .not. scene%springs%present .and. scene%drives%polynomial &
@@ -144,6 +149,7 @@ contains
     else
       pe = element_potential(scene, s%x, s%x_lo)
     end if
+    if (scene%n_stops > 0) pe = pe + stop_potential(scene, s%x, s%x_lo, s%t)
   end function potential
 
   !> One step from s toward t_stop, ended at the earliest event located in it (found, index)

@@ -7,10 +7,10 @@ module impact1d_nbody_step
   use impact1d_kinds, only: wp, eps_wp
   use impact1d_scene, only: scene_type
   use impact1d_state, only: state_type, add_compensated
-  use impact1d_events, only: hermite, earliest_crossing
+  use impact1d_events, only: hermite, earliest_crossing, stop_force_cubic
   use impact1d_yardsticks, only: gap_rounding, velocity_rounding, time_rounding
   use impact1d_elements, only: add_element_forces, add_moving_element_forces, add_element_rates, element_damping_power, &
-    element_drive_power
+    element_drive_power, add_stop_forces, add_stop_rates, stop_damping_power, stop_release_loss, stop_drive_power
   use impact1d_body_mode, only: body_mode_type, mode_work_type, solve_body_mode, same_mode, mode_solved, &
     drive_accelerations, shift_to_drives
   use impact1d_friction_laws, only: slip, add_stribeck_forces, law_powers
@@ -18,18 +18,22 @@ module impact1d_nbody_step
   private
   public :: nbody_force, nbody_rate, nbody_step, row_gap, row_velocity, row_gap_tolerance, locate_nbody, &
     refine_nbody, gaps_hold, mode_acceleration, ground_motion
-  public :: found_none, found_row, found_body, found_hold
+  public :: found_none, found_row, found_body, found_hold, found_stop, stop_gap_band, stop_force_band
 
-  !> What a location found: a row's gap closing, a sliding body stopping, the mode failing.
-  integer, parameter :: found_none = 0, found_row = 1, found_body = 2, found_hold = 3
+  !> What a location found: a row's gap closing (a compliant stop's too: its engagement), a
+  !> sliding body stopping, the mode failing, a compliant stop's force crossing zero (its
+  !> release, or its engagement again while still inside).
+  integer, parameter :: found_none = 0, found_row = 1, found_body = 2, found_hold = 3, found_stop = 4
 
 contains
 
-  !> Applied forces f (external and elements') at time t, positions x + dx, velocities v.
-  pure subroutine nbody_force(scene, t, x, dx, v, f)
+  !> Applied forces f (external and elements') at time t, positions x + dx, velocities v;
+  !> engaged: the compliant stops engaged (a mode's; absent: none).
+  pure subroutine nbody_force(scene, t, x, dx, v, f, engaged)
     type(scene_type), intent(in) :: scene
     real(wp), intent(in) :: t, x(:), dx(:), v(:)
     real(wp), intent(out) :: f(:)
+    logical, intent(in), optional :: engaged(:)
     call scene%forcing%force_all(t, f)
     if (.not. scene%springs%present) return
     if (scene%drives%n > 0) then
@@ -37,6 +41,8 @@ contains
     else
       call add_element_forces(scene, x, dx, v, f)
     end if
+    ! (a still ground's stops ignore t)
+    if (scene%n_stops > 0 .and. present(engaged)) call add_stop_forces(scene, engaged, x, dx, v, f, t)
   end subroutine nbody_force
 
   !> Accelerations a in the mode under applied forces f at time t: a body held to a moving
@@ -76,11 +82,13 @@ contains
   end function ground_motion
 
 
-  !> Right derivative df of the applied forces at time t, velocities v.
-  pure subroutine nbody_rate(scene, t, v, df)
+  !> Right derivative df of the applied forces at time t, velocities v (engaged: as for
+  !> nbody_force).
+  pure subroutine nbody_rate(scene, t, v, df, engaged)
     type(scene_type), intent(in) :: scene
     real(wp), intent(in) :: t, v(:)
     real(wp), intent(out) :: df(:)
+    logical, intent(in), optional :: engaged(:)
     call scene%forcing%rate(t, df)
     if (.not. scene%springs%present) return
     if (scene%drives%n > 0) then
@@ -88,6 +96,7 @@ contains
     else
       call add_element_rates(scene, v, df)
     end if
+    if (scene%n_stops > 0 .and. present(engaged)) call add_stop_rates(scene, engaged, v, df, t)
   end subroutine nbody_rate
 
   !> Accelerations a in the mode under applied forces f at time t and velocities v, with
@@ -160,11 +169,14 @@ contains
         (element_damping_power(scene, v0) + 4.0_wp * element_damping_power(scene, vm) + &
         element_damping_power(scene, v1)))
     end if
+    if (scene%n_stops > 0 .and. scene%springs%has_damper) call stop_ledger()
 
   contains
 
     !> Stage k's accelerations acc at external forces fx, positions a%x + dx', velocities v,
-    !> time a%t + tau (moving grounds apart: moving_stage).
+    !> time a%t + tau (moving grounds and compliant stops apart: moving_stage; tested as one
+    !> sum, since a second test here, or the stops' forces below, and the compiler no longer
+    !> inlined stage: input/train.nml's run took 1.5% more instructions).
     subroutine stage(fx, dx_stage, v, acc, tau, k)
       real(wp), intent(in) :: fx(:), dx_stage(:), v(:), tau
       real(wp), intent(out) :: acc(:)
@@ -181,9 +193,9 @@ contains
       call mode%acceleration(f, acc)
     end subroutine stage
 
-    !> stage with moving grounds at time t: and the power they put in; with a friction law
-    !> (with or without moving grounds: their procedures take none too), friction's loss and
-    !> the belts' power (loss(k), belt(k)).
+    !> stage with moving grounds, compliant stops or a friction law at time t: and the power
+    !> the grounds put in (a still ground's element ends are at w = 0 here, the same bits);
+    !> with a friction law, friction's loss and the belts' power (loss(k), belt(k)).
     subroutine moving_stage(fx, dx_stage, v, acc, t, drive_power, k)
       real(wp), intent(in) :: fx(:), dx_stage(:), v(:), t
       real(wp), intent(out) :: acc(:), drive_power
@@ -194,6 +206,10 @@ contains
         dx = dx_stage
         call add_moving_element_forces(scene, a%x, dx, v, f, t)
         drive_power = element_drive_power(scene, a%x, dx, v, t)
+        if (scene%n_stops > 0) then
+          call add_stop_forces(scene, mode%engaged, a%x, dx, v, f, t)
+          drive_power = drive_power + stop_drive_power(scene, mode%engaged, a%x, dx, v, t)
+        end if
       end if
       call law_acceleration(scene, mode, t, v, f, acc)
       drive_power = drive_power + held_drive_power(scene, mode, t, f, acc)
@@ -210,15 +226,25 @@ contains
         2.0_wp * (belt(2) + belt(3)) + belt(4)))
     end subroutine law_ledger
 
-    !> The step's end with moving grounds (or a friction law: moving_stage): the accelerations
-    !> there, and the work the prescribed motion did, by RK4's own quadrature of the stages'
-    !> power.
+    !> The step's end with moving grounds, compliant stops or a friction law (moving_stage):
+    !> the accelerations there, and the work the prescribed motion did, by RK4's own
+    !> quadrature of the stages' power (0 without moving grounds).
     subroutine drive_step_ledger()
       if (scene%springs%present) call add_moving_element_forces(scene, b%x, b%x_lo, v1, f, b%t)
+      if (scene%n_stops > 0) call add_stop_forces(scene, mode%engaged, b%x, b%x_lo, v1, f, b%t)
       call law_acceleration(scene, mode, b%t, v1, f, acc_end)
       call add_compensated(b%drive_work, b%drive_lo, step / 6.0_wp * (power(1) + 2.0_wp * (power(2) + &
         power(3)) + power(4)))
     end subroutine drive_step_ledger
+
+    !> The compliant stops' losses over the step: the engaged ones' dampers by Simpson's
+    !> rule, as the elements'; those released inside lose their stored energy exactly.
+    subroutine stop_ledger()
+      call add_compensated(b%damping_loss, b%damping_lo, step / 6.0_wp * &
+        (stop_damping_power(scene, mode%engaged, v0, a%t) + 4.0_wp * stop_damping_power(scene, mode%engaged, &
+        vm, a%t + half) + stop_damping_power(scene, mode%engaged, v1, a%t + step)) + &
+        stop_release_loss(scene, mode%engaged, a%x, a%x_lo, b%x, b%x_lo, a%t, b%t))
+    end subroutine stop_ledger
   end subroutine nbody_step
 
   !> Bodies held to a moving ground move with it exactly over the step from a to b (by w(t +
@@ -353,26 +379,13 @@ contains
     found = found_none
     index = 0
     call dense_output(a, b, step, c)
-    call nbody_force(scene, a%t, a%x, a%x_lo, a%v, f)
+    call nbody_force(scene, a%t, a%x, a%x_lo, a%v, f, mode%engaged)
     if (scene%stribeck) call add_stribeck_forces(scene, mode%sgn, a%v, f)
     call mode_acceleration(scene, mode, a%t, f, acc0)
     acc_rounding = 1.0e3_wp * eps_wp * sum(abs(f)) / minval(scene%body_mass)
     do k = 1, scene%n_rows
       if (mode%active(k)) cycle
-      associate (ea => scene%row_body(1, k), eb => scene%row_body(2, k), n => scene%row_normal(:, k))
-        p(0) = row_gap(scene, k, a)
-        p(1:3) = n(2) * c(:, eb)
-        q(1:3) = gap_rounding * abs(c(:, eb))
-        if (ea > 0) then
-          p(1:3) = p(1:3) + n(1) * c(:, ea)
-          q(1:3) = q(1:3) + gap_rounding * abs(c(:, ea))
-        else if (scene%drives%n > 0) then
-          ! A moving ground end on its own cubic over the step (exact for ground_v; the
-          ! step's end is checked on the exact w: gaps_hold).
-          if (scene%row_drive(k) > 0) p(1:3) = p(1:3) + hermite(-n(2) * scene%drives%displacement( &
-            scene%row_drive(k), a%t, step), ground_motion(scene, k, a%t, 1), ground_motion(scene, k, a%t + step, 1), step)
-        end if
-      end associate
+      call gap_cubic(scene, k, a, c, step, p, q)
       if (p(0) - step * (abs(p(1)) + step * (abs(p(2)) + step * abs(p(3)))) > 0.0_wp) cycle
       q(0) = row_gap_tolerance(scene, k, a, 0.0_wp)
       q(2) = q(2) + acc_rounding
@@ -401,10 +414,99 @@ contains
         index = i
       end if
     end do
+    if (scene%n_stops > 0) call locate_stops(scene, mode, a, c, step, acc0, acc_rounding, theta, found, index)
     if (mode%held .and. (scene%forcing%varies .or. scene%springs%present .or. .not. scene%drives%polynomial &
         .or. scene%stribeck)) &
       call mode_crossing(scene, mode, work, a, c, min(theta, step), theta, found)
   end subroutine locate_nbody
+
+  !> Row k's gap over the step from a with dense output c, as a cubic p in theta, and the
+  !> rounding of its terms of order 1 to 3 (q(1:3); q(0) is left to the caller).
+  subroutine gap_cubic(scene, k, a, c, step, p, q)
+    type(scene_type), intent(in) :: scene
+    integer, intent(in) :: k
+    type(state_type), intent(in) :: a
+    real(wp), intent(in) :: c(:, :), step
+    real(wp), intent(out) :: p(0:3), q(0:3)
+    q(0) = 0.0_wp
+    associate (ea => scene%row_body(1, k), eb => scene%row_body(2, k), n => scene%row_normal(:, k))
+      p(0) = row_gap(scene, k, a)
+      p(1:3) = n(2) * c(:, eb)
+      q(1:3) = gap_rounding * abs(c(:, eb))
+      if (ea > 0) then
+        p(1:3) = p(1:3) + n(1) * c(:, ea)
+        q(1:3) = q(1:3) + gap_rounding * abs(c(:, ea))
+      else if (scene%drives%n > 0) then
+        ! A moving ground end on its own cubic over the step (exact for ground_v; the
+        ! step's end is checked on the exact w: gaps_hold).
+        if (scene%row_drive(k) > 0) p(1:3) = p(1:3) + hermite(-n(2) * scene%drives%displacement( &
+          scene%row_drive(k), a%t, step), ground_motion(scene, k, a%t, 1), ground_motion(scene, k, a%t + step, 1), step)
+      end if
+    end associate
+  end subroutine gap_cubic
+
+  !> The compliant stops' events on the step's dense output c from a (docs/method.md section
+  !> 10; impact1d_location's locate_stops for the two-body engine), if earlier than theta:
+  !> an open stop's gap closing (its engagement: found_row), an engaged stop's force F =
+  !> -(k gap + c gap') falling through zero (its release: found_stop), and a stop released
+  !> inside (gap < 0) whose F rises through zero (engaged again: found_stop). On the cubic
+  !> gap(theta) F is a cubic too; its tolerance is the gap's carried through the same
+  !> combination. acc0, acc_rounding: the mode's accelerations at a and their rounding.
+  subroutine locate_stops(scene, mode, a, c, step, acc0, acc_rounding, theta, found, index)
+    type(scene_type), intent(in) :: scene
+    type(body_mode_type), intent(in) :: mode
+    type(state_type), intent(in) :: a
+    real(wp), intent(in) :: c(:, :), step, acc0(:), acc_rounding
+    real(wp), intent(inout) :: theta
+    integer, intent(inout) :: found, index
+    real(wp) :: g(0:3), q(0:3), force(0:3), tol(0:3), band, candidate
+    integer :: j, r, kind
+    do j = 1, scene%n_stops
+      r = scene%n_rows + j
+      call gap_cubic(scene, r, a, c, step, g, q)
+      q(0) = row_gap_tolerance(scene, r, a, 0.0_wp)
+      q(2) = q(2) + acc_rounding + abs(g(2) - 0.5_wp * (row_velocity(scene, r, acc0) + ground_motion(scene, r, a%t, 2)))
+      band = stop_gap_band(scene, r, a)
+      if (.not. mode%engaged(j) .and. g(0) >= -band) then
+        ! Open (released at the limit, within its rounding, it is open): the gap closing.
+        candidate = earliest_crossing(g, step, [max(q(0), band), q(1:3)])
+        kind = found_row
+      else
+        call stop_force_cubic(scene%row_k(r), scene%row_c(r), g, q, force, tol)
+        tol(0) = max(tol(0), stop_force_band(scene, r, a))
+        ! Engaged: F >= 0 until it falls through zero. Released inside: F < 0 until it rises.
+        if (.not. mode%engaged(j)) force = -force
+        candidate = earliest_crossing(force, step, tol)
+        kind = found_stop
+      end if
+      if (candidate < theta) then
+        theta = candidate
+        found = kind
+        index = r
+      end if
+    end do
+  end subroutine locate_stops
+
+  !> Within how much of its limit a compliant stop row r is at it in state s: the gap's
+  !> rounding and what the rounding of the clock at an event moves it by, either way (a
+  !> stop released at its limit leaves it, 1e-17 m inside, at once: open, not engaged again).
+  pure real(wp) function stop_gap_band(scene, r, s) result(band)
+    type(scene_type), intent(in) :: scene
+    integer, intent(in) :: r
+    type(state_type), intent(in) :: s
+    band = row_gap_tolerance(scene, r, s, 0.0_wp) + &
+      time_rounding * max(abs(s%t), scene%dt) * abs(row_velocity(scene, r, s%v, s%t))
+  end function stop_gap_band
+
+  !> The rounding of stop row r's force -(k gap + c gap') in state s: what counts as zero at
+  !> its engagement and release.
+  pure real(wp) function stop_force_band(scene, r, s) result(band)
+    type(scene_type), intent(in) :: scene
+    integer, intent(in) :: r
+    type(state_type), intent(in) :: s
+    band = 1.0e3_wp * eps_wp * (scene%row_k(r) * max(abs(row_gap(scene, r, s)), stop_gap_band(scene, r, s)) + &
+      scene%row_c(r) * abs(row_velocity(scene, r, s%v, s%t))) + tiny(1.0_wp)
+  end function stop_force_band
 
   !> The first instant in (0, until] at which the mode no longer holds (the mode solved anew
   !> with its held rows as the candidates differs), by bisection on the dense output c of
@@ -447,8 +549,8 @@ contains
       if (scene%belts) then
         where (mode%stuck) v = scene%body_belt
       end if
-      call nbody_force(scene, a%t + tau, a%x, dx, v, f)
-      call nbody_rate(scene, a%t + tau, v, df)
+      call nbody_force(scene, a%t + tau, a%x, dx, v, f, mode%engaged)
+      call nbody_rate(scene, a%t + tau, v, df, mode%engaged)
       if (scene%drives%n > 0) call shift_to_drives(scene, a%t + tau, mode%active, f, df)
       probe = mode
       call solve_body_mode(scene, work, f, df, v, mode%active, probe, status)
@@ -513,14 +615,23 @@ contains
       if (scene%row_drive(index) > 0) located_step = limit
     end if
     call nbody_step(scene, mode, a, step, b)
-    if (found /= found_row .and. found /= found_body) return
+    if (found /= found_row .and. found /= found_body .and. found /= found_stop) return
     do iteration = 1, 8
       if (found == found_body) then
         value = slip(scene, index, b%v(index))
-        call nbody_force(scene, b%t, b%x, b%x_lo, b%v, f)
+        call nbody_force(scene, b%t, b%x, b%x_lo, b%v, f, mode%engaged)
         call law_acceleration(scene, mode, b%t, b%v, f, acc)
         slope = acc(index)
         tol = velocity_rounding * max(abs(a%v(index)), abs(value))
+      else if (found == found_stop) then
+        ! A stop's force F = -(k gap + c gap'), its rate -(k gap' + c gap'').
+        call nbody_force(scene, b%t, b%x, b%x_lo, b%v, f, mode%engaged)
+        call mode_acceleration(scene, mode, b%t, f, acc)
+        slope = row_velocity(scene, index, b%v, b%t)
+        value = -(scene%row_k(index) * row_gap(scene, index, b) + scene%row_c(index) * slope)
+        tol = stop_force_band(scene, index, b)
+        slope = -(scene%row_k(index) * slope + scene%row_c(index) * (row_velocity(scene, index, acc) + &
+          ground_motion(scene, index, b%t, 2)))
       else
         value = row_gap(scene, index, b)
         slope = row_velocity(scene, index, b%v, b%t)

@@ -150,8 +150,9 @@ module impact1d_scene
     real(wp), allocatable :: body_belt(:)            !< (N) its friction surface's velocity, m/s
     real(wp), allocatable :: body_v_s(:)             !< (N) Stribeck velocity, m/s (0: none)
     real(wp), allocatable :: body_viscous(:)         !< (N) viscous friction c_v m g, N s/m
-    !> The N-body engine's RK4 stages book powers (moving grounds or a friction law: its
-    !> nbody_step's moving_stage), set by build_scene: one test in the stage's hot path.
+    !> The N-body engine's RK4 stages book powers (moving grounds, a friction law or compliant
+    !> stops: its nbody_step's moving_stage), set by build_scene: one test in the stage's hot
+    !> path (a second test there and gfortran no longer inlines the stage).
     logical :: stage_powers = .false.
     ! elements: springs and dampers, each pulling its ends together with tension
     ! k ((x_b - x_a) - rest) + c (v_b - v_a) (a ground end at x = 0)
@@ -692,9 +693,6 @@ contains
     ! more run on the N-body engine (impact1d_nbody_solver), or, with the vissim method, on
     ! the N-body form of the tutorial's scheme (impact1d_vissim).
     if (is_nbody(input)) then
-      call refuse_stops(records, 'are not supported for more than two bodies yet (N = ' // &
-        trim(fmt(input%chain%n_bodies)) // '): the N-body engine has rigid contacts only', error)
-      if (allocated(error)) return
       call set_chain_bodies(input, tables, scene)
     else
       call set_bodies(input, tables, scene)
@@ -708,16 +706,16 @@ contains
     call set_laws(input, scene, error)
     if (allocated(error)) return
     if (scene%belts .or. scene%stribeck) call refuse_stops(records, 'cannot be combined with belt_v, v_s ' // &
-      'or c_v yet: such scenes run on the N-body engine, which has rigid contacts only', error)
+      'or c_v yet (the two have not been tested together)', error)
     if (allocated(error)) return
     call set_records(input, records, scene)
-    if (scene%drives%n > 0) call refuse_drives(scene, records, error)
+    if (scene%drives%n > 0) call refuse_drives(scene, error)
     if (allocated(error)) return
     call set_rows(scene, error)
     if (allocated(error)) return
     call set_springs(scene, error)
     if (allocated(error)) return
-    scene%stage_powers = scene%drives%n > 0 .or. scene%belts .or. scene%stribeck
+    scene%stage_powers = scene%drives%n > 0 .or. scene%belts .or. scene%stribeck .or. scene%n_stops > 0
 
     scene%t_end = input%value(i_t_end)
     scene%dt = input%value(i_dt)
@@ -766,19 +764,13 @@ contains
     end if
   end subroutine set_laws
 
-  !> A scene with a moving ground runs on the N-body engine (whatever its N), which has
-  !> neither the vissim method nor compliant stops.
-  subroutine refuse_drives(scene, records, error)
+  !> A scene with a moving ground runs on the N-body engine (whatever its N), which has no
+  !> vissim method.
+  subroutine refuse_drives(scene, error)
     type(scene_type), intent(in) :: scene
-    type(mechanism_records), intent(in) :: records
     type(error_type), allocatable, intent(inout) :: error
-    if (scene%method == 'vissim') then
-      call raise(error, status_input, "method = 'vissim' is the tutorial's fixed-step scheme: a scene " // &
-        'with a moving ground (ground_v, ground_amp) runs with method = ''event''')
-      return
-    end if
-    call refuse_stops(records, 'cannot be combined with a moving ground (ground_v, ground_amp) yet: ' // &
-      'such scenes run on the N-body engine, which has rigid contacts only', error)
+    if (scene%method == 'vissim') call raise(error, status_input, "method = 'vissim' is the tutorial's " // &
+      'fixed-step scheme: a scene with a moving ground (ground_v, ground_amp) runs with method = ''event''')
   end subroutine refuse_drives
 
   !> A scene whose engine has no compliant stops: the first &contact record with k named
@@ -994,13 +986,15 @@ contains
   subroutine set_springs(scene, error)
     type(scene_type), intent(inout) :: scene
     type(error_type), allocatable, intent(inout) :: error
-    integer :: ne, j
+    integer :: ne
     ne = scene%n_elements
     if (scene%n_bodies > 2) then
-      ! The N-body engine reads the element records themselves (impact1d_elements).
-      scene%springs%present = ne > 0
+      ! The N-body engine reads the element records themselves (impact1d_elements), and the
+      ! compliant stops' rows as elements of the same kind.
+      scene%springs%present = ne > 0 .or. scene%n_stops > 0
       scene%springs%omega = rate_bound(scene%element_body, scene%element_k, scene%element_c, &
         minval(scene%body_mass))
+      if (scene%n_stops > 0) scene%springs%omega = scene%springs%omega + stops_rate_bound(scene)
       return
     end if
     if (ne > pair_elements) then
@@ -1027,12 +1021,19 @@ contains
     ! Compliant stops are state-dependent forces too (springs' stepping and sampling; the pe
     ! and damping_loss columns from springs_named); the sampling rate bounds them as if
     ! engaged (sqrt(a + b) <= sqrt(a) + sqrt(b)).
-    associate (stops => [(j, j = scene%n_rows + 1, scene%n_rows + scene%n_stops)])
-      scene%springs%omega = scene%springs%omega + rate_bound(scene%row_body(:, stops), scene%row_k(stops), &
-        scene%row_c(stops), minval(scene%body_mass))
-    end associate
+    scene%springs%omega = scene%springs%omega + stops_rate_bound(scene)
     scene%springs%present = .true.
   end subroutine set_springs
+
+  !> The compliant stops' rate bound, as if engaged.
+  pure real(wp) function stops_rate_bound(scene)
+    type(scene_type), intent(in) :: scene
+    integer :: j
+    associate (stops => [(j, j = scene%n_rows + 1, scene%n_rows + scene%n_stops)])
+      stops_rate_bound = rate_bound(scene%row_body(:, stops), scene%row_k(stops), scene%row_c(stops), &
+        minval(scene%body_mass))
+    end associate
+  end function stops_rate_bound
 
   !> Room for nc contact records, none of their limits present yet.
   subroutine allocate_contacts(scene, nc)
