@@ -21,16 +21,17 @@
 !> beta = c, solved again until none does.
 !> The contact forces are unique where the bodies move; along a run of stuck bodies they are
 !> not (friction may carry what a row carries). impact1d_body_mode then prefers friction:
-!> it lets go every held row whose force friction alone can carry, which leaves held exactly
-!> the rows whose force is positive in the least force distribution. That distribution is
-!> the least solution of the difference constraints lambda_t - lambda_(t-1) in [L_t, U_t],
-!> lambda >= 0: two sweeps. Held rows are then chosen as impact1d_cluster_mode's hold_rows
-!> does (a force above zero, or zero and rising; with nothing stuck, also the closed
-!> force-free rows joining bodies not yet joined).
+!> it lets go a held row whose force friction alone can carry while the row's ends stay
+!> otherwise joined, which leaves held the rows whose force is positive in the least force
+!> distribution and, of the force-free closed rows, all but one on each cycle through the
+!> ground (hold_path_rows). That distribution is the least solution of the difference
+!> constraints lambda_t - lambda_(t-1) in [L_t, U_t], lambda >= 0: two sweeps. A body with
+!> static but no sliding friction that breaks away slides the way it leaves, as in
+!> impact1d_cluster_mode's mode_of.
 !> No allocation: path_reserve sizes the work once.
 module impact1d_path_mode
   use impact1d_kinds, only: wp, eps_wp
-  use impact1d_clusters, only: uf_join, row_closed
+  use impact1d_clusters, only: row_closed
   implicit none
   private
   public :: path_work_type, path_reserve, path_order, path_walk, path_mode
@@ -67,7 +68,9 @@ module impact1d_path_mode
     integer, allocatable :: first(:)
     real(wp), allocatable, dimension(:) :: bm, bb, bdb, bbeta
     logical, allocatable :: fixed(:)
-    integer, allocatable :: root(:)               !< (0:n) union-find of the held rows
+    !> (0:n - 1) the cycle through the ground of the row at each position (hold_path_rows), 0 none;
+    !> (n) per cycle, its force-free rows still to visit, -1 once one is let go
+    integer, allocatable :: cycle(:), remaining(:)
     real(wp) :: tol_f = 0, tol_rate = 0           !< zero force and rate (the cluster's)
   end type path_work_type
 
@@ -81,14 +84,14 @@ contains
       if (size(work%order) >= n) return
       deallocate(work%order, work%edge, work%coef, work%adj, work%degree, work%position, work%lo, work%dlo, work%hi, &
         work%dhi, work%fw, work%dfw, work%bw, work%dbw, work%gone, work%first, work%bm, work%bb, work%bdb, &
-        work%bbeta, work%fixed, work%root)
+        work%bbeta, work%fixed, work%cycle, work%remaining)
       call free_solution(work%x)
       call free_solution(work%trial)
     end if
     allocate(work%order(n), work%edge(n), work%coef(n), work%adj(2, n), work%degree(n), work%position(n), work%lo(n), &
       work%dlo(n), work%hi(n), work%dhi(n), work%fw(0:n), work%dfw(0:n), work%bw(0:n), work%dbw(0:n), &
       work%gone(0:n), work%first(n + 2), work%bm(n + 1), work%bb(n + 1), work%bdb(n + 1), work%bbeta(n + 1), &
-      work%fixed(n + 1), work%root(0:n))
+      work%fixed(n + 1), work%cycle(0:n), work%remaining(n))
     call new_solution(work%x, n)
     call new_solution(work%trial, n)
   end subroutine path_reserve
@@ -245,9 +248,14 @@ contains
       x%sgn(t) = 0.0_wp
       if (velocity(i) /= 0.0_wp) then
         if (friction(i) > 0.0_wp) x%sgn(t) = sign(1.0_wp, velocity(i))
-      else if (x%boxed(t)) then
-        x%stuck(t) = still(mass(i), x%u(t), x%du(t), work%tol_f, work%tol_rate)
-        if (x%stuck(t)) cycle
+      else if (x%boxed(t) .or. x%broken(t)) then
+        ! A body at rest that moves slides the way it leaves; one broken away with no sliding
+        ! friction (mu = 0 < mus, no longer boxed) too, so that its stop is watched (as
+        ! impact1d_cluster_mode's mode_of).
+        if (still(mass(i), x%u(t), x%du(t), work%tol_f, work%tol_rate)) then
+          x%stuck(t) = x%boxed(t)
+          cycle
+        end if
         x%sgn(t) = work%s * sign(1.0_wp, merge(x%du(t), x%u(t), abs(mass(i) * x%u(t)) <= work%tol_f))
       end if
     end do
@@ -412,9 +420,14 @@ contains
 
   !> Held rows (module header), as impact1d_cluster_mode's hold_rows and impact1d_body_mode's
   !> prefer_friction choose them: first those with force (above tol_f, or at zero and rising);
-  !> then, in row order, the closed force-free rows joining bodies not yet joined - held
-  !> when nothing is stuck; else let go, unless the bodies then move otherwise (a fresh solve
-  !> of the two sides: a body that broke away pushed through the row may stick without it).
+  !> then the closed force-free rows, all held but one on each cycle through the ground. The
+  !> closed rows and stuck bodies join the bodies to each other and to the ground (the wall,
+  !> stuck bodies); along a path the only cycles are the runs of closed rows between two
+  !> stuck bodies or the wall and a stuck body. A force-free row off a cycle is held (its ends
+  !> are not otherwise joined: a frictionless body resting on a stuck one keeps its row). On a
+  !> cycle, in row order, the first row that can be let go with the bodies moving alike (a
+  !> fresh solve of the two sides: a body that broke away pushed through the row may stick
+  !> without it) is let go, or else the cycle's last, which the dense solve never holds.
   subroutine hold_path_rows(work, mass, force, rate, friction, static_friction, velocity, row_body, row_normal, &
       acceleration, acc_rate, active)
     type(path_work_type), intent(inout) :: work
@@ -422,13 +435,7 @@ contains
     real(wp), intent(in) :: row_normal(:, :), acceleration(:), acc_rate(:)
     integer, intent(in) :: row_body(:, :)
     logical, intent(out) :: active(:)
-    integer :: t, k, i
-    logical :: joined, any_stuck
-    work%root(0:work%n) = [(i, i = 0, work%n)]
-    do t = 1, work%n
-      if (work%x%stuck(t)) work%root(work%order(t)) = 0
-    end do
-    any_stuck = any(work%x%stuck(1:work%n))
+    integer :: t, k, c
     active = .false.
     work%gone(0:work%n) = .false.
     do t = 0, work%n - 1
@@ -437,19 +444,22 @@ contains
       if (work%fw(t) <= work%tol_f .and. (work%fw(t) < -work%tol_f .or. work%dfw(t) <= work%tol_rate)) cycle
       active(k) = closed(k)
     end do
-    do k = 1, size(active)
-      if (active(k)) joined = uf_join(work%root, row_body(1, k), row_body(2, k))
-    end do
+    call find_cycles()
     do k = 1, size(active)
       if (active(k) .or. .not. closed(k)) cycle
-      active(k) = uf_join(work%root, row_body(1, k), row_body(2, k))
-      if (.not. active(k) .or. .not. any_stuck) cycle
+      active(k) = .true.
       t = 0
-      if (k /= work%wall) t = work%position(row_body(1, k)) + work%position(row_body(2, k)) - &
-        max(work%position(row_body(1, k)), work%position(row_body(2, k)))
-      if (.not. moves_alike_without(t)) cycle
+      if (k /= work%wall) t = min(work%position(row_body(1, k)), work%position(row_body(2, k)))
+      c = work%cycle(t)
+      if (c == 0) cycle
+      if (work%remaining(c) < 0) cycle                  ! its cycle is cut: its ends are not otherwise joined
+      work%remaining(c) = work%remaining(c) - 1
+      if (work%remaining(c) > 0) then
+        if (.not. moves_alike_without(t)) cycle
+        work%gone(t) = .true.
+      end if
       active(k) = .false.
-      work%gone(t) = .true.
+      work%remaining(c) = -1
     end do
 
   contains
@@ -460,6 +470,43 @@ contains
       row_at = work%wall
       if (t > 0) row_at = work%edge(t)
     end function row_at
+
+    !> work%cycle and work%remaining: a closed row's cycle is numbered by its run's first
+    !> position + 1 when the run starts at the ground (the wall's row, or a stuck body) and
+    !> ends at a stuck body; the force-free rows (not yet active) counted per cycle.
+    subroutine find_cycles()
+      integer :: t, start
+      logical :: grounded
+      start = -1
+      do t = 0, work%n - 1
+        work%cycle(t) = 0
+        if (.not. closed_at(t)) then
+          start = -1
+          cycle
+        end if
+        if (t == 0) start = 0
+        if (t > 0) then
+          if (work%x%stuck(t)) start = t
+        end if
+        if (start >= 0) work%cycle(t) = start + 1
+      end do
+      grounded = .false.
+      work%remaining(1:work%n) = 0
+      do t = work%n - 1, 0, -1
+        if (t < work%n - 1) grounded = grounded .and. closed_at(t + 1)
+        grounded = grounded .or. work%x%stuck(t + 1)
+        if (.not. grounded) work%cycle(t) = 0
+        if (work%cycle(t) == 0) cycle
+        if (.not. active(row_at(t))) work%remaining(work%cycle(t)) = work%remaining(work%cycle(t)) + 1
+      end do
+    end subroutine find_cycles
+
+    !> Whether there is a row at position t and it is closed.
+    logical function closed_at(t)
+      integer, intent(in) :: t
+      closed_at = row_at(t) /= 0
+      if (closed_at) closed_at = closed(row_at(t))
+    end function closed_at
 
     !> Row k closed and staying closed: n.a and its rate zero (hold_rows' test).
     logical function closed(k)
