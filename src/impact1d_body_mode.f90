@@ -33,8 +33,6 @@ module impact1d_body_mode
   !> about 24 n^2 bytes, 2.4 GB here. A cluster whose rows form a path (a train) is solved
   !> in O(n) by impact1d_path_mode, whatever its size.
   integer, parameter, public :: max_dense_unknowns = 10000
-  !> Bodies past which a cluster whose rows form a path takes impact1d_path_mode (gathered_mode).
-  integer, parameter :: path_from = 64
 
   type :: body_mode_type
     logical, allocatable :: active(:)        !< (nr) rows held closed
@@ -271,11 +269,7 @@ contains
     integer, intent(in) :: nb, nr
     integer, intent(out) :: status
     work%candidate(1:nr) = .true.
-    ! Small paths go to the dense solve too: impact1d_path_mode does not have two of its
-    ! rules yet (a mu = 0 < mus body breaking away takes the direction it accelerates in,
-    ! cluster_mode's mode_of; a force-free held row stays held unless its ends are otherwise
-    ! joined, prefer_friction), so it takes only the clusters the dense solve would make slow.
-    if (.not. work%dense_only .and. nb > path_from) then
+    if (.not. work%dense_only) then
       if (path_order(work%path, nb, work%row_body(:, 1:nr), work%row_normal(:, 1:nr))) then
         call path_mode(work%path, work%mass(1:nb), work%force(1:nb), work%rate(1:nb), work%friction(1:nb), &
           work%static(1:nb), work%velocity(1:nb), work%row_body(:, 1:nr), work%row_normal(:, 1:nr), &
