@@ -186,19 +186,21 @@ contains
     work%needs_solve = .false.
     work%first = 0
     do i = 1, n
-      r = uf_find(work%root, i)
+      ! Flattened: root(i) is i's root from here on (no finds per look-up below).
+      work%root(i) = uf_find(work%root, i)
+      r = work%root(i)
       work%first(r + 1) = work%first(r + 1) + 1
       if (scene%body_static(i) > 0.0_wp .and. v(i) == 0.0_wp) work%needs_solve(r) = .true.
     end do
-    call bucket(work%first, work%member, [(uf_find(work%root, i), i = 1, n)])
+    call bucket(work%first, work%member, work%root(1:n))
     work%first_row = 0
     do k = 1, scene%n_rows
       if (.not. candidate(k)) cycle
-      r = uf_find(work%root, scene%row_body(2, k))
+      r = work%root(scene%row_body(2, k))
       work%first_row(r + 1) = work%first_row(r + 1) + 1
       work%needs_solve(r) = .true.
     end do
-    call bucket(work%first_row, work%row, [(merge(uf_find(work%root, scene%row_body(2, k)), 0, candidate(k)), &
+    call bucket(work%first_row, work%row, [(merge(work%root(scene%row_body(2, k)), 0, candidate(k)), &
       k = 1, scene%n_rows)])
   end subroutine partition
 
@@ -245,7 +247,9 @@ contains
     end do
     do j = 1, nr
       k = work%row(work%first_row(c) + j - 1)
-      work%row_body(:, j) = work%local(scene%row_body(:, k))
+      ! Element by element: a vector subscript here made a temporary (malloc, free) per row.
+      work%row_body(1, j) = work%local(scene%row_body(1, k))
+      work%row_body(2, j) = work%local(scene%row_body(2, k))
       work%row_normal(:, j) = scene%row_normal(:, k)
     end do
     call gathered_mode(work, nb, nr, status)
