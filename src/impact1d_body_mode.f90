@@ -247,10 +247,12 @@ contains
     end do
     do j = 1, nr
       k = work%row(work%first_row(c) + j - 1)
-      ! Element by element: a vector subscript here made a temporary (malloc, free) per row.
+      ! Element by element: a vector subscript here made a temporary (malloc, free) per row,
+      ! and a section a call of memcpy per row.
       work%row_body(1, j) = work%local(scene%row_body(1, k))
       work%row_body(2, j) = work%local(scene%row_body(2, k))
-      work%row_normal(:, j) = scene%row_normal(:, k)
+      work%row_normal(1, j) = scene%row_normal(1, k)
+      work%row_normal(2, j) = scene%row_normal(2, k)
     end do
     call gathered_mode(work, nb, nr, status)
     if (status /= cluster_solved) return
