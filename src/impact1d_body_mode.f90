@@ -34,8 +34,6 @@ module impact1d_body_mode
   !> about 24 n^2 bytes, 2.4 GB here. A cluster whose rows form a path (a train) is solved
   !> in O(n) by impact1d_path_mode, whatever its size.
   integer, parameter, public :: max_dense_unknowns = 10000
-  !> Bodies past which a cluster whose rows form a path takes impact1d_path_mode (gathered_mode).
-  integer, parameter :: path_from = 64
 
   type :: body_mode_type
     logical, allocatable :: active(:)        !< (nr) rows held closed
@@ -195,19 +193,21 @@ contains
     work%needs_solve = .false.
     work%first = 0
     do i = 1, n
-      r = uf_find(work%root, i)
+      ! Flattened: root(i) is i's root from here on (no finds per look-up below).
+      work%root(i) = uf_find(work%root, i)
+      r = work%root(i)
       work%first(r + 1) = work%first(r + 1) + 1
       if (scene%body_static(i) > 0.0_wp .and. slip(scene, i, v(i)) == 0.0_wp) work%needs_solve(r) = .true.
     end do
-    call bucket(work%first, work%member, [(uf_find(work%root, i), i = 1, n)])
+    call bucket(work%first, work%member, work%root(1:n))
     work%first_row = 0
     do k = 1, scene%n_rows
       if (.not. candidate(k)) cycle
-      r = uf_find(work%root, scene%row_body(2, k))
+      r = work%root(scene%row_body(2, k))
       work%first_row(r + 1) = work%first_row(r + 1) + 1
       work%needs_solve(r) = .true.
     end do
-    call bucket(work%first_row, work%row, [(merge(uf_find(work%root, scene%row_body(2, k)), 0, candidate(k)), &
+    call bucket(work%first_row, work%row, [(merge(work%root(scene%row_body(2, k)), 0, candidate(k)), &
       k = 1, scene%n_rows)])
   end subroutine partition
 
@@ -255,8 +255,12 @@ contains
     end do
     do j = 1, nr
       k = work%row(work%first_row(c) + j - 1)
-      work%row_body(:, j) = work%local(scene%row_body(:, k))
-      work%row_normal(:, j) = scene%row_normal(:, k)
+      ! Element by element: a vector subscript here made a temporary (malloc, free) per row,
+      ! and a section a call of memcpy per row.
+      work%row_body(1, j) = work%local(scene%row_body(1, k))
+      work%row_body(2, j) = work%local(scene%row_body(2, k))
+      work%row_normal(1, j) = scene%row_normal(1, k)
+      work%row_normal(2, j) = scene%row_normal(2, k)
     end do
     call gathered_mode(work, nb, nr, status)
     if (status /= cluster_solved) return
@@ -279,11 +283,7 @@ contains
     integer, intent(in) :: nb, nr
     integer, intent(out) :: status
     work%candidate(1:nr) = .true.
-    ! Small paths go to the dense solve too: impact1d_path_mode does not have two of its
-    ! rules yet (a mu = 0 < mus body breaking away takes the direction it accelerates in,
-    ! cluster_mode's mode_of; a force-free held row stays held unless its ends are otherwise
-    ! joined, prefer_friction), so it takes only the clusters the dense solve would make slow.
-    if (.not. work%dense_only .and. nb > path_from) then
+    if (.not. work%dense_only) then
       if (path_order(work%path, nb, work%row_body(:, 1:nr), work%row_normal(:, 1:nr))) then
         call path_mode(work%path, work%mass(1:nb), work%force(1:nb), work%rate(1:nb), work%friction(1:nb), &
           work%static(1:nb), work%velocity(1:nb), work%row_body(:, 1:nr), work%row_normal(:, 1:nr), &

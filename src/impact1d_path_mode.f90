@@ -21,16 +21,17 @@
 !> beta = c, solved again until none does.
 !> The contact forces are unique where the bodies move; along a run of stuck bodies they are
 !> not (friction may carry what a row carries). impact1d_body_mode then prefers friction:
-!> it lets go every held row whose force friction alone can carry, which leaves held exactly
-!> the rows whose force is positive in the least force distribution. That distribution is
-!> the least solution of the difference constraints lambda_t - lambda_(t-1) in [L_t, U_t],
-!> lambda >= 0: two sweeps. Held rows are then chosen as impact1d_cluster_mode's hold_rows
-!> does (a force above zero, or zero and rising; with nothing stuck, also the closed
-!> force-free rows joining bodies not yet joined).
+!> it lets go a held row whose force friction alone can carry while the row's ends stay
+!> otherwise joined, which leaves held the rows whose force is positive in the least force
+!> distribution and, of the force-free closed rows, all but one on each cycle through the
+!> ground (hold_path_rows). That distribution is the least solution of the difference
+!> constraints lambda_t - lambda_(t-1) in [L_t, U_t], lambda >= 0: two sweeps. A body with
+!> static but no sliding friction that breaks away slides the way it leaves, as in
+!> impact1d_cluster_mode's mode_of.
 !> No allocation: path_reserve sizes the work once.
 module impact1d_path_mode
   use impact1d_kinds, only: wp, eps_wp
-  use impact1d_clusters, only: uf_join, row_closed
+  use impact1d_clusters, only: row_closed
   implicit none
   private
   public :: path_work_type, path_reserve, path_order, path_walk, path_mode
@@ -63,11 +64,14 @@ module impact1d_path_mode
     real(wp), allocatable, dimension(:) :: lo, dlo, hi, dhi, fw, dfw, bw, dbw
     logical, allocatable :: gone(:)               !< (0:n) the row at the position is let go
     ! Blocks of the pooling (a stack of up to n + 1, the wall's block and a block a body):
-    ! first position, mass, sums, held at 0 (the wall's).
+    ! first position, mass, sums, their value and its rate (block_value), held at 0 (the wall's).
     integer, allocatable :: first(:)
-    real(wp), allocatable, dimension(:) :: bm, bb, bdb, bbeta
+    real(wp), allocatable, dimension(:) :: bm, bb, bdb, bbeta, bx, bdx
     logical, allocatable :: fixed(:)
-    integer, allocatable :: root(:)               !< (0:n) union-find of the held rows
+    !> (0:n - 1) the cycle through the ground of the row at each position (hold_path_rows), 0 none;
+    !> (n) per cycle, its force-free rows still to visit, -1 once one is let go
+    integer, allocatable :: cycle(:), remaining(:)
+    logical, allocatable :: shut(:)               !< (0:n - 1) the row at the position is closed
     real(wp) :: tol_f = 0, tol_rate = 0           !< zero force and rate (the cluster's)
   end type path_work_type
 
@@ -81,14 +85,14 @@ contains
       if (size(work%order) >= n) return
       deallocate(work%order, work%edge, work%coef, work%adj, work%degree, work%position, work%lo, work%dlo, work%hi, &
         work%dhi, work%fw, work%dfw, work%bw, work%dbw, work%gone, work%first, work%bm, work%bb, work%bdb, &
-        work%bbeta, work%fixed, work%root)
+        work%bbeta, work%bx, work%bdx, work%fixed, work%cycle, work%remaining, work%shut)
       call free_solution(work%x)
       call free_solution(work%trial)
     end if
     allocate(work%order(n), work%edge(n), work%coef(n), work%adj(2, n), work%degree(n), work%position(n), work%lo(n), &
       work%dlo(n), work%hi(n), work%dhi(n), work%fw(0:n), work%dfw(0:n), work%bw(0:n), work%dbw(0:n), &
       work%gone(0:n), work%first(n + 2), work%bm(n + 1), work%bb(n + 1), work%bdb(n + 1), work%bbeta(n + 1), &
-      work%fixed(n + 1), work%root(0:n))
+      work%bx(n + 1), work%bdx(n + 1), work%fixed(n + 1), work%cycle(0:n), work%remaining(n), work%shut(0:n))
     call new_solution(work%x, n)
     call new_solution(work%trial, n)
   end subroutine path_reserve
@@ -245,9 +249,14 @@ contains
       x%sgn(t) = 0.0_wp
       if (velocity(i) /= 0.0_wp) then
         if (friction(i) > 0.0_wp) x%sgn(t) = sign(1.0_wp, velocity(i))
-      else if (x%boxed(t)) then
-        x%stuck(t) = still(mass(i), x%u(t), x%du(t), work%tol_f, work%tol_rate)
-        if (x%stuck(t)) cycle
+      else if (x%boxed(t) .or. x%broken(t)) then
+        ! A body at rest that moves slides the way it leaves; one broken away with no sliding
+        ! friction (mu = 0 < mus, no longer boxed) too, so that its stop is watched (as
+        ! impact1d_cluster_mode's mode_of).
+        if (still(mass(i), x%u(t), x%du(t), work%tol_f, work%tol_rate)) then
+          x%stuck(t) = x%boxed(t)
+          cycle
+        end if
         x%sgn(t) = work%s * sign(1.0_wp, merge(x%du(t), x%u(t), abs(mass(i) * x%u(t)) <= work%tol_f))
       end if
     end do
@@ -285,12 +294,12 @@ contains
     logical, intent(in) :: wall
     real(wp), intent(in) :: mass(:)
     integer :: top, t, j
-    real(wp) :: x1, dx1, x2, dx2
     top = 0
     if (wall) then
       top = 1
       work%first(1) = lo - 1
       work%fixed(1) = .true.
+      call block_value(work, 1)
     end if
     do t = lo, hi
       top = top + 1
@@ -300,48 +309,47 @@ contains
       work%bb(top) = x%b(t)
       work%bdb(top) = x%db(t)
       work%bbeta(top) = x%beta(t)
+      call block_value(work, top)
       do while (top > 1)
-        call block_value(work, top - 1, x1, dx1)
-        call block_value(work, top, x2, dx2)
-        if (.not. greater(x1, dx1, x2, dx2, work%tol_f / (work%bm(top - 1) + work%bm(top)), &
-          work%tol_rate / (work%bm(top - 1) + work%bm(top)))) exit
+        if (.not. greater(work%bx(top - 1), work%bdx(top - 1), work%bx(top), work%bdx(top), &
+          work%tol_f / (work%bm(top - 1) + work%bm(top)), work%tol_rate / (work%bm(top - 1) + work%bm(top)))) exit
         top = top - 1
         work%fixed(top) = work%fixed(top) .or. work%fixed(top + 1)
         work%bm(top) = work%bm(top) + work%bm(top + 1)
         work%bb(top) = work%bb(top) + work%bb(top + 1)
         work%bdb(top) = work%bdb(top) + work%bdb(top + 1)
         work%bbeta(top) = work%bbeta(top) + work%bbeta(top + 1)
+        call block_value(work, top)
       end do
     end do
     work%first(top + 1) = hi + 1
     do j = 1, top
-      call block_value(work, j, x1, dx1)
       do t = max(work%first(j), lo), work%first(j + 1) - 1
-        x%u(t) = x1
-        x%du(t) = dx1
+        x%u(t) = work%bx(j)
+        x%du(t) = work%bdx(j)
       end do
     end do
   end subroutine pool
 
-  !> The minimiser of block j's summed f (a pair, lexicographic: the soft threshold of
-  !> (b, db) by beta, ties within rounding decided by the rate), 0 for the wall's block.
-  pure subroutine block_value(work, j, x, dx)
-    type(path_work_type), intent(in) :: work
+  !> Block j's value and rate (bx, bdx): the minimiser of its summed f (a pair,
+  !> lexicographic: the soft threshold of (b, db) by beta, ties within rounding decided by
+  !> the rate), 0 for the wall's block.
+  pure subroutine block_value(work, j)
+    type(path_work_type), intent(inout) :: work
     integer, intent(in) :: j
-    real(wp), intent(out) :: x, dx
     real(wp) :: b, db, k
-    x = 0.0_wp
-    dx = 0.0_wp
+    work%bx(j) = 0.0_wp
+    work%bdx(j) = 0.0_wp
     if (work%fixed(j)) return
     b = work%bb(j)
     db = work%bdb(j)
     k = work%bbeta(j)
     if (greater(b, db, k, 0.0_wp, work%tol_f, work%tol_rate)) then
-      x = max(b - k, 0.0_wp) / work%bm(j)
-      dx = db / work%bm(j)
+      work%bx(j) = max(b - k, 0.0_wp) / work%bm(j)
+      work%bdx(j) = db / work%bm(j)
     else if (greater(-k, 0.0_wp, b, db, work%tol_f, work%tol_rate)) then
-      x = min(b + k, 0.0_wp) / work%bm(j)
-      dx = db / work%bm(j)
+      work%bx(j) = min(b + k, 0.0_wp) / work%bm(j)
+      work%bdx(j) = db / work%bm(j)
     end if
   end subroutine block_value
 
@@ -412,9 +420,14 @@ contains
 
   !> Held rows (module header), as impact1d_cluster_mode's hold_rows and impact1d_body_mode's
   !> prefer_friction choose them: first those with force (above tol_f, or at zero and rising);
-  !> then, in row order, the closed force-free rows joining bodies not yet joined - held
-  !> when nothing is stuck; else let go, unless the bodies then move otherwise (a fresh solve
-  !> of the two sides: a body that broke away pushed through the row may stick without it).
+  !> then the closed force-free rows, all held but one on each cycle through the ground. The
+  !> closed rows and stuck bodies join the bodies to each other and to the ground (the wall,
+  !> stuck bodies); along a path the only cycles are the runs of closed rows between two
+  !> stuck bodies or the wall and a stuck body. A force-free row off a cycle is held (its ends
+  !> are not otherwise joined: a frictionless body resting on a stuck one keeps its row). On a
+  !> cycle, in row order, the first row that can be let go with the bodies moving alike (a
+  !> fresh solve of the two sides: a body that broke away pushed through the row may stick
+  !> without it) is let go, or else the cycle's last, which the dense solve never holds.
   subroutine hold_path_rows(work, mass, force, rate, friction, static_friction, velocity, row_body, row_normal, &
       acceleration, acc_rate, active)
     type(path_work_type), intent(inout) :: work
@@ -422,34 +435,34 @@ contains
     real(wp), intent(in) :: row_normal(:, :), acceleration(:), acc_rate(:)
     integer, intent(in) :: row_body(:, :)
     logical, intent(out) :: active(:)
-    integer :: t, k, i
-    logical :: joined, any_stuck
-    work%root(0:work%n) = [(i, i = 0, work%n)]
-    do t = 1, work%n
-      if (work%x%stuck(t)) work%root(work%order(t)) = 0
-    end do
-    any_stuck = any(work%x%stuck(1:work%n))
+    integer :: t, k, c
     active = .false.
     work%gone(0:work%n) = .false.
     do t = 0, work%n - 1
       k = row_at(t)
+      work%shut(t) = .false.
       if (k == 0) cycle
+      ! Closed and staying closed: n.a and its rate zero (cluster_mode's hold_rows' test).
+      work%shut(t) = row_closed(row_body, row_normal, k, mass, acceleration, acc_rate, work%tol_f, work%tol_rate)
       if (work%fw(t) <= work%tol_f .and. (work%fw(t) < -work%tol_f .or. work%dfw(t) <= work%tol_rate)) cycle
-      active(k) = closed(k)
+      active(k) = work%shut(t)
     end do
+    call find_cycles()
     do k = 1, size(active)
-      if (active(k)) joined = uf_join(work%root, row_body(1, k), row_body(2, k))
-    end do
-    do k = 1, size(active)
-      if (active(k) .or. .not. closed(k)) cycle
-      active(k) = uf_join(work%root, row_body(1, k), row_body(2, k))
-      if (.not. active(k) .or. .not. any_stuck) cycle
       t = 0
-      if (k /= work%wall) t = work%position(row_body(1, k)) + work%position(row_body(2, k)) - &
-        max(work%position(row_body(1, k)), work%position(row_body(2, k)))
-      if (.not. moves_alike_without(t)) cycle
+      if (k /= work%wall) t = min(work%position(row_body(1, k)), work%position(row_body(2, k)))
+      if (active(k) .or. .not. work%shut(t)) cycle
+      active(k) = .true.
+      c = work%cycle(t)
+      if (c == 0) cycle
+      if (work%remaining(c) < 0) cycle                  ! its cycle is cut: its ends are not otherwise joined
+      work%remaining(c) = work%remaining(c) - 1
+      if (work%remaining(c) > 0) then
+        if (.not. moves_alike_without(t)) cycle
+        work%gone(t) = .true.
+      end if
       active(k) = .false.
-      work%gone(t) = .true.
+      work%remaining(c) = -1
     end do
 
   contains
@@ -461,11 +474,35 @@ contains
       if (t > 0) row_at = work%edge(t)
     end function row_at
 
-    !> Row k closed and staying closed: n.a and its rate zero (hold_rows' test).
-    logical function closed(k)
-      integer, intent(in) :: k
-      closed = row_closed(row_body, row_normal, k, mass, acceleration, acc_rate, work%tol_f, work%tol_rate)
-    end function closed
+    !> work%cycle and work%remaining: a closed row's cycle is numbered by its run's first
+    !> position + 1 when the run starts at the ground (the wall's row, or a stuck body) and
+    !> ends at a stuck body; the force-free rows (not yet active) counted per cycle.
+    subroutine find_cycles()
+      integer :: t, start
+      logical :: grounded
+      start = -1
+      do t = 0, work%n - 1
+        work%cycle(t) = 0
+        if (.not. work%shut(t)) then
+          start = -1
+          cycle
+        end if
+        if (t == 0) start = 0
+        if (t > 0) then
+          if (work%x%stuck(t)) start = t
+        end if
+        if (start >= 0) work%cycle(t) = start + 1
+      end do
+      grounded = .false.
+      work%remaining(1:work%n) = 0
+      do t = work%n - 1, 0, -1
+        if (t < work%n - 1) grounded = grounded .and. work%shut(t + 1)
+        grounded = grounded .or. work%x%stuck(t + 1)
+        if (.not. grounded) work%cycle(t) = 0
+        if (work%cycle(t) == 0) cycle
+        if (.not. active(row_at(t))) work%remaining(work%cycle(t)) = work%remaining(work%cycle(t)) + 1
+      end do
+    end subroutine find_cycles
 
     !> Whether the bodies move as they do with the rows let go so far and the row at t too:
     !> the stretch of the path it was in solved afresh as two.

@@ -12,7 +12,7 @@
 program test_path_mode
   use impact1d_kinds, only: wp
   use impact1d_body_mode, only: mode_work_type, mode_reserve, gathered_mode, mode_solved
-  use impact1d_path_mode, only: path_order
+  use impact1d_path_mode, only: path_order, path_mode
   use impact1d_path_impact, only: path_impact_work_type, path_impact_reserve, path_projection
   use impact1d_cluster_impact, only: impact_work_type, impact_reserve, cluster_projection
   use impact1d_lcp, only: lcp_solved
@@ -20,39 +20,13 @@ program test_path_mode
   implicit none
   integer, parameter :: max_n = 12, trials = 40000
   type(mode_work_type) :: work
-  integer :: trial, n, nr, status, differ, shown, paths, motion = 0
-  logical :: stuck(max_n), active(max_n + 1), same
-  real(wp) :: sgn(max_n)
+  integer :: trial
 
   call seed_random(7919, 11)
   call mode_reserve(work, max_n, max_n + 1)
-  differ = 0
-  shown = 0
-  paths = 0
-  do trial = 1, trials
-    call random_path(n, nr)
-    if (path_order(work%path, n, work%row_body(:, 1:nr), work%row_normal(:, 1:nr))) paths = paths + 1
-    work%dense_only = .true.
-    call gathered_mode(work, n, nr, status)
-    if (status /= mode_solved) cycle
-    stuck(1:n) = work%stuck(1:n)
-    sgn(1:n) = work%sgn(1:n)
-    active(1:nr) = work%active(1:nr)
-    work%dense_only = .false.
-    call gathered_mode(work, n, nr, status)
-    same = status == mode_solved .and. all(stuck(1:n) .eqv. work%stuck(1:n)) .and. all(sgn(1:n) == work%sgn(1:n)) &
-      .and. all(active(1:nr) .eqv. work%active(1:nr))
-    if (.not. (all(stuck(1:n) .eqv. work%stuck(1:n)) .and. all(sgn(1:n) == work%sgn(1:n)))) motion = motion + 1
-    if (.not. same) then
-      differ = differ + 1
-      if (shown < 5) call show(n, nr, stuck, sgn, active)
-      shown = shown + 1
-    end if
-  end do
-  print '(a, i0, a, i0, a, i0, a, i0)', 'random paths: ', trials, ', accepted as paths ', paths, ', modes differing ', &
-    differ, ', in motion ', motion
-  call check(paths == trials, 'every random path is taken by the path solve')
-  call check(differ == 0, 'the path solve finds the dense solve''s mode')
+  call compare_random(.false.)
+  call compare_random(.true.)
+  call seed_clusters()
   call not_paths()
   call rising_into_a_stuck_body()
   call projections()
@@ -61,9 +35,48 @@ program test_path_mode
 
 contains
 
-  !> A random cluster along a path (program header) in work's gathered arrays.
-  subroutine random_path(n, nr)
+  !> The path solve against the dense one on random paths (program header); resting: most
+  !> bodies at rest, unloaded and frictionless or with static friction only (mu = 0 < mus),
+  !> so that force-free rows, frictionless bodies resting on stuck ones and break-aways with
+  !> no sliding friction are common.
+  subroutine compare_random(resting)
+    logical, intent(in) :: resting
+    integer :: trial, n, nr, status, differ, shown, paths, motion
+    logical :: stuck(max_n), active(max_n + 1), same
+    real(wp) :: sgn(max_n)
+    differ = 0
+    shown = 0
+    paths = 0
+    motion = 0
+    do trial = 1, trials
+      call random_path(n, nr, resting)
+      if (path_order(work%path, n, work%row_body(:, 1:nr), work%row_normal(:, 1:nr))) paths = paths + 1
+      work%dense_only = .true.
+      call gathered_mode(work, n, nr, status)
+      if (status /= mode_solved) cycle
+      stuck(1:n) = work%stuck(1:n)
+      sgn(1:n) = work%sgn(1:n)
+      active(1:nr) = work%active(1:nr)
+      call path_solve(n, nr, status)
+      same = status == mode_solved .and. all(stuck(1:n) .eqv. work%stuck(1:n)) .and. all(sgn(1:n) == work%sgn(1:n)) &
+        .and. all(active(1:nr) .eqv. work%active(1:nr))
+      if (.not. (all(stuck(1:n) .eqv. work%stuck(1:n)) .and. all(sgn(1:n) == work%sgn(1:n)))) motion = motion + 1
+      if (.not. same) then
+        differ = differ + 1
+        if (shown < 5) call show(n, nr, stuck, sgn, active)
+        shown = shown + 1
+      end if
+    end do
+    print '(a, l2, a, i0, a, i0, a, i0, a, i0)', 'random paths (resting', resting, '): ', trials, ', accepted as paths ', &
+      paths, ', modes differing ', differ, ', in motion ', motion
+    call check(paths == trials, 'every random path is taken by the path solve')
+    call check(differ == 0, 'the path solve finds the dense solve''s mode')
+  end subroutine compare_random
+
+  !> A random cluster along a path (program header, compare_random) in work's gathered arrays.
+  subroutine random_path(n, nr, resting)
     integer, intent(out) :: n, nr
+    logical, intent(in) :: resting
     integer :: perm(max_n), row_of(max_n + 1), t, i, k, wall_end
     real(wp) :: s, r
     n = 1 + int(rand() * max_n)
@@ -98,8 +111,55 @@ contains
       work%velocity(i) = 0.0_wp
       if (r < 0.2_wp) work%velocity(i) = 1.0_wp
       if (r >= 0.2_wp .and. r < 0.35_wp) work%velocity(i) = -2.0_wp
+      if (.not. resting) cycle
+      work%force(i) = pick([0.0_wp, 0.0_wp, 0.0_wp, 1.0_wp, -1.0_wp, 4.0_wp * rand() - 2.0_wp])
+      work%rate(i) = pick([0.0_wp, 0.0_wp, 1.0_wp, -1.0_wp])
+      work%friction(i) = pick([0.0_wp, 0.0_wp, 1.0_wp])
+      work%static(i) = work%friction(i) + pick([0.0_wp, 0.5_wp, 2.0_wp])
+      if (r >= 0.1_wp) work%velocity(i) = 0.0_wp
     end do
   end subroutine random_path
+
+  !> Clusters met by tests/test_nbody_stress.py's random scenes, where the path solve once
+  !> lacked the dense solve's rules: a frictionless body (1) resting on a body stuck on the
+  !> right wall keeps its force-free row (random_scene 82), and a body with static but no
+  !> sliding friction (1) pulled away by the body it is coupled to breaks away in the way it
+  !> leaves (random_scene 49 with force tables).
+  subroutine seed_clusters()
+    integer :: status
+    logical :: dense_active(2), dense_stuck(2)
+    real(wp) :: dense_sgn(2)
+    work%mass(1:2) = [2.5625_wp, 0.953125_wp]
+    work%force(1:2) = 0.0_wp
+    work%rate(1:2) = 0.0_wp
+    work%friction(1:2) = [0.0_wp, 2.338134765625_wp]
+    work%static(1:2) = [0.0_wp, 4.09173583984375_wp]
+    work%velocity(1:2) = 0.0_wp
+    work%row_body(:, 1:2) = reshape([1, 2, 0, 2], [2, 2])
+    work%row_normal(:, 1:2) = reshape([-1.0_wp, 1.0_wp, 0.0_wp, -1.0_wp], [2, 2])
+    work%dense_only = .true.
+    call gathered_mode(work, 2, 2, status)
+    dense_active = work%active(1:2)
+    call path_solve(2, 2, status)
+    call check(status == mode_solved .and. work%stuck(2) .and. work%active(1) .and. .not. work%active(2) .and. &
+      all(dense_active .eqv. work%active(1:2)), 'random_scene 82: a frictionless body keeps its row to a stuck one')
+    work%mass(1:2) = [1.3125_wp, 1.890625_wp]
+    work%force(1:2) = [8.27507246682375808_wp, 2.59509418081828258_wp]
+    work%rate(1:2) = [-4.625_wp, 22.0192307692307701_wp]
+    work%friction(1:2) = [0.0_wp, 3.7683258056640625_wp]
+    work%static(1:2) = [1.00616455078125_wp, 6.377166748046875_wp]
+    work%velocity(1:2) = 0.0_wp
+    work%row_body(:, 1) = [1, 2]
+    work%row_normal(:, 1) = [-1.0_wp, 1.0_wp]
+    work%dense_only = .true.
+    call gathered_mode(work, 2, 1, status)
+    dense_stuck = work%stuck(1:2)
+    dense_sgn = work%sgn(1:2)
+    call path_solve(2, 1, status)
+    call check(status == mode_solved .and. .not. any(work%stuck(1:2)) .and. all(work%sgn(1:2) == 1.0_wp) .and. &
+      all(dense_sgn == work%sgn(1:2)) .and. all(dense_stuck .eqv. work%stuck(1:2)), &
+      'random_scene 49 with tables: a mu = 0 < mus body breaks away in the way it leaves')
+  end subroutine seed_clusters
 
   !> The dense solve's preference for friction lets a held row go only if the motion stays
   !> the same, rates included: a free body at rest whose force is rising (body 2) against a
@@ -119,10 +179,22 @@ contains
     call gathered_mode(work, 3, 3, status)
     call check(status == mode_solved .and. work%stuck(1) .and. .not. work%stuck(2) .and. work%active(2), &
       'the dense solve holds a row a free body rises into')
-    work%dense_only = .false.
-    call gathered_mode(work, 3, 3, status)
+    call path_solve(3, 3, status)
     call check(status == mode_solved .and. work%active(2), 'so does the path solve')
   end subroutine rising_into_a_stuck_body
+
+  !> The gathered problem of n bodies and nr rows solved by the path solve (status:
+  !> mode_solved, or -1 when the rows do not form a path it takes).
+  subroutine path_solve(n, nr, status)
+    integer, intent(in) :: n, nr
+    integer, intent(out) :: status
+    status = -1
+    if (.not. path_order(work%path, n, work%row_body(:, 1:nr), work%row_normal(:, 1:nr))) return
+    call path_mode(work%path, work%mass(1:n), work%force(1:n), work%rate(1:n), work%friction(1:n), &
+      work%static(1:n), work%velocity(1:n), work%row_body(:, 1:nr), work%row_normal(:, 1:nr), &
+      work%acc(1:n), work%acc_rate(1:n), work%active(1:nr), work%stuck(1:n), work%sgn(1:n))
+    status = mode_solved
+  end subroutine path_solve
 
   !> Random paths (program header) struck: the path projection against the dense one.
   subroutine projections()
