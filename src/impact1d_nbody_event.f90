@@ -243,9 +243,10 @@ contains
     type(point_work_type), intent(inout) :: work
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
-    real(wp) :: momentum(0:scene%n_bodies), v_new(scene%n_bodies), v_before(scene%n_bodies)
+    real(wp) :: momentum(0:scene%n_bodies), v_new(scene%n_bodies), v_before(scene%n_bodies), frame(scene%n_bodies)
     integer :: i, k, r
-    logical :: joined, halt(0:scene%n_bodies)
+    logical :: joined, halt(0:scene%n_bodies), links(scene%n_rows)
+    type(error_type), allocatable :: ignored
     work%rigid = [(i, i = 0, scene%n_bodies)]
     do k = 1, scene%n_rows
       if (scene%row_partner(k) == 0) cycle
@@ -267,17 +268,30 @@ contains
       momentum(r) = momentum(r) + scene%body_mass(i) * s%v(i)
     end do
     v_new = s%v
+    ! (a group linked rigidly to a moving ground moves with it: the links' frame)
+    if (scene%drives%n > 0) then
+      do k = 1, scene%n_rows
+        links(k) = scene%row_partner(k) > 0 .and. closed(k)
+        if (links(k)) links(k) = closed(scene%row_partner(k))
+      end do
+      frame = frame_velocity(scene, links, s%t)
+    end if
     do i = 1, scene%n_bodies
       r = work%rigid(i)
       if (r == 0) then
         v_new(i) = 0.0_wp
+        if (scene%drives%n > 0) v_new(i) = frame(i)
       else if (work%rigid_mass(r) /= scene%body_mass(i)) then
         v_new(i) = momentum(r) / work%rigid_mass(r)
       end if
     end do
     if (all(v_new == s%v)) return
     v_before = s%v
-    call apply(scene, s, v_new)
+    if (scene%drives%n > 0) then
+      call apply_driven(scene, links, s, v_new, ignored)
+    else
+      call apply(scene, s, v_new)
+    end if
     do k = 1, scene%n_rows
       if (scene%row_partner(k) == 0) cycle
       if (.not. (closed(k) .and. closed(scene%row_partner(k)))) cycle

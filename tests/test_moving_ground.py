@@ -396,3 +396,28 @@ def test_output_header_rebuilds_the_moving_ground(tmp_path):
     again = impact1d.simulate(dataclasses.replace(back.scene, t_end=2.0))
     np.testing.assert_array_equal(again.x1, back.x1)
     np.testing.assert_array_equal(again.events["t"], back.events["t"])
+
+
+@pytest.mark.parametrize("v1", [0.5, 0.3])
+def test_rigid_link_to_a_moving_anchor_moves_with_it(v1):
+    """A rigid link (d_min = d_max = 0) to an anchor moving at 0.5 m/s: the body moves with
+    the anchor. Started at the anchor's velocity nothing hits (the link's lock once set the
+    body still, and its impact then logged 'before' 0); started at 0.3 m/s the lock is one
+    plastic impact, 0.3 -> 0.5, whose drive_work is the momentum the anchor gave times its
+    velocity, m (0.5 - 0.3) 0.5 = 0.1 J, the impact loss the relative motion's energy,
+    m 0.2^2 / 2 = 0.02 J."""
+    scene = impact1d.Scene(m1=1.0, x1=0.0, v1=v1, t_end=1.0, dt=1e-3, dt_out=0.1, contacts=[
+        dict(a=0, b=1, d_min=0.0, d_max=0.0, ground_v=0.5)])
+    result = impact1d.simulate(scene)
+    impacts = result.events[result.events["kind"] == "contact1_min"]
+    if v1 == 0.5:
+        assert len(impacts) == 0
+    else:
+        assert len(impacts) == 1
+        assert (impacts["v1_before"][0], impacts["v1_after"][0]) == (0.3, 0.5)
+    assert list(result.events["kind"][-1:]) == ["rest_contact1_min"]
+    np.testing.assert_allclose(result.x1, 0.5 * result.t, rtol=0, atol=1e-15)
+    np.testing.assert_array_equal(result.v1, 0.5)
+    assert result.drive_work[-1] == pytest.approx(0.5 * (0.5 - v1), abs=1e-15)
+    assert result.impact_loss[-1] == pytest.approx((0.5 - v1) ** 2 / 2, abs=1e-15)
+    assert result.energy_residual < 1e-15
