@@ -186,9 +186,8 @@ contains
       associate (b => scene%row_body(2, k))
         s%x(b) = -scene%row_offset(k) / scene%row_normal(2, k)
         s%x_lo(b) = 0.0_wp
-        ! (a moving ground's w(t) added exactly: the gap is 0 to its own rounding)
-        if (scene%drives%n > 0) call add_compensated(s%x(b), s%x_lo(b), &
-          -ground_motion(scene, k, s%t, 0) / scene%row_normal(2, k))
+        ! (a moving ground's w(t) added exactly, to the clock's low part: row_gap's)
+        if (scene%drives%n > 0) call place_on_drive(k, b, s)
         placed(b) = .true.
       end associate
     end do
@@ -227,6 +226,19 @@ contains
       step = -1
     end do
 
+  contains
+
+    !> Body b on row k's ground end: w(t + t_lo) as its two parts (impact1d_drives'
+    !> position_parts).
+    pure subroutine place_on_drive(k, b, s)
+      integer, intent(in) :: k, b
+      type(state_type), intent(inout) :: s
+      real(wp) :: w, w_lo
+      if (scene%row_drive(k) == 0) return
+      call scene%drives%position_parts(scene%row_drive(k), s%t, s%t_lo, w, w_lo)
+      call add_compensated(s%x(b), s%x_lo(b), w)
+      call add_compensated(s%x(b), s%x_lo(b), w_lo)
+    end subroutine place_on_drive
   end subroutine snap_closed
 
   !> Bodies joined by rigid links whose two rows are closed (d_min = d_max) are one body: the

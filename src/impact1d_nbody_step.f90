@@ -232,7 +232,7 @@ contains
     type(scene_type), intent(in) :: scene
     integer, intent(in) :: k
     type(state_type), intent(in) :: s
-    real(wp) :: p, q, total, rounded, low
+    real(wp) :: p, q, total, rounded, low, w, w_lo
     p = 0.0_wp
     q = 0.0_wp
     low = 0.0_wp
@@ -245,7 +245,12 @@ contains
       low = low + n(2) * s%x_lo(b)
     end associate
     if (scene%drives%n > 0) then
-      if (scene%row_drive(k) > 0) p = ground_motion(scene, k, s%t, 0)
+      ! (the ground's place to the clock's low part, as snap_closed puts a body on it)
+      if (scene%row_drive(k) > 0) then
+        call scene%drives%position_parts(scene%row_drive(k), s%t, s%t_lo, w, w_lo)
+        p = -scene%row_normal(2, k) * w
+        low = low - scene%row_normal(2, k) * w_lo
+      end if
     end if
     total = p + q
     rounded = total - p
