@@ -931,12 +931,18 @@ contains
       if (scene%row_body(1, j) > 0) row_abs_tol = row_abs_tol + tol(scene%row_body(1, j))
     end function row_abs_tol
 
-    !> The velocities of row j's ends (0 for the ground), as a release logs them.
+    !> The velocities of row j's ends (0 for the ground), as a release logs them; with one
+    !> or two bodies the bodies' own, (v1, v2) or (v1, 0), which log_event reports for any
+    !> row (a ground row's pair (0, v_b) was logged as v1 = 0, v2 = v_b).
     pure function pair_of(j, v) result(pair)
       integer, intent(in) :: j
       real(wp), intent(in) :: v(:)
       real(wp) :: pair(2)
       pair = 0.0_wp
+      if (scene%n_bodies <= 2) then
+        pair(:scene%n_bodies) = v
+        return
+      end if
       if (scene%row_body(1, j) > 0) pair(1) = v(scene%row_body(1, j))
       pair(2) = v(scene%row_body(2, j))
     end function pair_of

@@ -456,3 +456,31 @@ def test_rattle_on_a_floor_moving_at_constant_speed_is_frame_invariant(u):
     np.testing.assert_allclose(moving.x1 - u * moving.t, still.x1, rtol=0, atol=1e-13)
     np.testing.assert_allclose(moving.x2 - u * moving.t, still.x2, rtol=0, atol=1e-13)
     assert moving.energy_residual < 1e-12
+
+
+def test_a_release_on_the_nbody_engine_logs_the_bodies_velocities():
+    """With one or two bodies an event reports (v1, v2) (or (v1, 0)) whatever the row; the
+    N-body engine's release of a ground row logged its row's ends instead, (0, v_b): the
+    ball lifting off a table (test_ball_lifts_off_a_table_accelerating_down_faster_than_g)
+    was logged leaving at v1 = 0, and the lower of two balls at v1 = 0 with v2 its own."""
+    period, gamma = 0.5, 2.0
+    omega = 2 * math.pi / period
+    amp = gamma * G / omega**2
+    scene = impact1d.Scene(m1=1.0, f1=-G, x1=0.0, v1=amp * omega, t_end=0.1, dt=1e-3, contacts=[
+        dict(a=0, b=1, d_min=0.0, ground_amp=amp, ground_period=period, name="table")])
+    release = impact1d.simulate(scene).events[1]
+    assert release["kind"] == "release_table"
+    t_lift = math.asin(1 / gamma) / omega
+    assert release["v1_before"] == pytest.approx(amp * omega * math.cos(omega * t_lift), abs=1e-12)
+    assert release["v1_after"] == release["v1_before"]
+    still = impact1d.simulate(two_balls_on_a_floor(0.0)).events
+    moving = impact1d.simulate(two_balls_on_a_floor(-0.8)).events
+    for events in (still, moving):
+        # The floor lets the lower ball go at the instant it bounced off it: both balls
+        # leave with the velocities that impact left them.
+        at = np.flatnonzero(events["kind"] == "release_floor")
+        assert len(at) > 5
+        assert np.all(events["kind"][at - 1] == "floor") and np.all(events["t"][at - 1] == events["t"][at])
+        for name in ("v1", "v2"):
+            np.testing.assert_array_equal(events[name + "_before"][at], events[name + "_after"][at - 1])
+            np.testing.assert_array_equal(events[name + "_after"][at], events[name + "_after"][at - 1])
