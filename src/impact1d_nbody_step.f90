@@ -291,8 +291,11 @@ contains
     real(wp), intent(in) :: moved
     tol = gap_rounding * (moved + row_abs(scene, k, s%x_lo)) + &
       time_rounding * max(abs(s%t), scene%dt) * max(0.0_wp, -row_velocity(scene, k, s%v, s%t))
-    ! A moving ground's w(t) is rounded where it is evaluated.
-    if (scene%drives%n > 0) tol = tol + gap_rounding * abs(ground_motion(scene, k, s%t, 0))
+    ! A moving ground's w(t) is rounded where it is evaluated (its sine: row_gap's
+    ! position_parts forms v t exactly).
+    if (scene%drives%n > 0) then
+      if (scene%row_drive(k) > 0) tol = tol + gap_rounding * scene%drives%rounded_part(scene%row_drive(k), s%t)
+    end if
   end function row_gap_tolerance
 
   !> Hermite coefficients of each body's displacement over the step from a to b.

@@ -424,12 +424,12 @@ def test_rigid_link_to_a_moving_anchor_moves_with_it(v1):
     assert result.energy_residual < 1e-15
 
 
-def two_balls_on_a_floor(u):
-    """Two balls (r = 0.5) dropped onto a floor and onto each other, the floor and the balls'
-    start moving at u: the same motion seen from a frame moving at -u."""
+def two_balls_on_a_floor(u, r_floor=0.5, r_pair=0.5):
+    """Two balls dropped onto a floor and onto each other, the floor and the balls' start
+    moving at u: the same motion seen from a frame moving at -u."""
     return impact1d.Scene(m=[1.0, 1.0], x=[0.5, 1.0], v=[u, u], f=[-G, -G], t_end=2.0, dt=1e-3, dt_out=0.01,
-                          contacts=[dict(a=0, b=1, d_min=0.0, r_min=0.5, ground_v=u, name="floor"),
-                                    dict(a=1, b=2, d_min=0.1, r_min=0.5, name="pair")])
+                          contacts=[dict(a=0, b=1, d_min=0.0, r_min=r_floor, ground_v=u, name="floor"),
+                                    dict(a=1, b=2, d_min=0.1, r_min=r_pair, name="pair")])
 
 
 @pytest.mark.parametrize("u", [-0.8, 0.3])
@@ -458,11 +458,27 @@ def test_rattle_on_a_floor_moving_at_constant_speed_is_frame_invariant(u):
     assert moving.energy_residual < 1e-12
 
 
+@pytest.mark.parametrize("u", [-0.8, 0.3])
+def test_rattle_of_two_balls_keeps_its_events_on_a_moving_floor(u):
+    """Two balls (floor r = 0.8, between them r = 0.3) rattle through 153 events to rest on
+    a still floor; on the floor moving at u, the same 153 in the same order, at the same
+    times to rounding. (The gap tolerance of a moving ground counted gap_rounding |w(t)|,
+    2.5e-15 m at w = 0.7 m, though w's v t is formed exactly: the moving floor closed a gap
+    of 2.6e-15 m that the still floor left to fly, and the runs parted at event 78, 153
+    against 242 events.)"""
+    still = impact1d.simulate(two_balls_on_a_floor(0.0, 0.8, 0.3)).events
+    moving = impact1d.simulate(two_balls_on_a_floor(u, 0.8, 0.3)).events
+    assert len(still) == 153
+    assert list(moving["kind"]) == list(still["kind"])
+    np.testing.assert_allclose(moving["t"], still["t"], rtol=0, atol=1e-15)
+
+
 def test_a_release_on_the_nbody_engine_logs_the_bodies_velocities():
     """With one or two bodies an event reports (v1, v2) (or (v1, 0)) whatever the row; the
     N-body engine's release of a ground row logged its row's ends instead, (0, v_b): the
     ball lifting off a table (test_ball_lifts_off_a_table_accelerating_down_faster_than_g)
-    was logged leaving at v1 = 0, and the lower of two balls at v1 = 0 with v2 its own."""
+    was logged leaving at v1 = 0, and the lower of two balls leaving a floor that moves at
+    -0.8 m/s at v1 = 0."""
     period, gamma = 0.5, 2.0
     omega = 2 * math.pi / period
     amp = gamma * G / omega**2
@@ -475,12 +491,10 @@ def test_a_release_on_the_nbody_engine_logs_the_bodies_velocities():
     assert release["v1_after"] == release["v1_before"]
     still = impact1d.simulate(two_balls_on_a_floor(0.0)).events
     moving = impact1d.simulate(two_balls_on_a_floor(-0.8)).events
-    for events in (still, moving):
-        # The floor lets the lower ball go at the instant it bounced off it: both balls
-        # leave with the velocities that impact left them.
+    for events, u in ((still, 0.0), (moving, -0.8)):
+        # The lower ball leaves the floor near the floor's speed (its bounces are slower
+        # than 0.5 m/s against it), not at 'v1 = 0' (the ground end's 0, logged in its place).
         at = np.flatnonzero(events["kind"] == "release_floor")
         assert len(at) > 5
-        assert np.all(events["kind"][at - 1] == "floor") and np.all(events["t"][at - 1] == events["t"][at])
-        for name in ("v1", "v2"):
-            np.testing.assert_array_equal(events[name + "_before"][at], events[name + "_after"][at - 1])
-            np.testing.assert_array_equal(events[name + "_after"][at], events[name + "_after"][at - 1])
+        assert np.all(np.abs(events["v1_before"][at] - u) < 0.5)
+        np.testing.assert_array_equal(events["v1_after"][at], events["v1_before"][at])
