@@ -18,6 +18,8 @@ module impact1d_drives
   contains
     procedure :: add
     procedure :: position
+    procedure :: position_parts
+    procedure :: rounded_part
     procedure :: displacement
     procedure :: velocity
     procedure :: acceleration
@@ -47,6 +49,43 @@ contains
     w = self%v(d) * t
     if (self%omega(d) /= 0.0_wp) w = w + self%amp(d) * sin(self%omega(d) * t + self%phase(d))
   end function position
+
+  !> w_d at the clock t + t_lo as hi + lo: v t without rounding (Dekker's product), the
+  !> clock's low part w' t_lo and the sine in lo. A body put on the ground (snapped) is then
+  !> where the step, which moves a body held to it by the clock's exact increments, took it:
+  !> with w rounded, each snap moved a held body by up to an ulp of its position, against
+  !> the bodies in flight beside it, and a ground moving at constant speed did not give the
+  !> still ground's rattle (two balls came to rest on a floor in 551 events, on the same
+  !> floor seen from a moving frame in 346,946).
+  pure subroutine position_parts(self, d, t, t_lo, hi, lo)
+    class(drive_type), intent(in) :: self
+    integer, intent(in) :: d
+    real(wp), intent(in) :: t, t_lo
+    real(wp), intent(out) :: hi, lo
+    real(wp), parameter :: split = 134217729.0_wp   ! 2**27 + 1
+    real(wp) :: c, v_hi, v_lo, t_hi, t_lo_part
+    hi = self%v(d) * t
+    c = split * self%v(d)
+    v_hi = c - (c - self%v(d))
+    v_lo = self%v(d) - v_hi
+    c = split * t
+    t_hi = c - (c - t)
+    t_lo_part = t - t_hi
+    lo = ((v_hi * t_hi - hi) + v_hi * t_lo_part + v_lo * t_hi) + v_lo * t_lo_part
+    lo = lo + self%velocity(d, t) * t_lo
+    if (self%omega(d) /= 0.0_wp) lo = lo + self%amp(d) * sin(self%omega(d) * t + self%phase(d))
+  end subroutine position_parts
+
+  !> The size of what position_parts rounds in w_d(t): the sine's |amp sin(omega t + phase)|
+  !> (v t is exact there), for a gap's rounding level. Counting all of |w| made a floor
+  !> moving at constant speed close gaps a still floor leaves open (2.5e-15 m at w = 0.7 m).
+  pure real(wp) function rounded_part(self, d, t) result(w)
+    class(drive_type), intent(in) :: self
+    integer, intent(in) :: d
+    real(wp), intent(in) :: t
+    w = 0.0_wp
+    if (self%omega(d) /= 0.0_wp) w = abs(self%amp(d) * sin(self%omega(d) * t + self%phase(d)))
+  end function rounded_part
 
   !> w_d(t + h) - w_d(t), accurate however small h is against t (a difference of positions
   !> would round a step below the clock's ulp to 0): sin(a + c) - sin(a) = 2 cos(a + c/2)

@@ -252,9 +252,8 @@ contains
       associate (b => scene%row_body(2, k))
         s%x(b) = -scene%row_offset(k) / scene%row_normal(2, k)
         s%x_lo(b) = 0.0_wp
-        ! (a moving ground's w(t) added exactly: the gap is 0 to its own rounding)
-        if (scene%drives%n > 0) call add_compensated(s%x(b), s%x_lo(b), &
-          -ground_motion(scene, k, s%t, 0) / scene%row_normal(2, k))
+        ! (a moving ground's w(t) added exactly, to the clock's low part: row_gap's)
+        if (scene%drives%n > 0) call place_on_drive(k, b, s)
         placed(b) = .true.
       end associate
     end do
@@ -293,6 +292,19 @@ contains
       step = -1
     end do
 
+  contains
+
+    !> Body b on row k's ground end: w(t + t_lo) as its two parts (impact1d_drives'
+    !> position_parts).
+    pure subroutine place_on_drive(k, b, s)
+      integer, intent(in) :: k, b
+      type(state_type), intent(inout) :: s
+      real(wp) :: w, w_lo
+      if (scene%row_drive(k) == 0) return
+      call scene%drives%position_parts(scene%row_drive(k), s%t, s%t_lo, w, w_lo)
+      call add_compensated(s%x(b), s%x_lo(b), w)
+      call add_compensated(s%x(b), s%x_lo(b), w_lo)
+    end subroutine place_on_drive
   end subroutine snap_closed
 
   !> Bodies joined by rigid links whose two rows are closed (d_min = d_max) are one body: the
@@ -309,9 +321,10 @@ contains
     type(point_work_type), intent(inout) :: work
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
-    real(wp) :: momentum(0:scene%n_bodies), v_new(scene%n_bodies), v_before(scene%n_bodies)
+    real(wp) :: momentum(0:scene%n_bodies), v_new(scene%n_bodies), v_before(scene%n_bodies), frame(scene%n_bodies)
     integer :: i, k, r
-    logical :: joined, halt(0:scene%n_bodies)
+    logical :: joined, halt(0:scene%n_bodies), links(scene%n_rows)
+    type(error_type), allocatable :: ignored
     work%rigid = [(i, i = 0, scene%n_bodies)]
     do k = 1, scene%n_rows
       if (scene%row_partner(k) == 0) cycle
@@ -333,17 +346,30 @@ contains
       momentum(r) = momentum(r) + scene%body_mass(i) * s%v(i)
     end do
     v_new = s%v
+    ! (a group linked rigidly to a moving ground moves with it: the links' frame)
+    if (scene%drives%n > 0) then
+      do k = 1, scene%n_rows
+        links(k) = scene%row_partner(k) > 0 .and. closed(k)
+        if (links(k)) links(k) = closed(scene%row_partner(k))
+      end do
+      frame = frame_velocity(scene, links, s%t)
+    end if
     do i = 1, scene%n_bodies
       r = work%rigid(i)
       if (r == 0) then
         v_new(i) = 0.0_wp
+        if (scene%drives%n > 0) v_new(i) = frame(i)
       else if (work%rigid_mass(r) /= scene%body_mass(i)) then
         v_new(i) = momentum(r) / work%rigid_mass(r)
       end if
     end do
     if (all(v_new == s%v)) return
     v_before = s%v
-    call apply(scene, s, v_new)
+    if (scene%drives%n > 0) then
+      call apply_driven(scene, links, s, v_new, ignored)
+    else
+      call apply(scene, s, v_new)
+    end if
     do k = 1, scene%n_rows
       if (scene%row_partner(k) == 0) cycle
       if (.not. (closed(k) .and. closed(scene%row_partner(k)))) cycle
@@ -985,12 +1011,18 @@ contains
       if (scene%row_body(1, j) > 0) row_abs_tol = row_abs_tol + tol(scene%row_body(1, j))
     end function row_abs_tol
 
-    !> The velocities of row j's ends (0 for the ground), as a release logs them.
+    !> The velocities of row j's ends (0 for the ground), as a release logs them; with one
+    !> or two bodies the bodies' own, (v1, v2) or (v1, 0), which log_event reports for any
+    !> row (a ground row's pair (0, v_b) was logged as v1 = 0, v2 = v_b).
     pure function pair_of(j, v) result(pair)
       integer, intent(in) :: j
       real(wp), intent(in) :: v(:)
       real(wp) :: pair(2)
       pair = 0.0_wp
+      if (scene%n_bodies <= 2) then
+        pair(:scene%n_bodies) = v
+        return
+      end if
       if (scene%row_body(1, j) > 0) pair(1) = v(scene%row_body(1, j))
       pair(2) = v(scene%row_body(2, j))
     end function pair_of

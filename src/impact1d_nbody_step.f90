@@ -291,7 +291,7 @@ contains
     type(scene_type), intent(in) :: scene
     integer, intent(in) :: k
     type(state_type), intent(in) :: s
-    real(wp) :: p, q, total, rounded, low
+    real(wp) :: p, q, total, rounded, low, w, w_lo
     p = 0.0_wp
     q = 0.0_wp
     low = 0.0_wp
@@ -304,7 +304,12 @@ contains
       low = low + n(2) * s%x_lo(b)
     end associate
     if (scene%drives%n > 0) then
-      if (scene%row_drive(k) > 0) p = ground_motion(scene, k, s%t, 0)
+      ! (the ground's place to the clock's low part, as snap_closed puts a body on it)
+      if (scene%row_drive(k) > 0) then
+        call scene%drives%position_parts(scene%row_drive(k), s%t, s%t_lo, w, w_lo)
+        p = -scene%row_normal(2, k) * w
+        low = low - scene%row_normal(2, k) * w_lo
+      end if
     end if
     total = p + q
     rounded = total - p
@@ -345,8 +350,11 @@ contains
     real(wp), intent(in) :: moved
     tol = gap_rounding * (moved + row_abs(scene, k, s%x_lo)) + &
       time_rounding * max(abs(s%t), scene%dt) * max(0.0_wp, -row_velocity(scene, k, s%v, s%t))
-    ! A moving ground's w(t) is rounded where it is evaluated.
-    if (scene%drives%n > 0) tol = tol + gap_rounding * abs(ground_motion(scene, k, s%t, 0))
+    ! A moving ground's w(t) is rounded where it is evaluated (its sine: row_gap's
+    ! position_parts forms v t exactly).
+    if (scene%drives%n > 0) then
+      if (scene%row_drive(k) > 0) tol = tol + gap_rounding * scene%drives%rounded_part(scene%row_drive(k), s%t)
+    end if
   end function row_gap_tolerance
 
   !> Hermite coefficients of each body's displacement over the step from a to b.
@@ -656,13 +664,25 @@ contains
     gaps_hold = .true.
     do k = 1, scene%n_rows
       if (mode%active(k) .or. k == located) cycle
-      if (row_gap(scene, k, b) < -row_gap_tolerance(scene, k, b, &
-        row_abs(scene, k, (b%x - s%x) + (b%x_lo - s%x_lo)))) gaps_hold = .false.
+      if (row_gap(scene, k, b) < -row_gap_tolerance(scene, k, b, moved(k))) gaps_hold = .false.
     end do
     do i = 1, scene%n_bodies
       if (scene%body_static(i) == 0.0_wp .or. mode%sgn(i) == 0.0_wp) cycle
       if (mode%sgn(i) * slip(scene, i, b%v(i)) < -velocity_rounding * max(abs(s%v(i)), abs(b%v(i)), &
           abs(b%v(i) - s%v(i)))) gaps_hold = .false.
     end do
+
+  contains
+
+    !> What the step moved row k's gap by (row_abs of the bodies' displacements, formed for
+    !> its two ends only: over all N bodies for each row, it was O(N) a row and most of a
+    !> long chain's step).
+    pure real(wp) function moved(k)
+      integer, intent(in) :: k
+      associate (ea => scene%row_body(1, k), eb => scene%row_body(2, k))
+        moved = abs((b%x(eb) - s%x(eb)) + (b%x_lo(eb) - s%x_lo(eb)))
+        if (ea > 0) moved = moved + abs((b%x(ea) - s%x(ea)) + (b%x_lo(ea) - s%x_lo(ea)))
+      end associate
+    end function moved
   end function gaps_hold
 end module impact1d_nbody_step

@@ -907,3 +907,47 @@ def test_cli_time_window(tmp_path, cli, capsys):
     assert cli.main([str(out), "--t-from", "7"]) == 1
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "misses the run" in err
+
+
+def test_moving_grounds_are_drawn_where_they_are():
+    """A limit whose ground end moves (ground_v, ground_amp ...; &walls x_left_v ...) is
+    drawn at its prescribed position over the run, not at its limit: the vibrating table
+    (input/vibrating_table.nml) at w(t) = A sin(2 pi t / T + phi), which the ball meets at
+    each impact (it was drawn still at 0 while the ball met it near 0.05 m), a wall closing
+    at constant speed, and a moving stop of one body of three (dashed, in its colour)."""
+    scene = IMPACT1D.load_scene(ROOT / "input" / "vibrating_table.nml")
+    scene.t_end = 2.0
+    res = IMPACT1D.simulate(scene)
+    pos = axes_by_label(plot.figure(res))["positions"]
+    table = artist(pos, "wall:table")
+    (record,) = scene.contacts
+    w = record["ground_amp"] * np.sin(2 * np.pi * res.t / record["ground_period"] + record["ground_phase"])
+    np.testing.assert_array_equal(table.get_xdata(), res.t)
+    np.testing.assert_allclose(table.get_ydata(), w, rtol=0, atol=1e-15)
+    assert table.get_label() == "table: x1 \u2265 0 m + w(t)"
+    impacts = res.events["t"][res.events["kind"] == "table"]
+    assert len(impacts) > 2
+    # (the samples 1 ms apart: the ball and the table 3 m/s apart there)
+    np.testing.assert_allclose(np.interp(impacts, res.t, table.get_ydata()), np.interp(impacts, res.t, res.x1),
+                               rtol=0, atol=5e-3)
+    assert np.all(np.abs(np.interp(impacts, res.t, res.x1)) > 0.03)      # not where a still table is
+    assert np.all(res.x1 >= table.get_ydata() - 1e-12)
+
+    walls = IMPACT1D.Scene(m1=1.0, x1=0.0, v1=1.0, x_left=0.0, x_right=1.0, x_right_v=-0.1, t_end=2.0, dt=1e-3,
+                           dt_out=0.01)
+    res = IMPACT1D.simulate(walls)
+    pos = axes_by_label(plot.figure(res))["positions"]
+    right = artist(pos, "wall:right")
+    np.testing.assert_allclose(right.get_ydata(), 1.0 - 0.1 * res.t, rtol=0, atol=1e-15)
+    assert list(artist(pos, "wall:left").get_ydata()) == [0.0, 0.0]       # a still wall as before
+    assert np.all(res.x1 <= right.get_ydata() + 1e-12)
+
+    three = IMPACT1D.Scene(m=[1.0, 1.0, 1.0], x=[0.0, 1.0, 2.0], v=[0.0, 0.5, 0.0], t_end=1.0, dt=1e-3,
+                           dt_out=0.01, contacts=[dict(a=0, b=2, d_max=1.2, ground_v=0.1, name="pusher")])
+    res = IMPACT1D.simulate(three)
+    for fig in (plot.figure(res), plot.spacetime(res)):
+        line = [a for ax in fig.axes for a in ax.get_children() if a.get_gid() == "wall:pusher"]
+        assert len(line) == 1
+        assert line[0].get_linestyle() == "--"
+        np.testing.assert_allclose(line[0].get_ydata(), 1.2 + 0.1 * np.asarray(line[0].get_xdata()), rtol=0,
+                                   atol=1e-15)

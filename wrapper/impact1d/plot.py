@@ -407,23 +407,27 @@ def _draw_positions(ax, result, events):
     d_min = _float_or_none(_scene_value(result, "d_min"))
     d_max = _float_or_none(_scene_value(result, "d_max"))
     # Walls: the tutorial's, then the records' limits that bound every body (body 1's
-    # lower, body N's upper); the records' other limits are drawn as stops and slots.
-    walls = [(name, w, side, f"{name} wall x = {w:g} m") for name, side, w in
-             (("left", "min", _float_or_none(_scene_value(result, "x_left"))),
-              ("right", "max", _float_or_none(_scene_value(result, "x_right")))) if w is not None]
+    # lower, body N's upper); the records' other limits are drawn as stops and slots. Each
+    # as (name, line over t, side, label, still): a moving wall where it is at each time.
+    walls = [(row.name, _ground_line(row, t), row.side,
+              f"{row.name} wall x = {row.limit:g} m" + (" + w(t)" if row.motion else ""), not row.motion)
+             for record in _tutorial_records(result, n) if record["name"] in ("left", "right")
+             for row in _record_rows(0, record)]
     records = _scene_record_rows(result)
-    walls += [(row.name, row.limit, row.side, _row_label(row)) for row in records if _is_wall(row, n)]
+    walls += [(row.name, _ground_line(row, t), row.side, _row_label(row), not row.motion)
+              for row in records if _is_wall(row, n)]
 
     # Limits from the bodies and the walls only: a wide slot (case 5 has
     # d_max = 50 m) must not squash the motion.
     lo = [np.min(x1)] + ([np.min(x2)] if x2.size else []) if t.size else [0.0]
     hi = [np.max(x1)] + ([np.max(x2)] if x2.size else []) if t.size else [1.0]
-    lo, hi = float(min(lo + [w[1] for w in walls])), float(max(hi + [w[1] for w in walls]))
+    lo = float(min(lo + [np.min(w[1]) for w in walls if w[1].size]))
+    hi = float(max(hi + [np.max(w[1]) for w in walls if w[1].size]))
     pad = 0.06 * (hi - lo) if hi > lo else 0.5
     ylim = (lo - pad, hi + pad)
 
-    wall_lo = max((w for _, w, side, _ in walls if side == "min"), default=-np.inf)
-    wall_hi = min((w for _, w, side, _ in walls if side == "max"), default=np.inf)
+    wall_lo = np.max([w for _, w, side, _, _ in walls if side == "min"] or [np.full(t.shape, -np.inf)], axis=0)
+    wall_hi = np.min([w for _, w, side, _, _ in walls if side == "max"] or [np.full(t.shape, np.inf)], axis=0)
 
     def inside_walls(y):
         # x2 cannot pass a wall, so neither does the band that says where it may be.
@@ -432,7 +436,8 @@ def _draw_positions(ax, result, events):
     # A slot limit that stays beyond the walls (or out of view) all run never binds before
     # a wall does: drawn, it would only shade the panel (case 5: d_max = 50 m, walls 10 m
     # apart). Such a limit is left out.
-    view = (max(wall_lo, ylim[0]), min(wall_hi, ylim[1]))
+    view = (max(float(np.min(wall_lo, initial=np.inf)), ylim[0]), min(float(np.max(wall_hi, initial=-np.inf)),
+                                                                    ylim[1]))
     if d_min is not None and not _in_view(x1 + d_min, "min", view):
         d_min = None
     if d_max is not None and not _in_view(x1 + d_max, "max", view):
@@ -449,10 +454,15 @@ def _draw_positions(ax, result, events):
     _draw_record_limits(ax, t, (x1, x2), [row for row in records if not _is_wall(row, n)], view,
                         inside_walls)
 
-    for name, w, side, label in walls:
+    for name, w, side, label, still in walls:
         beyond = ylim[0] - 1e3 * (pad + 1) if side == "min" else ylim[1] + 1e3 * (pad + 1)
-        ax.axhspan(min(w, beyond), max(w, beyond), color="0.85", zorder=0)
-        ax.axhline(w, color="0.25", linewidth=1.5, gid=f"wall:{name}", label=label)
+        if still:
+            w = float(w[0]) if w.size else 0.0
+            ax.axhspan(min(w, beyond), max(w, beyond), color="0.85", zorder=0)
+            ax.axhline(w, color="0.25", linewidth=1.5, gid=f"wall:{name}", label=label)
+        else:
+            ax.fill_between(t, w, beyond, color="0.85", linewidth=0, zorder=0)
+            ax.plot(t, w, color="0.25", linewidth=1.5, gid=f"wall:{name}", label=label)
 
     ax.plot(t, x1, color=_BODY_COLOR[1], linewidth=1.4, gid="x1", label="x1 (body 1)")
     if x2.size:
@@ -503,11 +513,11 @@ def _draw_record_limits(ax, t, positions, rows, view, inside_walls):
     each in the colour of the body it holds (dash-dotted: the slot's lines are dotted),
     left out as a slot limit is when it stays out of view all run."""
     for row in rows:
-        line = np.full(t.shape, row.limit) if row.a == 0 else positions[row.a - 1] + row.limit
+        line = _ground_line(row, t) if row.a == 0 else positions[row.a - 1] + row.limit
         if not _in_view(line, row.side, view):
             continue
         if row.a == 0:
-            _draw_stop(ax, row, _BODY_COLOR[row.b])
+            _draw_stop(ax, row, _BODY_COLOR[row.b], t)
         else:
             _draw_slot_line(ax, t, inside_walls(line), f"limit:{row.name}", _row_label(row),
                             _BODY_COLOR[row.b], "-.")
@@ -744,6 +754,31 @@ class _Row(NamedTuple):
     side: str
     limit: float
     record: int         # the record it comes from (a slot's two rows share one)
+    motion: tuple = ()  # its ground end's (v, amp, period, phase) when it moves (ground_*)
+
+
+_MOTION_FIELDS = ("v", "amp", "period", "phase")
+
+
+def _motion(values):
+    """(v, amp, period, phase) from a record's ground_* values (None: not named), or ()
+    when none is named: the ground end stays at 0."""
+    if all(value is None for value in values):
+        return ()
+    return tuple(float(value) if value is not None else 0.0 for value in values)
+
+
+def _ground_line(row, t):
+    """Where a limit of body b with the ground holds b over the times t: its limit plus the
+    ground end's prescribed position w(t) = v t + amp sin(2 pi t / period + phase)
+    (docs/method.md section 11), as the engine moves it."""
+    line = np.full(np.shape(t), row.limit, dtype=float)
+    if row.motion:
+        v, amp, period, phase = row.motion
+        line = line + v * np.asarray(t, dtype=float)
+        if amp:
+            line = line + amp * np.sin(2.0 * np.pi * np.asarray(t, dtype=float) / period + phase)
+    return line
 
 
 def _tutorial_records(result, n, joined=()):
@@ -755,10 +790,11 @@ def _tutorial_records(result, n, joined=()):
     value = {name: _float_or_none(_scene_value(result, name))
              for name in ("x_left", "x_right", "d_min", "d_max")}
     records = []
-    if value["x_left"] is not None:
-        records.append(dict(a=0, b=1, d_min=value["x_left"], name="left"))
-    if value["x_right"] is not None:
-        records.append(dict(a=0, b=n, d_max=value["x_right"], name="right"))
+    for wall, side, body in (("left", "min", 1), ("right", "max", n)):
+        if value["x_" + wall] is not None:
+            # (a moving wall, &walls x_left_v ...: its record's ground_* fields, as the engine's)
+            records.append(dict(a=0, b=body, name=wall, **{"d_" + side: value["x_" + wall]}, **{
+                "ground_" + f: _float_or_none(_scene_value(result, f"x_{wall}_{f}")) for f in _MOTION_FIELDS}))
     if n > 2:
         return records + _chain_links(result, n, joined)
     if n == 2:
@@ -799,15 +835,16 @@ def _record_rows(j, record):
     limits = {side: _float_or_none(_field(record, "d_" + side)) for side in ("min", "max")}
     name = str(_field(record, "name", f"contact{j + 1}"))
     both = None not in limits.values()
+    motion = _motion([_float_or_none(_field(record, "ground_" + f)) for f in _MOTION_FIELDS])
     rows = []
     for side, limit in limits.items():
         if limit is None:
             continue
         label = str(_field(record, "name_" + side, f"{name}_{side}" if both else name))
         if b == 0:
-            rows.append(_Row(label, 0, a, "max" if side == "min" else "min", -limit, j))
+            rows.append(_Row(label, 0, a, "max" if side == "min" else "min", -limit, j, motion))
         else:
-            rows.append(_Row(label, a, b, side, limit, j))
+            rows.append(_Row(label, a, b, side, limit, j, motion))
     return rows
 
 
@@ -1043,13 +1080,16 @@ def _stretches(mech, body, stretches):
 
 def _draw_ground_rows(ax, mech, colors):
     """Walls (body 1's lower limit, body N's upper one) as today's plot draws them; stops
-    of the other bodies as dashed lines in the body's colour."""
+    of the other bodies as dashed lines in the body's colour (a moving one where it is)."""
     for row in (r for r in mech.rows if r.a == 0):
-        if _is_wall(row, mech.n):
+        if _is_wall(row, mech.n) and row.motion:
+            ax.plot(mech.t, _ground_line(row, mech.t), color="0.25", linewidth=1.5, gid=f"wall:{row.name}",
+                    label=_row_label(row))
+        elif _is_wall(row, mech.n):
             ax.axhline(row.limit, color="0.25", linewidth=1.5, gid=f"wall:{row.name}",
                        label=_row_label(row))
         else:
-            _draw_stop(ax, row, colors[row.b - 1])
+            _draw_stop(ax, row, colors[row.b - 1], mech.t)
 
 
 def _is_wall(row, n):
@@ -1058,8 +1098,13 @@ def _is_wall(row, n):
     return row.a == 0 and (row.b, row.side) in ((1, "min"), (n, "max"))
 
 
-def _draw_stop(ax, row, color):
-    """A stop: a limit of body b with the ground that is not a wall, dashed in b's colour."""
+def _draw_stop(ax, row, color, t):
+    """A stop: a limit of body b with the ground that is not a wall, dashed in b's colour
+    (a moving one at its prescribed position over the times t)."""
+    if row.motion:
+        ax.plot(t, _ground_line(row, t), color=color, linewidth=1.0, linestyle="--", gid=f"wall:{row.name}",
+                label=_row_label(row))
+        return
     ax.axhline(row.limit, color=color, linewidth=1.0, linestyle="--", gid=f"wall:{row.name}",
                label=_row_label(row))
 
@@ -1069,7 +1114,7 @@ def _row_label(row):
     between two bodies."""
     sign = "\u2265" if row.side == "min" else "\u2264"
     if row.a == 0:
-        return f"{row.name}: x{row.b} {sign} {row.limit:.4g} m"
+        return f"{row.name}: x{row.b} {sign} {row.limit:.4g} m" + (" + w(t)" if row.motion else "")
     offset = f"+ {row.limit:.4g}" if row.limit >= 0 else f"\u2212 {-row.limit:.4g}"
     return f"{row.name}: x{row.b} {sign} x{row.a} {offset} m"
 
