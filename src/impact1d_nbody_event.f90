@@ -14,13 +14,13 @@ module impact1d_nbody_event
     force_scale
   use impact1d_event_log, only: event_log_type, log_event
   use impact1d_event_point, only: bounce_series_time
-  use impact1d_clusters, only: uf_join, uf_find
+  use impact1d_clusters, only: uf_join, uf_find, cluster_set_type, clusters_build
   use impact1d_accumulation, only: join_cycle
   use impact1d_cluster_impact, only: impact_work_type, impact_reserve, cluster_projection
   use impact1d_path_impact, only: path_impact_reserve, path_projection
   use impact1d_lcp, only: lcp_solved, lcp_too_large
   use impact1d_body_mode, only: body_mode_type, mode_work_type, solve_body_mode, mode_solved, max_dense_unknowns, &
-    drive_accelerations, shift_to_drives, drive_components
+    drive_accelerations, shift_to_drives, drive_components, solve_cluster
   use impact1d_nbody_step, only: nbody_force, nbody_rate, row_gap, row_velocity, row_gap_tolerance, &
     found_row, found_body, mode_acceleration, ground_motion
   implicit none
@@ -37,7 +37,18 @@ module impact1d_nbody_event
     real(wp), allocatable :: scale(:)
     integer, allocatable :: rigid(:)          !< (0:N) bodies locked by rigid links (union-find)
     real(wp), allocatable :: rigid_mass(:)    !< (0:N) mass of each rigid group, by root
+    !> The rows on each body (impact1d_clusters' incidence lists, built at the first event
+    !> point) and its breadth-first search's queue and marks: what an event touches is found
+    !> from its rows' ends, not by a scan of all N (issue 20 item 3).
+    type(cluster_set_type) :: incidence
+    !> A mode whose entries only the bodies of the clusters solved last are read from
+    !> (cluster_gap_acceleration).
+    type(body_mode_type) :: scratch
   end type point_work_type
+
+  !> The largest cluster (bodies; rows four times as many) whose mode is solved on its own
+  !> to find a row's free gap acceleration; a larger one takes the solve of all clusters.
+  integer, parameter :: max_scope = 64, max_scope_rows = 4 * max_scope
 
 contains
 
@@ -67,6 +78,10 @@ contains
     type(body_mode_type) :: new
     integer :: k, i, status
 
+    if (initial) then
+      call clusters_build(work%incidence, scene%n_bodies, scene%row_body)
+      work%scratch = mode
+    end if
     call nbody_force(scene, s%t, s%x, s%x_lo, s%v, f)
     call nbody_rate(scene, s%t, s%v, df)
     call close_rows(scene, initial, merge(index, 0, found == found_row), s, closed)
@@ -738,9 +753,11 @@ contains
     real(wp) function free_gap_acceleration(v) result(a_gap)
       real(wp), intent(in) :: v(:)
       type(body_mode_type) :: free
-      logical :: candidate(scene%n_rows)
+      logical :: candidate(scene%n_rows), scoped
       real(wp) :: a(scene%n_bodies)
       integer :: j, status
+      call scoped_gap_acceleration(scene, work, k, closed, s%t, v, f, df, acc, entry_scale, a_gap, scoped)
+      if (scoped) return
       do j = 1, scene%n_rows
         candidate(j) = closed(j) .and. j /= k
         if (candidate(j)) candidate(j) = abs(row_velocity(scene, j, v, s%t)) <= &
@@ -754,6 +771,182 @@ contains
       a_gap = row_velocity(scene, k, a) + ground_motion(scene, k, s%t, 2)
     end function free_gap_acceleration
   end subroutine settle_bounce_series
+
+  !> settle_bounce_series' free gap acceleration of row k at velocities v from the clusters
+  !> of k's ends alone (scoped), not from the mode solve of all N bodies: the solve is per
+  !> cluster and the accelerations per group, each a sum in body order, so these are the
+  !> same numbers. Not scoped (the caller solves every cluster): moving grounds, or a
+  !> cluster of more than max_scope bodies. A cluster whose solve fails gives 0, as the
+  !> solve of all does (which also gives 0 when another cluster fails: one the event point's
+  !> own mode solve then fails on).
+  subroutine scoped_gap_acceleration(scene, work, k, closed, t, v, f, df, acc, entry_scale, a_gap, scoped)
+    type(scene_type), intent(in) :: scene
+    type(point_work_type), intent(inout) :: work
+    integer, intent(in) :: k
+    logical, intent(in) :: closed(:)
+    real(wp), intent(in) :: t, v(:), f(:), df(:), acc(:), entry_scale(:)
+    real(wp), intent(out) :: a_gap
+    logical, intent(out) :: scoped
+    real(wp) :: a_end(2)
+    integer :: e, status
+    a_gap = 0.0_wp
+    a_end = 0.0_wp
+    scoped = scene%drives%n == 0
+    if (.not. scoped) return
+    do e = 1, 2
+      if (scene%row_body(e, k) == 0) cycle
+      call cluster_acceleration(scene, work, k, scene%row_body(e, k), closed, t, v, f, df, acc, entry_scale, &
+        a_end(e), status, scoped)
+      if (.not. scoped .or. status /= mode_solved) return
+    end do
+    ! (row_velocity's sum, and free_gap_acceleration's ground term, 0 here)
+    a_gap = scene%row_normal(2, k) * a_end(2)
+    if (scene%row_body(1, k) > 0) a_gap = a_gap + scene%row_normal(1, k) * a_end(1)
+    a_gap = a_gap + 0.0_wp
+  end subroutine scoped_gap_acceleration
+
+  !> Body i's acceleration in the mode of its cluster (the bodies joined to it by candidate
+  !> rows: closed, other than row k, normal velocity within rounding at v), the cluster
+  !> found breadth first over the rows on its bodies and solved as solve_body_mode solves
+  !> it (members in body order, rows in row order, into work%scratch). fits: the cluster has
+  !> at most max_scope bodies and max_scope_rows rows.
+  subroutine cluster_acceleration(scene, work, k, i, closed, t, v, f, df, acc, entry_scale, a_i, status, fits)
+    type(scene_type), intent(in) :: scene
+    type(point_work_type), intent(inout) :: work
+    integer, intent(in) :: k, i
+    logical, intent(in) :: closed(:)
+    real(wp), intent(in) :: t, v(:), f(:), df(:), acc(:), entry_scale(:)
+    real(wp), intent(out) :: a_i
+    integer, intent(out) :: status
+    logical, intent(out) :: fits
+    integer :: body(max_scope), rows(max_scope_rows), nb, nr, j
+    logical :: needs_solve
+    a_i = 0.0_wp
+    status = mode_solved
+    call cluster_of(scene, work%incidence, k, i, closed, t, v, acc, entry_scale, body, nb, rows, nr, fits)
+    if (.not. fits) return
+    needs_solve = nr > 0
+    do j = 1, nb
+      associate (b => body(j))
+        work%scratch%stuck(b) = .false.
+        work%scratch%sgn(b) = 0.0_wp
+        if (v(b) /= 0.0_wp .and. scene%body_friction(b) > 0.0_wp) work%scratch%sgn(b) = sign(1.0_wp, v(b))
+        if (scene%body_static(b) > 0.0_wp .and. v(b) == 0.0_wp) needs_solve = .true.
+      end associate
+    end do
+    if (needs_solve) then
+      work%mode%first(1:2) = [1, nb + 1]
+      work%mode%member(1:nb) = body(:nb)
+      work%mode%first_row(1:2) = [1, nr + 1]
+      work%mode%row(1:nr) = rows(:nr)
+      call solve_cluster(scene, work%mode, 1, f, df, v, work%scratch, status)
+      if (status /= mode_solved) return
+    end if
+    do j = 1, nb
+      associate (b => body(j))
+        if (work%scratch%sgn(b) == 0.0_wp .and. v(b) /= 0.0_wp .and. scene%body_static(b) > 0.0_wp) &
+          work%scratch%sgn(b) = sign(1.0_wp, v(b))
+      end associate
+    end do
+    a_i = group_acceleration(scene, work%scratch, work%mode%local, body(:nb), rows(:nr), i, f)
+  end subroutine cluster_acceleration
+
+  !> Body i's acceleration in mode (its stuck, sgn, active read for the cluster's bodies and
+  !> rows): set_groups' groups and acceleration's sums over i's group, in body order. local:
+  !> scratch, (0:N).
+  real(wp) function group_acceleration(scene, mode, local, body, rows, i, f) result(a_i)
+    type(scene_type), intent(in) :: scene
+    type(body_mode_type), intent(in) :: mode
+    integer, intent(inout) :: local(0:)
+    integer, intent(in) :: body(:), rows(:), i
+    real(wp), intent(in) :: f(:)
+    integer :: root(0:size(body)), j, p, group
+    real(wp) :: load, mass
+    logical :: joined
+    local(0) = 0
+    do j = 1, size(body)
+      local(body(j)) = j
+      root(j) = j
+      if (mode%stuck(body(j))) root(j) = 0
+    end do
+    root(0) = 0
+    do p = 1, size(rows)
+      if (mode%active(rows(p))) joined = uf_join(root, local(scene%row_body(1, rows(p))), &
+        local(scene%row_body(2, rows(p))))
+    end do
+    a_i = 0.0_wp
+    group = uf_find(root, local(i))
+    if (group == 0) return
+    load = 0.0_wp
+    mass = 0.0_wp
+    do j = 1, size(body)
+      if (uf_find(root, j) /= group) cycle
+      mass = mass + scene%body_mass(body(j))
+      load = load + (f(body(j)) + (-scene%body_friction(body(j)) * mode%sgn(body(j))))
+    end do
+    a_i = load / mass
+  end function group_acceleration
+
+  !> The cluster of body i (cluster_acceleration): its bodies and its candidate rows, each in
+  !> increasing order (fits: no more than max_scope, max_scope_rows of them).
+  subroutine cluster_of(scene, set, k, i, closed, t, v, acc, entry_scale, body, nb, rows, nr, fits)
+    type(scene_type), intent(in) :: scene
+    type(cluster_set_type), intent(inout) :: set
+    integer, intent(in) :: k, i
+    logical, intent(in) :: closed(:)
+    real(wp), intent(in) :: t, v(:), acc(:), entry_scale(:)
+    integer, intent(out) :: body(:), nb, rows(:), nr
+    logical, intent(out) :: fits
+    integer :: head, b, p, j, other
+    set%stamp = set%stamp + 1
+    set%mark(i) = set%stamp
+    body(1) = i
+    nb = 1
+    nr = 0
+    head = 0
+    fits = .true.
+    do while (head < nb)
+      head = head + 1
+      b = body(head)
+      do p = set%row_start(b), set%row_start(b + 1) - 1
+        j = set%row_list(p)
+        if (.not. closed(j) .or. j == k) cycle
+        if (abs(row_velocity(scene, j, v, t)) > u_tolerance(scene, j, v, acc, entry_scale)) cycle
+        ! (each row once: from its b end, which every row has)
+        if (scene%row_body(2, j) == b) then
+          fits = nr < size(rows)
+          if (.not. fits) return
+          nr = nr + 1
+          rows(nr) = j
+        end if
+        other = scene%row_body(1, j) + scene%row_body(2, j) - b
+        if (scene%row_body(1, j) == 0 .or. set%mark(other) == set%stamp) cycle
+        fits = nb < size(body)
+        if (.not. fits) return
+        set%mark(other) = set%stamp
+        nb = nb + 1
+        body(nb) = other
+      end do
+    end do
+    call sort_increasing(body(:nb))
+    call sort_increasing(rows(:nr))
+  end subroutine cluster_of
+
+  !> Insertion sort (a cluster's few bodies or rows).
+  pure subroutine sort_increasing(list)
+    integer, intent(inout) :: list(:)
+    integer :: j, p, item
+    do j = 2, size(list)
+      item = list(j)
+      p = j - 1
+      do while (p >= 1)
+        if (list(p) <= item) exit
+        list(p + 1) = list(p)
+        p = p - 1
+      end do
+      list(p + 1) = item
+    end do
+  end subroutine sort_increasing
 
   !> Bodies whose velocity is below the rounding of what a step changes it by, or of the
   !> velocities this event point started from, are at rest.
