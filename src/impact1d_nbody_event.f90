@@ -41,6 +41,13 @@ module impact1d_nbody_event
     !> point) and its breadth-first search's queue and marks: what an event touches is found
     !> from its rows' ends, not by a scan of all N (issue 20 item 3).
     type(cluster_set_type) :: incidence
+    !> The closed rows of this event point, in row order (list_closed): the loops over closed
+    !> rows go over these, not over all rows.
+    integer, allocatable :: closed_rows(:)
+    integer :: n_closed = 0
+    !> Some row is a rigid link's (row_partner): without, every body is its own rigid group.
+    logical :: any_rigid = .false.
+    integer, allocatable :: local(:)          !< (0:N) joint_projection's body numbering, 0 between uses
     !> A mode whose entries only the bodies of the clusters solved last are read from
     !> (cluster_gap_acceleration).
     type(body_mode_type) :: scratch
@@ -60,6 +67,25 @@ contains
     work%scale = 0.0_wp
   end subroutine new_point_work
 
+  !> What the event points of a run share, set at its first: the rows on each body, the
+  !> rigid groups when there are no rigid links (each body alone), a scratch mode.
+  subroutine first_point(scene, mode, work)
+    type(scene_type), intent(in) :: scene
+    type(body_mode_type), intent(in) :: mode
+    type(point_work_type), intent(inout) :: work
+    integer :: i
+    call clusters_build(work%incidence, scene%n_bodies, scene%row_body)
+    work%scratch = mode
+    if (allocated(work%closed_rows)) deallocate(work%closed_rows, work%local)
+    allocate(work%closed_rows(max(scene%n_rows, 1)), work%local(0:scene%n_bodies))
+    work%local = 0
+    work%any_rigid = any(scene%row_partner > 0)
+    ! (lock_rigid's groups and masses without rigid links)
+    work%rigid = [(i, i = 0, scene%n_bodies)]
+    work%rigid_mass(0) = 0.0_wp
+    work%rigid_mass(1:) = scene%body_mass
+  end subroutine first_point
+
   !> The event point at s%t: found, index say what the location found (a row, a body); initial:
   !> the run's start (no mode yet). Leaves the new mode.
   subroutine nbody_event_point(scene, initial, found, index, s, mode, event_log, work, sink, stats, error)
@@ -75,16 +101,12 @@ contains
     type(error_type), allocatable, intent(inout) :: error
     real(wp), dimension(scene%n_bodies) :: f, df, acc, entry_scale
     logical :: closed(scene%n_rows), candidate(scene%n_rows), hit(scene%n_rows), stopped(scene%n_bodies)
-    type(body_mode_type) :: new
-    integer :: k, i, status
+    integer :: k, i, p, status
 
-    if (initial) then
-      call clusters_build(work%incidence, scene%n_bodies, scene%row_body)
-      work%scratch = mode
-    end if
+    if (initial) call first_point(scene, mode, work)
     call nbody_force(scene, s%t, s%x, s%x_lo, s%v, f)
     call nbody_rate(scene, s%t, s%v, df)
-    call close_rows(scene, initial, merge(index, 0, found == found_row), s, closed)
+    call close_rows(scene, initial, merge(index, 0, found == found_row), s, closed, work%closed_rows, work%n_closed)
     ! Velocity scale of each body entering this event point: impulses redistribute velocity
     ! but cannot create precision, so what is below its rounding is zero.
     if (initial) then
@@ -102,7 +124,7 @@ contains
     call lock_rigid(scene, closed, stopped, s, work, sink, stats)
     call impacts(scene, closed, entry_scale, acc, s, work, hit, sink, stats, error)
     if (allocated(error)) return
-    if (any(hit)) call cut_cycle(scene, hit, closed, s, event_log, sink, stats)
+    if (any(hit)) call cut_cycle(scene, hit, closed, s, event_log, work, sink, stats)
     work%scale_time = s%t
     work%scale = entry_scale
     call settle(scene, mode, closed, f, df, acc, entry_scale, s, event_log, work, sink, stats)
@@ -112,13 +134,13 @@ contains
       call nbody_force(scene, s%t, s%x, s%x_lo, s%v, f)
       call nbody_rate(scene, s%t, s%v, df)
     end if
-    do k = 1, scene%n_rows
-      candidate(k) = closed(k)
-      if (candidate(k)) candidate(k) = abs(row_velocity(scene, k, s%v, s%t)) <= &
-        u_tolerance(scene, k, s%v, acc, entry_scale)
+    candidate = .false.
+    do p = 1, work%n_closed
+      k = work%closed_rows(p)
+      candidate(k) = abs(row_velocity(scene, k, s%v, s%t)) <= u_tolerance(scene, k, s%v, acc, entry_scale)
     end do
-    new = mode
-    call solve_mode_at(scene, work%mode, s%t, f, df, s%v, candidate, new, status)
+    ! (solved in place: the old mode is not read past here, and a failed solve ends the run)
+    call solve_mode_at(scene, work%mode, s%t, f, df, s%v, candidate, mode, status)
     if (status == lcp_too_large) then
       call raise(error, status_simulation, 'at t = ' // trim(fmt(s%t)) // ': the bodies joined by closed ' // &
         'contacts form a cluster too large for the dense mode solve (more than ' // &
@@ -130,8 +152,7 @@ contains
         ': no consistent contact and friction state (complementarity problem has no solution)')
       return
     end if
-    call log_mode_change(scene, initial, f, df, candidate, new, s, event_log, sink, stats)
-    mode = new
+    call log_mode_change(scene, initial, f, df, candidate, mode, s, event_log, sink, stats)
   end subroutine nbody_event_point
 
   !> solve_body_mode at time t: with moving grounds, on the forces as seen from the ground
@@ -157,12 +178,13 @@ contains
   !> The closed rows (the located one, gaps within rounding; at the start, within the
   !> rounding of the user's decimals), a rigid link's two rows together, each snapped onto
   !> its constraint.
-  pure subroutine close_rows(scene, initial, located, s, closed)
+  pure subroutine close_rows(scene, initial, located, s, closed, rows, n_closed)
     type(scene_type), intent(in) :: scene
     logical, intent(in) :: initial
     integer, intent(in) :: located
     type(state_type), intent(inout) :: s
     logical, intent(out) :: closed(:)
+    integer, intent(out) :: rows(:), n_closed    !< the closed rows in row order
     integer :: k
     real(wp) :: size_scale
     do k = 1, scene%n_rows
@@ -176,8 +198,22 @@ contains
     do k = 1, scene%n_rows
       if (scene%row_partner(k) > 0) closed(k) = closed(k) .or. closed(scene%row_partner(k))
     end do
-    call snap_closed(scene, closed, s)
+    call list_closed(closed, rows, n_closed)
+    call snap_closed(scene, rows(:n_closed), s)
   end subroutine close_rows
+
+  !> The rows marked closed, in row order.
+  pure subroutine list_closed(closed, rows, n_closed)
+    logical, intent(in) :: closed(:)
+    integer, intent(out) :: rows(:), n_closed
+    integer :: k
+    n_closed = 0
+    do k = 1, size(closed)
+      if (.not. closed(k)) cycle
+      n_closed = n_closed + 1
+      rows(n_closed) = k
+    end do
+  end subroutine list_closed
 
   !> Put every closed row exactly on its constraint, the bodies placed outward from what
   !> holds them: the bodies on closed ground rows first (at -offset / n_b), then across
@@ -190,14 +226,15 @@ contains
   !> link's second limit) move nothing. Passes alternate in direction: a chain takes two.
   pure subroutine snap_closed(scene, closed, s)
     type(scene_type), intent(in) :: scene
-    logical, intent(in) :: closed(:)
+    integer, intent(in) :: closed(:)      !< the closed rows, in row order
     type(state_type), intent(inout) :: s
     logical :: placed(0:scene%n_bodies), grew
     real(wp) :: limit
-    integer :: k, j, first, last, step
+    integer :: k, j, p, first, last, step
     placed = .false.
-    do k = 1, scene%n_rows
-      if (.not. closed(k) .or. scene%row_body(1, k) /= 0) cycle
+    do p = 1, size(closed)
+      k = closed(p)
+      if (scene%row_body(1, k) /= 0) cycle
       associate (b => scene%row_body(2, k))
         s%x(b) = -scene%row_offset(k) / scene%row_normal(2, k)
         s%x_lo(b) = 0.0_wp
@@ -211,10 +248,11 @@ contains
     do
       grew = .false.
       step = -step
-      first = merge(1, scene%n_rows, step > 0)
-      last = merge(scene%n_rows, 1, step > 0)
-      do k = first, last, step
-        if (.not. closed(k) .or. scene%row_body(1, k) == 0) cycle
+      first = merge(1, size(closed), step > 0)
+      last = merge(size(closed), 1, step > 0)
+      do p = first, last, step
+        k = closed(p)
+        if (scene%row_body(1, k) == 0) cycle
         associate (ea => scene%row_body(1, k), eb => scene%row_body(2, k))
           if (placed(ea) .eqv. placed(eb)) cycle
           limit = -scene%row_offset(k) / scene%row_normal(2, k)
@@ -233,11 +271,12 @@ contains
       end do
       if (grew) cycle
       ! A group that no placed body reaches: its first row's a end stays where it is.
-      do j = 1, scene%n_rows
-        if (.not. closed(j) .or. scene%row_body(1, j) == 0) cycle
+      do p = 1, size(closed)
+        j = closed(p)
+        if (scene%row_body(1, j) == 0) cycle
         if (.not. (placed(scene%row_body(1, j)) .or. placed(scene%row_body(2, j)))) exit
       end do
-      if (j > scene%n_rows) exit
+      if (p > size(closed)) exit
       placed(scene%row_body(1, j)) = .true.
       step = -1
     end do
@@ -261,6 +300,13 @@ contains
     real(wp) :: momentum(0:scene%n_bodies), v_new(scene%n_bodies), v_before(scene%n_bodies)
     integer :: i, k, r
     logical :: joined, halt(0:scene%n_bodies)
+    if (.not. work%any_rigid) then
+      ! No rigid links: each body its own group (first_point's), the stopped ones halt alone.
+      do i = 1, scene%n_bodies
+        if (stopped(i)) call zero_velocity(scene, s, i)
+      end do
+      return
+    end if
     work%rigid = [(i, i = 0, scene%n_bodies)]
     do k = 1, scene%n_rows
       if (scene%row_partner(k) == 0) cycle
@@ -337,10 +383,16 @@ contains
     real(wp), dimension(scene%n_bodies) :: v_before, v_after
     real(wp) :: restitution(scene%n_rows), tol(scene%n_rows)
     logical :: pushed(scene%n_rows), group(scene%n_rows), internal(scene%n_rows), joint
-    integer :: k, n_impulses, root_a, root_b
+    integer :: k, p, n_impulses, root_a, root_b, group_rows(scene%n_rows), n_group
 
     hit = .false.
-    do k = 1, scene%n_rows
+    internal = .false.
+    tol = 0.0_wp
+    ! (only closed rows' restitution is read; with rigid links every row's roots are found,
+    ! as they were: the union-find's path halving is part of what impulse reads)
+    do p = 1, merge(scene%n_rows, work%n_closed, work%any_rigid)
+      k = p
+      if (.not. work%any_rigid) k = work%closed_rows(p)
       root_a = uf_find(work%rigid, scene%row_body(1, k))
       root_b = uf_find(work%rigid, scene%row_body(2, k))
       internal(k) = closed(k) .and. root_a == root_b
@@ -349,7 +401,7 @@ contains
     n_impulses = 0
     do
       call closed_tolerances(tol)
-      k = most_approaching(scene, closed, s%t, s%v, tol)
+      k = most_approaching(scene, work%closed_rows(:work%n_closed), s%t, s%v, tol)
       if (k == 0) exit
       n_impulses = n_impulses + 1
       if (n_impulses > scene%max_impulses) then
@@ -359,13 +411,13 @@ contains
           'ratio; raise &run max_impulses)')
         return
       end if
-      call closed_group(scene, closed, k, group)
-      joint = count(group) > 1 .and. all(restitution == 0.0_wp .or. .not. group) .and. &
-        .not. all(internal .or. .not. group)
+      call closed_group(scene, work%incidence, closed, k, group, group_rows, n_group)
+      joint = n_group > 1 .and. all(restitution(group_rows(:n_group)) == 0.0_wp) .and. &
+        .not. all(internal(group_rows(:n_group)))
       v_before = s%v
       if (joint) then
         call closed_tolerances(tol)
-        call joint_projection(scene, work%impact, group, s%t, s%v, tol, v_after, pushed, error)
+        call joint_projection(scene, work, group, group_rows(:n_group), s%t, s%v, tol, v_after, pushed, error)
         if (allocated(error)) return
       else
         call impulse(scene, work, k, restitution(k), s%t, s%v, v_after)
@@ -381,9 +433,11 @@ contains
         if (allocated(error)) return
         call apply(scene, s, v_after)
       end if
-      call share_scale(scene, pushed, entry_scale)
-      hit = hit .or. pushed
-      do k = 1, scene%n_rows
+      ! (what was pushed is in the group: its rows, in row order)
+      call share_scale(scene, pushed, group_rows(:n_group), entry_scale)
+      do p = 1, n_group
+        k = group_rows(p)
+        hit(k) = hit(k) .or. pushed(k)
         if (pushed(k)) call log_event(scene, sink, stats, s%t, class_impact, k, v_before, s%v)
       end do
     end do
@@ -394,11 +448,10 @@ contains
     !> closed rows, a joint impact at its group's; every row's was a few percent of a
     !> 1000-body chain's run).
     subroutine closed_tolerances(tol)
-      real(wp), intent(out) :: tol(:)
+      real(wp), intent(inout) :: tol(:)
       integer :: j
-      do j = 1, scene%n_rows
-        tol(j) = 0.0_wp
-        if (closed(j)) tol(j) = u_tolerance(scene, j, s%v, acc, entry_scale)
+      do j = 1, work%n_closed
+        tol(work%closed_rows(j)) = u_tolerance(scene, work%closed_rows(j), s%v, acc, entry_scale)
       end do
     end subroutine closed_tolerances
   end subroutine impacts
@@ -453,49 +506,72 @@ contains
     end do
   end function frame_velocity
 
-  !> The closed rows joined to row `start` through shared bodies (the ground joins nothing).
-  !> Sweeps over the rows until none joins, every other one in reverse: a chain numbered
-  !> along its length is then reached in three sweeps whichever way it grows from start (in
-  !> one direction only a sweep added one row: a train's take-up, reaching back through its
-  !> standing part, took N sweeps and 88% of a 10,000-wagon run).
-  pure subroutine closed_group(scene, closed, start, group)
+  !> The closed rows joined to row `start` through shared bodies (the ground joins nothing):
+  !> group, and the same rows listed in row order (rows(:n)). Breadth first over the rows on
+  !> each body reached (set: the incidence lists), so O(the group), not sweeps over all rows.
+  subroutine closed_group(scene, set, closed, start, group, rows, n)
     type(scene_type), intent(in) :: scene
+    type(cluster_set_type), intent(inout) :: set
     logical, intent(in) :: closed(:)
     integer, intent(in) :: start
     logical, intent(out) :: group(:)
-    logical :: reached(0:scene%n_bodies), grew
-    integer :: k, sweep
+    integer, intent(out) :: rows(:), n
+    integer :: head, n_queued, p, j, e, b
     group = .false.
     group(start) = .true.
-    reached = .false.
-    reached(scene%row_body(:, start)) = .true.
-    grew = .true.
-    sweep = 0
-    do while (grew)
-      grew = .false.
-      sweep = sweep + 1
-      do k = merge(1, scene%n_rows, mod(sweep, 2) == 1), merge(scene%n_rows, 1, mod(sweep, 2) == 1), &
-          merge(1, -1, mod(sweep, 2) == 1)
-        if (group(k) .or. .not. closed(k)) cycle
-        if (.not. (reached(scene%row_body(2, k)) .or. (scene%row_body(1, k) > 0 .and. &
-            reached(scene%row_body(1, k))))) cycle
-        group(k) = .true.
-        reached(scene%row_body(:, k)) = .true.
-        grew = .true.
+    rows(1) = start
+    n = 1
+    set%stamp = set%stamp + 1
+    n_queued = 0
+    call reach_ends(start)
+    head = 0
+    do while (head < n_queued)
+      head = head + 1
+      b = set%queue(head)
+      do p = set%row_start(b), set%row_start(b + 1) - 1
+        j = set%row_list(p)
+        if (group(j) .or. .not. closed(j)) cycle
+        group(j) = .true.
+        n = n + 1
+        rows(n) = j
+        call reach_ends(j)
       end do
     end do
+    ! (row order: a few rows sorted, a long group read off the marks)
+    if (n <= max_scope) then
+      call sort_increasing(rows(:n))
+    else
+      call list_closed(group, rows, n)
+    end if
+
+  contains
+
+    !> Row j's bodies not reached yet join the queue.
+    subroutine reach_ends(j)
+      integer, intent(in) :: j
+      do e = 1, 2
+        associate (i => scene%row_body(e, j))
+          if (i == 0) cycle
+          if (set%mark(i) == set%stamp) cycle
+          set%mark(i) = set%stamp
+          n_queued = n_queued + 1
+          set%queue(n_queued) = i
+        end associate
+      end do
+    end subroutine reach_ends
   end subroutine closed_group
 
   !> An event point whose impulses hit the rows marked, recorded; when the last points make
   !> an accumulation over several contacts (impact1d_accumulation) whose rest is near, its
   !> rows close now: snapped, the bodies they join moving as one (at rest if joined to the
   !> ground), their rests logged at the series' limit time.
-  subroutine cut_cycle(scene, hit, closed, s, event_log, sink, stats)
+  subroutine cut_cycle(scene, hit, closed, s, event_log, work, sink, stats)
     type(scene_type), intent(in) :: scene
     logical, intent(in) :: hit(:)
     logical, intent(inout) :: closed(:)
     type(state_type), intent(inout) :: s
     type(event_log_type), intent(inout) :: event_log
+    type(point_work_type), intent(inout) :: work
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
     real(wp) :: u(scene%n_rows), remaining, v(scene%n_bodies)
@@ -510,7 +586,8 @@ contains
     if (.not. found) return
     call event_log%cycles%forget()
     closed = closed .or. rows
-    call snap_closed(scene, closed, s)
+    call list_closed(closed, work%closed_rows, work%n_closed)
+    call snap_closed(scene, work%closed_rows(:work%n_closed), s)
     v = s%v
     call join_moving(scene, rows, s%t, v)
     if (scene%drives%n > 0) then
@@ -527,14 +604,14 @@ contains
   !> order among equals); rows inside a rigid group never approach.
   integer function most_approaching(scene, closed, t, v, tol) result(k_best)
     type(scene_type), intent(in) :: scene
-    logical, intent(in) :: closed(:)
+    integer, intent(in) :: closed(:)      !< the closed rows, in row order
     real(wp), intent(in) :: t, v(:), tol(:)
-    integer :: k
+    integer :: k, p
     real(wp) :: u, u_best
     k_best = 0
     u_best = 0.0_wp
-    do k = 1, scene%n_rows
-      if (.not. closed(k)) cycle
+    do p = 1, size(closed)
+      k = closed(p)
       u = row_velocity(scene, k, v, t)
       if (u < min(u_best, -tol(k))) then
         k_best = k
@@ -562,6 +639,13 @@ contains
     end do
     if (root(1) == root(2) .or. sum(inverse) == 0.0_wp) return
     p = -(1.0_wp + r) * row_velocity(scene, k, v, t) / sum(inverse)
+    if (.not. work%any_rigid) then
+      ! (each body its own group: the row's ends alone)
+      do e = 1, 2
+        if (root(e) > 0) v_after(root(e)) = v(root(e)) + scene%row_normal(e, k) * p * inverse(e)
+      end do
+      return
+    end if
     do i = 1, scene%n_bodies
       do e = 1, 2
         if (root(e) > 0 .and. work%rigid(i) == root(e)) v_after(i) = v(i) + scene%row_normal(e, k) * p * inverse(e)
@@ -569,47 +653,48 @@ contains
     end do
   end subroutine impulse
 
-  !> The joint perfectly inelastic impact of the closed rows (impact1d_cluster_impact), on the
-  !> bodies they touch gathered into one problem: v_after, and pushed, the rows it pushed.
-  !> With moving grounds it is taken in each body's ground's frame (frame_velocity).
-  subroutine joint_projection(scene, work, closed, t, v, tol, v_after, pushed, error)
+  !> The joint perfectly inelastic impact of the closed rows marked (closed; listed in row
+  !> order: rows) (impact1d_cluster_impact), on the bodies they touch gathered into one
+  !> problem: v_after, and pushed, the rows it pushed. With moving grounds it is taken in
+  !> each body's ground's frame (frame_velocity).
+  subroutine joint_projection(scene, work, closed, rows, t, v, tol, v_after, pushed, error)
     type(scene_type), intent(in) :: scene
-    type(impact_work_type), intent(inout) :: work
+    type(point_work_type), intent(inout) :: work
     logical, intent(in) :: closed(:)
+    integer, intent(in) :: rows(:)
     real(wp), intent(in) :: t, v(:), tol(:)
     real(wp), intent(out) :: v_after(:)
     logical, intent(out) :: pushed(:)
     type(error_type), allocatable, intent(inout) :: error
-    integer :: local(0:scene%n_bodies), body(scene%n_bodies), rows(scene%n_rows), row_local(2, scene%n_rows), nb, &
-      nr, k, e, status
-    real(wp) :: v_local(scene%n_bodies), impulse_local(scene%n_rows), frame(scene%n_bodies)
-    logical :: pushed_local(scene%n_rows), fits
-    local = 0
+    integer :: body(scene%n_bodies), row_local(2, size(rows)), nb, nr, k, e, status
+    real(wp) :: v_local(scene%n_bodies), impulse_local(size(rows)), frame(scene%n_bodies)
+    logical :: pushed_local(size(rows)), fits
     nb = 0
-    nr = 0
-    do k = 1, scene%n_rows
-      if (.not. closed(k)) cycle
-      nr = nr + 1
-      rows(nr) = k
+    nr = size(rows)
+    ! (work%local: 0 but for the bodies numbered here, reset before leaving)
+    do k = 1, nr
       do e = 1, 2
-        associate (i => scene%row_body(e, k))
+        associate (i => scene%row_body(e, rows(k)))
           if (i == 0) cycle
-          if (local(i) > 0) cycle
+          if (work%local(i) > 0) cycle
           nb = nb + 1
           body(nb) = i
-          local(i) = nb
+          work%local(i) = nb
         end associate
       end do
     end do
+    do k = 1, nr
+      row_local(:, k) = work%local(scene%row_body(:, rows(k)))
+    end do
+    work%local(body(:nb)) = 0
     v_after = v
     pushed = .false.
     if (nr == 0) return
     ! (with moving grounds the projection is taken in their frame: frame_velocity)
     frame = 0.0_wp
     if (scene%drives%n > 0) frame = frame_velocity(scene, closed, t)
-    row_local(:, :nr) = reshape([(local(scene%row_body(:, rows(k))), k = 1, nr)], [2, nr])
-    call path_impact_reserve(work%path, nb)
-    call path_projection(work%path, scene%body_mass(body(:nb)), v(body(:nb)) - frame(body(:nb)), row_local(:, :nr), &
+    call path_impact_reserve(work%impact%path, nb)
+    call path_projection(work%impact%path, scene%body_mass(body(:nb)), v(body(:nb)) - frame(body(:nb)), row_local(:, :nr), &
       scene%row_normal(:, rows(:nr)), tol(rows(:nr)), v_local(:nb), impulse_local(:nr), pushed_local(:nr), fits)
     if (.not. fits) then
       call dense_projection()
@@ -628,8 +713,8 @@ contains
           'too large for the dense projection (more than ' // trim(fmt(max_dense_unknowns)) // ': issue 20)')
         return
       end if
-      call impact_reserve(work, nb, nr)
-      call cluster_projection(work, scene%body_mass(body(:nb)), v(body(:nb)) - frame(body(:nb)), row_local(:, :nr), &
+      call impact_reserve(work%impact, nb, nr)
+      call cluster_projection(work%impact, scene%body_mass(body(:nb)), v(body(:nb)) - frame(body(:nb)), row_local(:, :nr), &
         scene%row_normal(:, rows(:nr)), spread(.true., 1, nr), tol(rows(:nr)), v_local(:nb), impulse_local(:nr), &
         pushed_local(:nr), status)
       if (status /= lcp_solved) then
@@ -641,12 +726,14 @@ contains
   end subroutine joint_projection
 
   !> A row between bodies that took an impulse gives both its ends the larger scale.
-  pure subroutine share_scale(scene, pushed, entry_scale)
+  pure subroutine share_scale(scene, pushed, rows, entry_scale)
     type(scene_type), intent(in) :: scene
     logical, intent(in) :: pushed(:)
+    integer, intent(in) :: rows(:)     !< rows in row order, the pushed ones among them
     real(wp), intent(inout) :: entry_scale(:)
-    integer :: k
-    do k = 1, scene%n_rows
+    integer :: k, p
+    do p = 1, size(rows)
+      k = rows(p)
       if (.not. pushed(k) .or. scene%row_body(1, k) == 0) cycle
       entry_scale(scene%row_body(:, k)) = maxval(entry_scale(scene%row_body(:, k)))
     end do
@@ -669,26 +756,30 @@ contains
     real(wp) :: v_after(scene%n_bodies)
     logical :: pushed(scene%n_rows)
     type(error_type), allocatable :: ignored
-    integer :: k, e
+    integer :: k, e, p
     call zero_stopped(scene, s, acc, entry_scale)
-    call joint_projection(scene, work%impact, closed, s%t, s%v, spread(0.0_wp, 1, scene%n_rows), v_after, pushed, &
-      ignored)
-    if (.not. allocated(ignored) .and. count(pushed) >= 2) call settle_apply(closed)
-    do k = 1, scene%n_rows
-      if (.not. closed(k)) cycle
+    associate (rows => work%closed_rows(:work%n_closed))
+      call joint_projection(scene, work, closed, rows, s%t, s%v, spread(0.0_wp, 1, scene%n_rows), v_after, pushed, &
+        ignored)
+      if (.not. allocated(ignored) .and. count(pushed(rows)) >= 2) call settle_apply(closed)
+    end associate
+    ! (the closed rows, in row order: work%closed_rows)
+    do p = 1, work%n_closed
+      k = work%closed_rows(p)
       if (abs(row_velocity(scene, k, s%v, s%t)) <= u_tolerance(scene, k, s%v, acc, entry_scale) .and. &
           row_velocity(scene, k, s%v, s%t) /= 0.0_wp) then
         call impulse(scene, work, k, 0.0_wp, s%t, s%v, v_after)
         call settle_apply(closed)
       end if
     end do
-    do k = 1, scene%n_rows
-      if (closed(k)) call settle_bounce_series(scene, mode, k, f, df, closed, acc, entry_scale, s, event_log, &
+    do p = 1, work%n_closed
+      call settle_bounce_series(scene, mode, work%closed_rows(p), f, df, closed, acc, entry_scale, s, event_log, &
         work, sink, stats)
     end do
     call zero_stopped(scene, s, acc, entry_scale)
-    do k = 1, scene%n_rows
-      if (.not. closed(k) .or. scene%row_body(1, k) == 0) cycle
+    do p = 1, work%n_closed
+      k = work%closed_rows(p)
+      if (scene%row_body(1, k) == 0) cycle
       if (abs(row_velocity(scene, k, s%v)) > u_tolerance(scene, k, s%v, acc, entry_scale)) cycle
       do e = 1, 2
         if (s%v(scene%row_body(e, k)) == 0.0_wp) call zero_velocity(scene, s, scene%row_body(3 - e, k))
@@ -1032,18 +1123,18 @@ contains
     type(run_stats), intent(inout) :: stats
     real(wp), dimension(scene%n_bodies) :: acc, tol_a, acc_rate
     real(wp) :: rate_tol, direction
-    logical :: leaving, resting_now
+    logical :: leaving, resting_now, ready
     integer :: k, i
 
-    call mode_acceleration(scene, new, s%t, f, acc)
-    call new%rate_response(df, acc_rate)
-    if (scene%drives%n > 0) call drive_accelerations(scene, new, s%t, 3, acc_rate)
-    tol_a = 1.0e3_wp * eps_wp * force_scale(scene, f, df) / scene%body_mass
-    rate_tol = 1.0e3_wp * eps_wp * sum(abs(df))
+    ! (the accelerations, their rates and tolerances only where a row leaves contact or a
+    ! body has static friction: an event of frictionless bodies that no contact held needs
+    ! none of these O(N) sums)
+    ready = .false.
     do k = 1, scene%n_rows
       if (new%active(k) .and. .not. event_log%in_contact(k)) then
         call event_log%begin_rest(scene, k, s%t, s%t, s%v, sink, stats)
       else if (event_log%in_contact(k) .and. .not. new%active(k)) then
+        call prepare()
         if (.not. candidate(k) .or. row_acceleration(k, acc, 2) > row_abs_tol(k, tol_a) .or. &
             (row_acceleration(k, acc, 2) >= -row_abs_tol(k, tol_a) .and. &
             row_acceleration(k, acc_rate, 3) > rate_tol / minval(scene%body_mass))) then
@@ -1059,6 +1150,7 @@ contains
     end do
     do i = 1, scene%n_bodies
       if (scene%body_static(i) == 0.0_wp) cycle
+      call prepare()
       ! Its sliding direction; a body that breaks away with no sliding friction has none
       ! (sgn 0): the way it accelerates.
       direction = new%sgn(i)
@@ -1080,6 +1172,17 @@ contains
     end do
 
   contains
+
+    !> acc, acc_rate, tol_a and rate_tol, once.
+    subroutine prepare()
+      if (ready) return
+      ready = .true.
+      call mode_acceleration(scene, new, s%t, f, acc)
+      call new%rate_response(df, acc_rate)
+      if (scene%drives%n > 0) call drive_accelerations(scene, new, s%t, 3, acc_rate)
+      tol_a = 1.0e3_wp * eps_wp * force_scale(scene, f, df) / scene%body_mass
+      rate_tol = 1.0e3_wp * eps_wp * sum(abs(df))
+    end subroutine prepare
 
     !> Row j's gap acceleration (order 2) or its rate (3) at the bodies' a (with its moving
     !> ground end's).
