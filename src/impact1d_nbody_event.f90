@@ -48,6 +48,14 @@ module impact1d_nbody_event
     !> Some row is a rigid link's (row_partner): without, every body is its own rigid group.
     logical :: any_rigid = .false.
     integer, allocatable :: local(:)          !< (0:N) joint_projection's body numbering, 0 between uses
+    !> No body has friction: a mode is the clusters' solves, every other body alone
+    !> (scoped_mode).
+    logical :: frictionless = .false.
+    !> The bodies and rows of the clusters scoped_mode solved last: the only mode entries
+    !> not those of a body alone (when tracked; a solve of all clusters forgets them).
+    integer, allocatable :: mode_bodies(:), mode_rows(:)
+    integer :: n_mode_bodies = 0, n_mode_rows = 0
+    logical :: mode_tracked = .false.
     !> A mode whose entries only the bodies of the clusters solved last are read from
     !> (cluster_gap_acceleration).
     type(body_mode_type) :: scratch
@@ -80,6 +88,10 @@ contains
     allocate(work%closed_rows(max(scene%n_rows, 1)), work%local(0:scene%n_bodies))
     work%local = 0
     work%any_rigid = any(scene%row_partner > 0)
+    work%frictionless = all(scene%body_static == 0.0_wp) .and. all(scene%body_friction == 0.0_wp)
+    if (allocated(work%mode_bodies)) deallocate(work%mode_bodies, work%mode_rows)
+    allocate(work%mode_bodies(scene%n_bodies), work%mode_rows(max(scene%n_rows, 1)))
+    work%mode_tracked = .false.
     ! (lock_rigid's groups and masses without rigid links)
     work%rigid = [(i, i = 0, scene%n_bodies)]
     work%rigid_mass(0) = 0.0_wp
@@ -140,7 +152,12 @@ contains
       candidate(k) = abs(row_velocity(scene, k, s%v, s%t)) <= u_tolerance(scene, k, s%v, acc, entry_scale)
     end do
     ! (solved in place: the old mode is not read past here, and a failed solve ends the run)
-    call solve_mode_at(scene, work%mode, s%t, f, df, s%v, candidate, mode, status)
+    if (initial .or. .not. work%frictionless .or. scene%drives%n > 0) then
+      call solve_mode_at(scene, work%mode, s%t, f, df, s%v, candidate, mode, status)
+      work%mode_tracked = .false.
+    else
+      call scoped_mode(scene, work, closed, f, df, acc, entry_scale, s%t, s%v, candidate, mode, status)
+    end if
     if (status == lcp_too_large) then
       call raise(error, status_simulation, 'at t = ' // trim(fmt(s%t)) // ': the bodies joined by closed ' // &
         'contacts form a cluster too large for the dense mode solve (more than ' // &
@@ -416,7 +433,7 @@ contains
         .not. all(internal(group_rows(:n_group)))
       v_before = s%v
       if (joint) then
-        call closed_tolerances(tol)
+        ! (tol is this iteration's: the velocities have not moved since)
         call joint_projection(scene, work, group, group_rows(:n_group), s%t, s%v, tol, v_after, pushed, error)
         if (allocated(error)) return
       else
@@ -1022,6 +1039,115 @@ contains
     call sort_increasing(body(:nb))
     call sort_increasing(rows(:nr))
   end subroutine cluster_of
+
+  !> The mode of a scene without friction or moving grounds as solve_body_mode solves it, at
+  !> the cost of the clusters that need a solve (those of candidate rows: closed rows listed
+  !> in work%closed_rows) and of the ones solved last time: every other body is alone (not
+  !> stuck, no sliding direction, its own group), every other row free. Each cluster is found
+  !> breadth first (cluster_of: the candidate predicate of nbody_event_point), solved by
+  !> solve_cluster and grouped as set_groups groups it (cluster_groups). A cluster past
+  !> max_scope bodies, or a failed solve, takes solve_body_mode over all, which sets every
+  !> entry (and its status is the run's).
+  subroutine scoped_mode(scene, work, closed, f, df, acc, entry_scale, t, v, candidate, mode, status)
+    type(scene_type), intent(in) :: scene
+    type(point_work_type), intent(inout) :: work
+    logical, intent(in) :: closed(:), candidate(:)
+    real(wp), intent(in) :: f(:), df(:), acc(:), entry_scale(:), t, v(:)
+    type(body_mode_type), intent(inout) :: mode
+    integer, intent(out) :: status
+    integer :: body(max_scope), rows(max_scope_rows), nb, nr, p, i, k
+    logical :: fits
+    if (work%mode_tracked) then
+      do p = 1, work%n_mode_bodies
+        call alone(work%mode_bodies(p))
+      end do
+      mode%active(work%mode_rows(:work%n_mode_rows)) = .false.
+    else
+      do i = 1, scene%n_bodies
+        call alone(i)
+      end do
+      mode%active = .false.
+    end if
+    work%n_mode_bodies = 0
+    work%n_mode_rows = 0
+    work%mode_tracked = .true.
+    mode%held = .false.
+    status = mode_solved
+    do p = 1, work%n_closed
+      k = work%closed_rows(p)
+      if (.not. candidate(k)) cycle
+      ! (a cluster already solved: its bodies are listed)
+      if (any(work%mode_bodies(:work%n_mode_bodies) == scene%row_body(2, k))) cycle
+      call cluster_of(scene, work%incidence, 0, scene%row_body(2, k), closed, t, v, acc, entry_scale, body, nb, &
+        rows, nr, fits)
+      if (fits) then
+        work%mode_bodies(work%n_mode_bodies + 1:work%n_mode_bodies + nb) = body(:nb)
+        work%mode_rows(work%n_mode_rows + 1:work%n_mode_rows + nr) = rows(:nr)
+        work%n_mode_bodies = work%n_mode_bodies + nb
+        work%n_mode_rows = work%n_mode_rows + nr
+        work%mode%first(1:2) = [1, nb + 1]
+        work%mode%member(1:nb) = body(:nb)
+        work%mode%first_row(1:2) = [1, nr + 1]
+        work%mode%row(1:nr) = rows(:nr)
+        call solve_cluster(scene, work%mode, 1, f, df, v, mode, status)
+      end if
+      if (.not. fits .or. status /= mode_solved) then
+        call solve_body_mode(scene, work%mode, f, df, v, candidate, mode, status)
+        work%mode_tracked = .false.
+        return
+      end if
+      call cluster_groups(scene, mode, body(:nb), rows(:nr))
+    end do
+
+  contains
+
+    !> Body j as solve_body_mode leaves a body in no cluster, without friction.
+    subroutine alone(j)
+      integer, intent(in) :: j
+      mode%stuck(j) = .false.
+      mode%sgn(j) = 0.0_wp
+      mode%group(j) = j
+      mode%group_mass(j) = 0.0_wp + scene%body_mass(j)
+      mode%f_slide(j) = -scene%body_friction(j) * mode%sgn(j)
+    end subroutine alone
+  end subroutine scoped_mode
+
+  !> set_groups over one solved cluster (its bodies and rows in increasing order): a group's
+  !> id is its least body (0: joined to the ground or a stuck body), as set_groups' union-find
+  !> leaves it; its mass summed in body order; the sliding forces; held.
+  subroutine cluster_groups(scene, mode, body, rows)
+    type(scene_type), intent(in) :: scene
+    type(body_mode_type), intent(inout) :: mode
+    integer, intent(in) :: body(:), rows(:)
+    integer :: root(0:size(body)), j, p, r
+    logical :: joined
+    root = [(j, j = 0, size(body))]
+    do j = 1, size(body)
+      if (mode%stuck(body(j))) root(j) = 0
+      mode%group_mass(body(j)) = 0.0_wp
+    end do
+    do p = 1, size(rows)
+      if (mode%active(rows(p))) joined = uf_join(root, local_of(scene%row_body(1, rows(p))), &
+        local_of(scene%row_body(2, rows(p))))
+    end do
+    do j = 1, size(body)
+      r = uf_find(root, j)
+      mode%group(body(j)) = 0
+      if (r > 0) mode%group(body(j)) = body(r)
+      if (r > 0) mode%group_mass(body(r)) = mode%group_mass(body(r)) + scene%body_mass(body(j))
+      mode%f_slide(body(j)) = -scene%body_friction(body(j)) * mode%sgn(body(j))
+    end do
+    mode%held = mode%held .or. any(mode%active(rows)) .or. any(mode%stuck(body))
+
+  contains
+
+    !> Body i's number in the cluster (0: the ground).
+    integer function local_of(i)
+      integer, intent(in) :: i
+      local_of = 0
+      if (i > 0) local_of = findloc(body, i, 1)
+    end function local_of
+  end subroutine cluster_groups
 
   !> Insertion sort (a cluster's few bodies or rows).
   pure subroutine sort_increasing(list)
