@@ -774,6 +774,7 @@ contains
     logical :: pushed(scene%n_rows)
     type(error_type), allocatable :: ignored
     integer :: k, e, p
+    real(wp) :: accel_bound
     call zero_stopped(scene, s, acc, entry_scale)
     associate (rows => work%closed_rows(:work%n_closed))
       call joint_projection(scene, work, closed, rows, s%t, s%v, spread(0.0_wp, 1, scene%n_rows), v_after, pushed, &
@@ -789,9 +790,15 @@ contains
         call settle_apply(closed)
       end if
     end do
+    ! A bound on any row's gap acceleration in a mode, |n . a| <= 2 (sum |f| + friction) /
+    ! least mass, doubled for rounding (none with moving grounds, whose rows follow w''; nor
+    ! with rigid links, whose impulses' union-find steps must all be taken)
+    accel_bound = huge(1.0_wp)
+    if (work%n_closed > 0 .and. scene%drives%n == 0 .and. .not. work%any_rigid) accel_bound = &
+      4.0_wp * (sum(abs(f)) + sum(scene%body_friction)) / minval(scene%body_mass)
     do p = 1, work%n_closed
-      call settle_bounce_series(scene, mode, work%closed_rows(p), f, df, closed, acc, entry_scale, s, event_log, &
-        work, sink, stats)
+      call settle_bounce_series(scene, mode, work%closed_rows(p), f, df, closed, acc, entry_scale, accel_bound, s, &
+        event_log, work, sink, stats)
     end do
     call zero_stopped(scene, s, acc, entry_scale)
     do p = 1, work%n_closed
@@ -821,11 +828,13 @@ contains
   !> rising (a_up) and falling back (a_down) from the mode with k left free. If what remains
   !> of the series is below the clock's resolution, the row rests now, logged at the
   !> series' accumulation time (the two-body engine's settle_bounce_series).
-  subroutine settle_bounce_series(scene, mode, k, f, df, closed, acc, entry_scale, s, event_log, work, sink, stats)
+  subroutine settle_bounce_series(scene, mode, k, f, df, closed, acc, entry_scale, accel_bound, s, event_log, work, &
+    sink, stats)
     type(scene_type), intent(in) :: scene
     type(body_mode_type), intent(in) :: mode
     integer, intent(in) :: k
     real(wp), intent(in) :: f(:), df(:), acc(:), entry_scale(:)
+    real(wp), intent(in) :: accel_bound   !< on |the row's gap acceleration| in any mode
     logical, intent(in) :: closed(:)
     type(state_type), intent(inout) :: s
     type(event_log_type), intent(inout) :: event_log
@@ -836,6 +845,9 @@ contains
     type(error_type), allocatable :: unchecked
     u = row_velocity(scene, k, s%v, s%t)
     if (u <= u_tolerance(scene, k, s%v, acc, entry_scale)) return
+    ! The series lasts at least u / |a_up|: one that cannot end within the clock's resolution
+    ! needs no mode solved (the test below would return).
+    if (u > time_rounding * max(abs(s%t), scene%dt) * accel_bound) return
     a_up = free_gap_acceleration(s%v)
     if (a_up >= 0.0_wp) return
     call impulse(scene, work, k, 1.0_wp, s%t, s%v, v_bounce)
