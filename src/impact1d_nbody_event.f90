@@ -57,7 +57,7 @@ module impact1d_nbody_event
     integer :: n_mode_bodies = 0, n_mode_rows = 0
     logical :: mode_tracked = .false.
     !> A mode whose entries only the bodies of the clusters solved last are read from
-    !> (cluster_gap_acceleration).
+    !> (cluster_acceleration).
     type(body_mode_type) :: scratch
   end type point_work_type
 
@@ -282,7 +282,9 @@ contains
             s%x_lo(ea) = s%x_lo(eb)
             call add_compensated(s%x(ea), s%x_lo(ea), -limit)
           end if
-          placed(scene%row_body(:, k)) = .true.
+          ! (each end by itself: a vector subscript took a heap temporary a row)
+          placed(ea) = .true.
+          placed(eb) = .true.
           grew = .true.
         end associate
       end do
@@ -701,7 +703,8 @@ contains
       end do
     end do
     do k = 1, nr
-      row_local(:, k) = work%local(scene%row_body(:, rows(k)))
+      row_local(1, k) = work%local(scene%row_body(1, rows(k)))
+      row_local(2, k) = work%local(scene%row_body(2, rows(k)))
     end do
     work%local(body(:nb)) = 0
     v_after = v
@@ -752,7 +755,11 @@ contains
     do p = 1, size(rows)
       k = rows(p)
       if (.not. pushed(k) .or. scene%row_body(1, k) == 0) cycle
-      entry_scale(scene%row_body(:, k)) = maxval(entry_scale(scene%row_body(:, k)))
+      ! (the two ends by name: a vector subscript took a heap temporary a row)
+      associate (a => scene%row_body(1, k), b => scene%row_body(2, k))
+        entry_scale(a) = max(entry_scale(a), entry_scale(b))
+        entry_scale(b) = entry_scale(a)
+      end associate
     end do
   end subroutine share_scale
 
@@ -774,7 +781,7 @@ contains
     logical :: pushed(scene%n_rows)
     type(error_type), allocatable :: ignored
     integer :: k, e, p
-    real(wp) :: accel_bound
+    real(wp) :: accel_bound, u
     call zero_stopped(scene, s, acc, entry_scale)
     associate (rows => work%closed_rows(:work%n_closed))
       call joint_projection(scene, work, closed, rows, s%t, s%v, spread(0.0_wp, 1, scene%n_rows), v_after, pushed, &
@@ -797,8 +804,15 @@ contains
     if (work%n_closed > 0 .and. scene%drives%n == 0 .and. .not. work%any_rigid) accel_bound = &
       4.0_wp * (sum(abs(f)) + sum(scene%body_friction)) / minval(scene%body_mass)
     do p = 1, work%n_closed
-      call settle_bounce_series(scene, mode, work%closed_rows(p), f, df, closed, acc, entry_scale, accel_bound, s, &
-        event_log, work, sink, stats)
+      k = work%closed_rows(p)
+      ! (its tests that need no mode first, here: settle_bounce_series' N-long scratch is a
+      ! heap allocation a call)
+      u = row_velocity(scene, k, s%v, s%t)
+      if (u <= u_tolerance(scene, k, s%v, acc, entry_scale)) cycle
+      ! The series lasts at least u / |a_up|: one that cannot end within the clock's
+      ! resolution needs no mode solved (settle_bounce_series would return).
+      if (u > time_rounding * max(abs(s%t), scene%dt) * accel_bound) cycle
+      call settle_bounce_series(scene, mode, k, u, f, df, closed, acc, entry_scale, s, event_log, work, sink, stats)
     end do
     call zero_stopped(scene, s, acc, entry_scale)
     do p = 1, work%n_closed
@@ -828,26 +842,20 @@ contains
   !> rising (a_up) and falling back (a_down) from the mode with k left free. If what remains
   !> of the series is below the clock's resolution, the row rests now, logged at the
   !> series' accumulation time (the two-body engine's settle_bounce_series).
-  subroutine settle_bounce_series(scene, mode, k, f, df, closed, acc, entry_scale, accel_bound, s, event_log, work, &
-    sink, stats)
+  subroutine settle_bounce_series(scene, mode, k, u, f, df, closed, acc, entry_scale, s, event_log, work, sink, stats)
     type(scene_type), intent(in) :: scene
     type(body_mode_type), intent(in) :: mode
     integer, intent(in) :: k
+    real(wp), intent(in) :: u    !< its normal velocity, separating beyond rounding (settle)
     real(wp), intent(in) :: f(:), df(:), acc(:), entry_scale(:)
-    real(wp), intent(in) :: accel_bound   !< on |the row's gap acceleration| in any mode
     logical, intent(in) :: closed(:)
     type(state_type), intent(inout) :: s
     type(event_log_type), intent(inout) :: event_log
     type(point_work_type), intent(inout) :: work
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
-    real(wp) :: u, a_up, a_down, remaining, v_bounce(scene%n_bodies)
+    real(wp) :: a_up, a_down, remaining, v_bounce(scene%n_bodies)
     type(error_type), allocatable :: unchecked
-    u = row_velocity(scene, k, s%v, s%t)
-    if (u <= u_tolerance(scene, k, s%v, acc, entry_scale)) return
-    ! The series lasts at least u / |a_up|: one that cannot end within the clock's resolution
-    ! needs no mode solved (the test below would return).
-    if (u > time_rounding * max(abs(s%t), scene%dt) * accel_bound) return
     a_up = free_gap_acceleration(s%v)
     if (a_up >= 0.0_wp) return
     call impulse(scene, work, k, 1.0_wp, s%t, s%v, v_bounce)
