@@ -26,7 +26,7 @@ module impact1d_body_mode
   implicit none
   private
   public :: body_mode_type, mode_work_type, new_mode, solve_body_mode, same_mode, mode_solved
-  public :: mode_reserve, gathered_mode
+  public :: mode_reserve, gathered_mode, solve_cluster
   public :: drive_accelerations, shift_to_drives, drive_components
 
   integer, parameter :: mode_solved = cluster_solved   !< otherwise an impact1d_lcp status

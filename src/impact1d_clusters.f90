@@ -1,7 +1,9 @@
 !> Clusters: the connected sets of bodies under closed body-body rows (issue 19, stage 4;
 !> docs/nbody-plan.md section 5, "Clusters"). A cluster is the unit of the mode solve and of
-!> a joint impact; a wall is the ground and never joins bodies. Kernel in place; the engine
-!> is wired to it in stage 4.
+!> a joint impact; a wall is the ground and never joins bodies. The N-body event point uses
+!> clusters_build's incidence lists (row_start, row_list) and the search's queue and marks to
+!> find what an event touches (impact1d_nbody_event); clusters_close / clusters_open are not
+!> called yet.
 !>
 !> What it guarantees:
 !> - After any sequence of clusters_close / clusters_open, cluster_of(i) = cluster_of(j) exactly

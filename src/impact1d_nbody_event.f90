@@ -15,13 +15,13 @@ module impact1d_nbody_event
   use impact1d_event_log, only: event_log_type, log_event
   use impact1d_event_point, only: bounce_series_time
   use impact1d_friction_laws, only: slip
-  use impact1d_clusters, only: uf_join, uf_find
+  use impact1d_clusters, only: uf_join, uf_find, cluster_set_type, clusters_build
   use impact1d_accumulation, only: join_cycle
   use impact1d_cluster_impact, only: impact_work_type, impact_reserve, cluster_projection
   use impact1d_path_impact, only: path_impact_reserve, path_projection
   use impact1d_lcp, only: lcp_solved, lcp_too_large
   use impact1d_body_mode, only: body_mode_type, mode_work_type, solve_body_mode, mode_solved, max_dense_unknowns, &
-    drive_accelerations, shift_to_drives, drive_components
+    drive_accelerations, shift_to_drives, drive_components, solve_cluster
   use impact1d_nbody_step, only: nbody_force, nbody_rate, row_gap, row_velocity, row_gap_tolerance, &
     found_row, found_body, found_stop, mode_acceleration, ground_motion, stop_gap_band, stop_force_band
   implicit none
@@ -38,7 +38,33 @@ module impact1d_nbody_event
     real(wp), allocatable :: scale(:)
     integer, allocatable :: rigid(:)          !< (0:N) bodies locked by rigid links (union-find)
     real(wp), allocatable :: rigid_mass(:)    !< (0:N) mass of each rigid group, by root
+    !> The rows on each body (impact1d_clusters' incidence lists, built at the first event
+    !> point) and its breadth-first search's queue and marks: what an event touches is found
+    !> from its rows' ends, not by a scan of all N (issue 20 item 3).
+    type(cluster_set_type) :: incidence
+    !> The closed rows of this event point, in row order (list_closed): the loops over closed
+    !> rows go over these, not over all rows.
+    integer, allocatable :: closed_rows(:)
+    integer :: n_closed = 0
+    !> Some row is a rigid link's (row_partner): without, every body is its own rigid group.
+    logical :: any_rigid = .false.
+    integer, allocatable :: local(:)          !< (0:N) joint_projection's body numbering, 0 between uses
+    !> No body has friction: a mode is the clusters' solves, every other body alone
+    !> (scoped_mode).
+    logical :: frictionless = .false.
+    !> The bodies and rows of the clusters scoped_mode solved last: the only mode entries
+    !> not those of a body alone (when tracked; a solve of all clusters forgets them).
+    integer, allocatable :: mode_bodies(:), mode_rows(:)
+    integer :: n_mode_bodies = 0, n_mode_rows = 0
+    logical :: mode_tracked = .false.
+    !> A mode whose entries only the bodies of the clusters solved last are read from
+    !> (cluster_acceleration).
+    type(body_mode_type) :: scratch
   end type point_work_type
+
+  !> The largest cluster (bodies; rows four times as many) whose mode is solved on its own
+  !> to find a row's free gap acceleration; a larger one takes the solve of all clusters.
+  integer, parameter :: max_scope = 64, max_scope_rows = 4 * max_scope
 
 contains
 
@@ -49,6 +75,30 @@ contains
     allocate(work%scale(n), work%rigid(0:n), work%rigid_mass(0:n))
     work%scale = 0.0_wp
   end subroutine new_point_work
+
+  !> What the event points of a run share, set at its first: the rows on each body, the
+  !> rigid groups when there are no rigid links (each body alone), a scratch mode.
+  subroutine first_point(scene, mode, work)
+    type(scene_type), intent(in) :: scene
+    type(body_mode_type), intent(in) :: mode
+    type(point_work_type), intent(inout) :: work
+    integer :: i
+    ! (the rigid rows only: the compliant stops' rows after them are elements, never closed)
+    call clusters_build(work%incidence, scene%n_bodies, scene%row_body(:, 1:scene%n_rows))
+    work%scratch = mode
+    if (allocated(work%closed_rows)) deallocate(work%closed_rows, work%local)
+    allocate(work%closed_rows(max(scene%n_rows, 1)), work%local(0:scene%n_bodies))
+    work%local = 0
+    work%any_rigid = any(scene%row_partner > 0)
+    work%frictionless = all(scene%body_static == 0.0_wp) .and. all(scene%body_friction == 0.0_wp)
+    if (allocated(work%mode_bodies)) deallocate(work%mode_bodies, work%mode_rows)
+    allocate(work%mode_bodies(scene%n_bodies), work%mode_rows(max(scene%n_rows, 1)))
+    work%mode_tracked = .false.
+    ! (lock_rigid's groups and masses without rigid links)
+    work%rigid = [(i, i = 0, scene%n_bodies)]
+    work%rigid_mass(0) = 0.0_wp
+    work%rigid_mass(1:) = scene%body_mass
+  end subroutine first_point
 
   !> The event point at s%t: found, index say what the location found (a row, a body); initial:
   !> the run's start (no mode yet). Leaves the new mode.
@@ -65,9 +115,9 @@ contains
     type(error_type), allocatable, intent(inout) :: error
     real(wp), dimension(scene%n_bodies) :: f, df, acc, entry_scale
     logical :: closed(scene%n_rows), candidate(scene%n_rows), hit(scene%n_rows), stopped(scene%n_bodies)
-    type(body_mode_type) :: new
-    integer :: k, i, status
+    integer :: k, i, p, status
 
+    if (initial) call first_point(scene, mode, work)
     if (scene%n_stops > 0) then
       call nbody_force(scene, s%t, s%x, s%x_lo, s%v, f, mode%engaged)
       if (initial) then
@@ -79,7 +129,7 @@ contains
     end if
     call nbody_force(scene, s%t, s%x, s%x_lo, s%v, f, mode%engaged)
     call nbody_rate(scene, s%t, s%v, df, mode%engaged)
-    call close_rows(scene, initial, merge(index, 0, found == found_row), s, closed)
+    call close_rows(scene, initial, merge(index, 0, found == found_row), s, closed, work%closed_rows, work%n_closed)
     ! Velocity scale of each body entering this event point: impulses redistribute velocity
     ! but cannot create precision, so what is below its rounding is zero.
     if (initial) then
@@ -97,7 +147,7 @@ contains
     call lock_rigid(scene, closed, stopped, s, work, sink, stats)
     call impacts(scene, closed, entry_scale, acc, s, work, hit, sink, stats, error)
     if (allocated(error)) return
-    if (any(hit)) call cut_cycle(scene, hit, closed, s, event_log, sink, stats)
+    if (any(hit)) call cut_cycle(scene, hit, closed, s, event_log, work, sink, stats)
     work%scale_time = s%t
     work%scale = entry_scale
     call settle(scene, mode, closed, f, df, acc, entry_scale, s, event_log, work, sink, stats)
@@ -107,13 +157,18 @@ contains
       call nbody_force(scene, s%t, s%x, s%x_lo, s%v, f, mode%engaged)
       call nbody_rate(scene, s%t, s%v, df, mode%engaged)
     end if
-    do k = 1, scene%n_rows
-      candidate(k) = closed(k)
-      if (candidate(k)) candidate(k) = abs(row_velocity(scene, k, s%v, s%t)) <= &
-        u_tolerance(scene, k, s%v, acc, entry_scale)
+    candidate = .false.
+    do p = 1, work%n_closed
+      k = work%closed_rows(p)
+      candidate(k) = abs(row_velocity(scene, k, s%v, s%t)) <= u_tolerance(scene, k, s%v, acc, entry_scale)
     end do
-    new = mode
-    call solve_mode_at(scene, work%mode, s%t, f, df, s%v, candidate, new, status)
+    ! (solved in place: the old mode is not read past here, and a failed solve ends the run)
+    if (initial .or. .not. work%frictionless .or. scene%drives%n > 0) then
+      call solve_mode_at(scene, work%mode, s%t, f, df, s%v, candidate, mode, status)
+      work%mode_tracked = .false.
+    else
+      call scoped_mode(scene, work, closed, f, df, acc, entry_scale, s%t, s%v, candidate, mode, status)
+    end if
     if (status == lcp_too_large) then
       call raise(error, status_simulation, 'at t = ' // trim(fmt(s%t)) // ': the bodies joined by closed ' // &
         'contacts form a cluster too large for the dense mode solve (more than ' // &
@@ -125,8 +180,7 @@ contains
         ': no consistent contact and friction state (complementarity problem has no solution)')
       return
     end if
-    call log_mode_change(scene, initial, f, df, candidate, new, s, event_log, sink, stats)
-    mode = new
+    call log_mode_change(scene, initial, f, df, candidate, mode, s, event_log, sink, stats)
   end subroutine nbody_event_point
 
   !> The compliant stops at this instant (docs/method.md section 10; impact1d_event_point's
@@ -208,12 +262,13 @@ contains
   !> The closed rows (the located one, gaps within rounding; at the start, within the
   !> rounding of the user's decimals), a rigid link's two rows together, each snapped onto
   !> its constraint.
-  pure subroutine close_rows(scene, initial, located, s, closed)
+  pure subroutine close_rows(scene, initial, located, s, closed, rows, n_closed)
     type(scene_type), intent(in) :: scene
     logical, intent(in) :: initial
     integer, intent(in) :: located
     type(state_type), intent(inout) :: s
     logical, intent(out) :: closed(:)
+    integer, intent(out) :: rows(:), n_closed    !< the closed rows in row order
     integer :: k
     real(wp) :: size_scale
     do k = 1, scene%n_rows
@@ -227,8 +282,22 @@ contains
     do k = 1, scene%n_rows
       if (scene%row_partner(k) > 0) closed(k) = closed(k) .or. closed(scene%row_partner(k))
     end do
-    call snap_closed(scene, closed, s)
+    call list_closed(closed, rows, n_closed)
+    call snap_closed(scene, rows(:n_closed), s)
   end subroutine close_rows
+
+  !> The rows marked closed, in row order.
+  pure subroutine list_closed(closed, rows, n_closed)
+    logical, intent(in) :: closed(:)
+    integer, intent(out) :: rows(:), n_closed
+    integer :: k
+    n_closed = 0
+    do k = 1, size(closed)
+      if (.not. closed(k)) cycle
+      n_closed = n_closed + 1
+      rows(n_closed) = k
+    end do
+  end subroutine list_closed
 
   !> Put every closed row exactly on its constraint, the bodies placed outward from what
   !> holds them: the bodies on closed ground rows first (at -offset / n_b), then across
@@ -241,14 +310,15 @@ contains
   !> link's second limit) move nothing. Passes alternate in direction: a chain takes two.
   pure subroutine snap_closed(scene, closed, s)
     type(scene_type), intent(in) :: scene
-    logical, intent(in) :: closed(:)
+    integer, intent(in) :: closed(:)      !< the closed rows, in row order
     type(state_type), intent(inout) :: s
     logical :: placed(0:scene%n_bodies), grew
     real(wp) :: limit
-    integer :: k, j, first, last, step
+    integer :: k, j, p, first, last, step
     placed = .false.
-    do k = 1, scene%n_rows
-      if (.not. closed(k) .or. scene%row_body(1, k) /= 0) cycle
+    do p = 1, size(closed)
+      k = closed(p)
+      if (scene%row_body(1, k) /= 0) cycle
       associate (b => scene%row_body(2, k))
         s%x(b) = -scene%row_offset(k) / scene%row_normal(2, k)
         s%x_lo(b) = 0.0_wp
@@ -261,10 +331,11 @@ contains
     do
       grew = .false.
       step = -step
-      first = merge(1, scene%n_rows, step > 0)
-      last = merge(scene%n_rows, 1, step > 0)
-      do k = first, last, step
-        if (.not. closed(k) .or. scene%row_body(1, k) == 0) cycle
+      first = merge(1, size(closed), step > 0)
+      last = merge(size(closed), 1, step > 0)
+      do p = first, last, step
+        k = closed(p)
+        if (scene%row_body(1, k) == 0) cycle
         associate (ea => scene%row_body(1, k), eb => scene%row_body(2, k))
           if (placed(ea) .eqv. placed(eb)) cycle
           limit = -scene%row_offset(k) / scene%row_normal(2, k)
@@ -277,17 +348,20 @@ contains
             s%x_lo(ea) = s%x_lo(eb)
             call add_compensated(s%x(ea), s%x_lo(ea), -limit)
           end if
-          placed(scene%row_body(:, k)) = .true.
+          ! (each end by itself: a vector subscript took a heap temporary a row)
+          placed(ea) = .true.
+          placed(eb) = .true.
           grew = .true.
         end associate
       end do
       if (grew) cycle
       ! A group that no placed body reaches: its first row's a end stays where it is.
-      do j = 1, scene%n_rows
-        if (.not. closed(j) .or. scene%row_body(1, j) == 0) cycle
+      do p = 1, size(closed)
+        j = closed(p)
+        if (scene%row_body(1, j) == 0) cycle
         if (.not. (placed(scene%row_body(1, j)) .or. placed(scene%row_body(2, j)))) exit
       end do
-      if (j > scene%n_rows) exit
+      if (p > size(closed)) exit
       placed(scene%row_body(1, j)) = .true.
       step = -1
     end do
@@ -325,6 +399,13 @@ contains
     integer :: i, k, r
     logical :: joined, halt(0:scene%n_bodies), links(scene%n_rows)
     type(error_type), allocatable :: ignored
+    if (.not. work%any_rigid) then
+      ! No rigid links: each body its own group (first_point's), the stopped ones halt alone.
+      do i = 1, scene%n_bodies
+        if (stopped(i)) call zero_velocity(scene, s, i)
+      end do
+      return
+    end if
     work%rigid = [(i, i = 0, scene%n_bodies)]
     do k = 1, scene%n_rows
       if (scene%row_partner(k) == 0) cycle
@@ -414,10 +495,16 @@ contains
     real(wp), dimension(scene%n_bodies) :: v_before, v_after
     real(wp) :: restitution(scene%n_rows), tol(scene%n_rows)
     logical :: pushed(scene%n_rows), group(scene%n_rows), internal(scene%n_rows), joint
-    integer :: k, n_impulses, root_a, root_b
+    integer :: k, p, n_impulses, root_a, root_b, group_rows(scene%n_rows), n_group
 
     hit = .false.
-    do k = 1, scene%n_rows
+    internal = .false.
+    tol = 0.0_wp
+    ! (only closed rows' restitution is read; with rigid links every row's roots are found,
+    ! as they were: the union-find's path halving is part of what impulse reads)
+    do p = 1, merge(scene%n_rows, work%n_closed, work%any_rigid)
+      k = p
+      if (.not. work%any_rigid) k = work%closed_rows(p)
       root_a = uf_find(work%rigid, scene%row_body(1, k))
       root_b = uf_find(work%rigid, scene%row_body(2, k))
       internal(k) = closed(k) .and. root_a == root_b
@@ -426,7 +513,7 @@ contains
     n_impulses = 0
     do
       call closed_tolerances(tol)
-      k = most_approaching(scene, closed, s%t, s%v, tol)
+      k = most_approaching(scene, work%closed_rows(:work%n_closed), s%t, s%v, tol)
       if (k == 0) exit
       n_impulses = n_impulses + 1
       if (n_impulses > scene%max_impulses) then
@@ -436,13 +523,13 @@ contains
           'ratio; raise &run max_impulses)')
         return
       end if
-      call closed_group(scene, closed, k, group)
-      joint = count(group) > 1 .and. all(restitution == 0.0_wp .or. .not. group) .and. &
-        .not. all(internal .or. .not. group)
+      call closed_group(scene, work%incidence, closed, k, group, group_rows, n_group)
+      joint = n_group > 1 .and. all(restitution(group_rows(:n_group)) == 0.0_wp) .and. &
+        .not. all(internal(group_rows(:n_group)))
       v_before = s%v
       if (joint) then
-        call closed_tolerances(tol)
-        call joint_projection(scene, work%impact, group, s%t, s%v, tol, v_after, pushed, error)
+        ! (tol is this iteration's: the velocities have not moved since)
+        call joint_projection(scene, work, group, group_rows(:n_group), s%t, s%v, tol, v_after, pushed, error)
         if (allocated(error)) return
       else
         call impulse(scene, work, k, restitution(k), s%t, s%v, v_after)
@@ -458,9 +545,11 @@ contains
         if (allocated(error)) return
         call apply(scene, s, v_after)
       end if
-      call share_scale(scene, pushed, entry_scale)
-      hit = hit .or. pushed
-      do k = 1, scene%n_rows
+      ! (what was pushed is in the group: its rows, in row order)
+      call share_scale(scene, pushed, group_rows(:n_group), entry_scale)
+      do p = 1, n_group
+        k = group_rows(p)
+        hit(k) = hit(k) .or. pushed(k)
         if (pushed(k)) call log_event(scene, sink, stats, s%t, class_impact, k, v_before, s%v)
       end do
     end do
@@ -471,11 +560,10 @@ contains
     !> closed rows, a joint impact at its group's; every row's was a few percent of a
     !> 1000-body chain's run).
     subroutine closed_tolerances(tol)
-      real(wp), intent(out) :: tol(:)
+      real(wp), intent(inout) :: tol(:)
       integer :: j
-      do j = 1, scene%n_rows
-        tol(j) = 0.0_wp
-        if (closed(j)) tol(j) = u_tolerance(scene, j, s%v, acc, entry_scale)
+      do j = 1, work%n_closed
+        tol(work%closed_rows(j)) = u_tolerance(scene, work%closed_rows(j), s%v, acc, entry_scale)
       end do
     end subroutine closed_tolerances
   end subroutine impacts
@@ -530,49 +618,72 @@ contains
     end do
   end function frame_velocity
 
-  !> The closed rows joined to row `start` through shared bodies (the ground joins nothing).
-  !> Sweeps over the rows until none joins, every other one in reverse: a chain numbered
-  !> along its length is then reached in three sweeps whichever way it grows from start (in
-  !> one direction only a sweep added one row: a train's take-up, reaching back through its
-  !> standing part, took N sweeps and 88% of a 10,000-wagon run).
-  pure subroutine closed_group(scene, closed, start, group)
+  !> The closed rows joined to row `start` through shared bodies (the ground joins nothing):
+  !> group, and the same rows listed in row order (rows(:n)). Breadth first over the rows on
+  !> each body reached (set: the incidence lists), so O(the group), not sweeps over all rows.
+  subroutine closed_group(scene, set, closed, start, group, rows, n)
     type(scene_type), intent(in) :: scene
+    type(cluster_set_type), intent(inout) :: set
     logical, intent(in) :: closed(:)
     integer, intent(in) :: start
     logical, intent(out) :: group(:)
-    logical :: reached(0:scene%n_bodies), grew
-    integer :: k, sweep
+    integer, intent(out) :: rows(:), n
+    integer :: head, n_queued, p, j, e, b
     group = .false.
     group(start) = .true.
-    reached = .false.
-    reached(scene%row_body(:, start)) = .true.
-    grew = .true.
-    sweep = 0
-    do while (grew)
-      grew = .false.
-      sweep = sweep + 1
-      do k = merge(1, scene%n_rows, mod(sweep, 2) == 1), merge(scene%n_rows, 1, mod(sweep, 2) == 1), &
-          merge(1, -1, mod(sweep, 2) == 1)
-        if (group(k) .or. .not. closed(k)) cycle
-        if (.not. (reached(scene%row_body(2, k)) .or. (scene%row_body(1, k) > 0 .and. &
-            reached(scene%row_body(1, k))))) cycle
-        group(k) = .true.
-        reached(scene%row_body(:, k)) = .true.
-        grew = .true.
+    rows(1) = start
+    n = 1
+    set%stamp = set%stamp + 1
+    n_queued = 0
+    call reach_ends(start)
+    head = 0
+    do while (head < n_queued)
+      head = head + 1
+      b = set%queue(head)
+      do p = set%row_start(b), set%row_start(b + 1) - 1
+        j = set%row_list(p)
+        if (group(j) .or. .not. closed(j)) cycle
+        group(j) = .true.
+        n = n + 1
+        rows(n) = j
+        call reach_ends(j)
       end do
     end do
+    ! (row order: a few rows sorted, a long group read off the marks)
+    if (n <= max_scope) then
+      call sort_increasing(rows(:n))
+    else
+      call list_closed(group, rows, n)
+    end if
+
+  contains
+
+    !> Row j's bodies not reached yet join the queue.
+    subroutine reach_ends(j)
+      integer, intent(in) :: j
+      do e = 1, 2
+        associate (i => scene%row_body(e, j))
+          if (i == 0) cycle
+          if (set%mark(i) == set%stamp) cycle
+          set%mark(i) = set%stamp
+          n_queued = n_queued + 1
+          set%queue(n_queued) = i
+        end associate
+      end do
+    end subroutine reach_ends
   end subroutine closed_group
 
   !> An event point whose impulses hit the rows marked, recorded; when the last points make
   !> an accumulation over several contacts (impact1d_accumulation) whose rest is near, its
   !> rows close now: snapped, the bodies they join moving as one (at rest if joined to the
   !> ground), their rests logged at the series' limit time.
-  subroutine cut_cycle(scene, hit, closed, s, event_log, sink, stats)
+  subroutine cut_cycle(scene, hit, closed, s, event_log, work, sink, stats)
     type(scene_type), intent(in) :: scene
     logical, intent(in) :: hit(:)
     logical, intent(inout) :: closed(:)
     type(state_type), intent(inout) :: s
     type(event_log_type), intent(inout) :: event_log
+    type(point_work_type), intent(inout) :: work
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
     real(wp) :: u(scene%n_rows), remaining, v(scene%n_bodies)
@@ -587,7 +698,8 @@ contains
     if (.not. found) return
     call event_log%cycles%forget()
     closed = closed .or. rows
-    call snap_closed(scene, closed, s)
+    call list_closed(closed, work%closed_rows, work%n_closed)
+    call snap_closed(scene, work%closed_rows(:work%n_closed), s)
     v = s%v
     call join_moving(scene, rows, s%t, v)
     if (scene%drives%n > 0) then
@@ -604,14 +716,14 @@ contains
   !> order among equals); rows inside a rigid group never approach.
   integer function most_approaching(scene, closed, t, v, tol) result(k_best)
     type(scene_type), intent(in) :: scene
-    logical, intent(in) :: closed(:)
+    integer, intent(in) :: closed(:)      !< the closed rows, in row order
     real(wp), intent(in) :: t, v(:), tol(:)
-    integer :: k
+    integer :: k, p
     real(wp) :: u, u_best
     k_best = 0
     u_best = 0.0_wp
-    do k = 1, scene%n_rows
-      if (.not. closed(k)) cycle
+    do p = 1, size(closed)
+      k = closed(p)
       u = row_velocity(scene, k, v, t)
       if (u < min(u_best, -tol(k))) then
         k_best = k
@@ -639,6 +751,13 @@ contains
     end do
     if (root(1) == root(2) .or. sum(inverse) == 0.0_wp) return
     p = -(1.0_wp + r) * row_velocity(scene, k, v, t) / sum(inverse)
+    if (.not. work%any_rigid) then
+      ! (each body its own group: the row's ends alone)
+      do e = 1, 2
+        if (root(e) > 0) v_after(root(e)) = v(root(e)) + scene%row_normal(e, k) * p * inverse(e)
+      end do
+      return
+    end if
     do i = 1, scene%n_bodies
       do e = 1, 2
         if (root(e) > 0 .and. work%rigid(i) == root(e)) v_after(i) = v(i) + scene%row_normal(e, k) * p * inverse(e)
@@ -646,47 +765,49 @@ contains
     end do
   end subroutine impulse
 
-  !> The joint perfectly inelastic impact of the closed rows (impact1d_cluster_impact), on the
-  !> bodies they touch gathered into one problem: v_after, and pushed, the rows it pushed.
-  !> With moving grounds it is taken in each body's ground's frame (frame_velocity).
-  subroutine joint_projection(scene, work, closed, t, v, tol, v_after, pushed, error)
+  !> The joint perfectly inelastic impact of the closed rows marked (closed; listed in row
+  !> order: rows) (impact1d_cluster_impact), on the bodies they touch gathered into one
+  !> problem: v_after, and pushed, the rows it pushed. With moving grounds it is taken in
+  !> each body's ground's frame (frame_velocity).
+  subroutine joint_projection(scene, work, closed, rows, t, v, tol, v_after, pushed, error)
     type(scene_type), intent(in) :: scene
-    type(impact_work_type), intent(inout) :: work
+    type(point_work_type), intent(inout) :: work
     logical, intent(in) :: closed(:)
+    integer, intent(in) :: rows(:)
     real(wp), intent(in) :: t, v(:), tol(:)
     real(wp), intent(out) :: v_after(:)
     logical, intent(out) :: pushed(:)
     type(error_type), allocatable, intent(inout) :: error
-    integer :: local(0:scene%n_bodies), body(scene%n_bodies), rows(scene%n_rows), row_local(2, scene%n_rows), nb, &
-      nr, k, e, status
-    real(wp) :: v_local(scene%n_bodies), impulse_local(scene%n_rows), frame(scene%n_bodies)
-    logical :: pushed_local(scene%n_rows), fits
-    local = 0
+    integer :: body(scene%n_bodies), row_local(2, size(rows)), nb, nr, k, e, status
+    real(wp) :: v_local(scene%n_bodies), impulse_local(size(rows)), frame(scene%n_bodies)
+    logical :: pushed_local(size(rows)), fits
     nb = 0
-    nr = 0
-    do k = 1, scene%n_rows
-      if (.not. closed(k)) cycle
-      nr = nr + 1
-      rows(nr) = k
+    nr = size(rows)
+    ! (work%local: 0 but for the bodies numbered here, reset before leaving)
+    do k = 1, nr
       do e = 1, 2
-        associate (i => scene%row_body(e, k))
+        associate (i => scene%row_body(e, rows(k)))
           if (i == 0) cycle
-          if (local(i) > 0) cycle
+          if (work%local(i) > 0) cycle
           nb = nb + 1
           body(nb) = i
-          local(i) = nb
+          work%local(i) = nb
         end associate
       end do
     end do
+    do k = 1, nr
+      row_local(1, k) = work%local(scene%row_body(1, rows(k)))
+      row_local(2, k) = work%local(scene%row_body(2, rows(k)))
+    end do
+    work%local(body(:nb)) = 0
     v_after = v
     pushed = .false.
     if (nr == 0) return
     ! (with moving grounds the projection is taken in their frame: frame_velocity)
     frame = 0.0_wp
     if (scene%drives%n > 0) frame = frame_velocity(scene, closed, t)
-    row_local(:, :nr) = reshape([(local(scene%row_body(:, rows(k))), k = 1, nr)], [2, nr])
-    call path_impact_reserve(work%path, nb)
-    call path_projection(work%path, scene%body_mass(body(:nb)), v(body(:nb)) - frame(body(:nb)), row_local(:, :nr), &
+    call path_impact_reserve(work%impact%path, nb)
+    call path_projection(work%impact%path, scene%body_mass(body(:nb)), v(body(:nb)) - frame(body(:nb)), row_local(:, :nr), &
       scene%row_normal(:, rows(:nr)), tol(rows(:nr)), v_local(:nb), impulse_local(:nr), pushed_local(:nr), fits)
     if (.not. fits) then
       call dense_projection()
@@ -705,8 +826,8 @@ contains
           'too large for the dense projection (more than ' // trim(fmt(max_dense_unknowns)) // ': issue 20)')
         return
       end if
-      call impact_reserve(work, nb, nr)
-      call cluster_projection(work, scene%body_mass(body(:nb)), v(body(:nb)) - frame(body(:nb)), row_local(:, :nr), &
+      call impact_reserve(work%impact, nb, nr)
+      call cluster_projection(work%impact, scene%body_mass(body(:nb)), v(body(:nb)) - frame(body(:nb)), row_local(:, :nr), &
         scene%row_normal(:, rows(:nr)), spread(.true., 1, nr), tol(rows(:nr)), v_local(:nb), impulse_local(:nr), &
         pushed_local(:nr), status)
       if (status /= lcp_solved) then
@@ -718,14 +839,20 @@ contains
   end subroutine joint_projection
 
   !> A row between bodies that took an impulse gives both its ends the larger scale.
-  pure subroutine share_scale(scene, pushed, entry_scale)
+  pure subroutine share_scale(scene, pushed, rows, entry_scale)
     type(scene_type), intent(in) :: scene
     logical, intent(in) :: pushed(:)
+    integer, intent(in) :: rows(:)     !< rows in row order, the pushed ones among them
     real(wp), intent(inout) :: entry_scale(:)
-    integer :: k
-    do k = 1, scene%n_rows
+    integer :: k, p
+    do p = 1, size(rows)
+      k = rows(p)
       if (.not. pushed(k) .or. scene%row_body(1, k) == 0) cycle
-      entry_scale(scene%row_body(:, k)) = maxval(entry_scale(scene%row_body(:, k)))
+      ! (the two ends by name: a vector subscript took a heap temporary a row)
+      associate (a => scene%row_body(1, k), b => scene%row_body(2, k))
+        entry_scale(a) = max(entry_scale(a), entry_scale(b))
+        entry_scale(b) = entry_scale(a)
+      end associate
     end do
   end subroutine share_scale
 
@@ -746,26 +873,46 @@ contains
     real(wp) :: v_after(scene%n_bodies)
     logical :: pushed(scene%n_rows)
     type(error_type), allocatable :: ignored
-    integer :: k, e
+    integer :: k, e, p
+    real(wp) :: accel_bound, u
     call zero_stopped(scene, s, acc, entry_scale)
-    call joint_projection(scene, work%impact, closed, s%t, s%v, spread(0.0_wp, 1, scene%n_rows), v_after, pushed, &
-      ignored)
-    if (.not. allocated(ignored) .and. count(pushed) >= 2) call settle_apply(closed)
-    do k = 1, scene%n_rows
-      if (.not. closed(k)) cycle
+    associate (rows => work%closed_rows(:work%n_closed))
+      call joint_projection(scene, work, closed, rows, s%t, s%v, spread(0.0_wp, 1, scene%n_rows), v_after, pushed, &
+        ignored)
+      if (.not. allocated(ignored) .and. count(pushed(rows)) >= 2) call settle_apply(closed)
+    end associate
+    ! (the closed rows, in row order: work%closed_rows)
+    do p = 1, work%n_closed
+      k = work%closed_rows(p)
       if (abs(row_velocity(scene, k, s%v, s%t)) <= u_tolerance(scene, k, s%v, acc, entry_scale) .and. &
           row_velocity(scene, k, s%v, s%t) /= 0.0_wp) then
         call impulse(scene, work, k, 0.0_wp, s%t, s%v, v_after)
         call settle_apply(closed)
       end if
     end do
-    do k = 1, scene%n_rows
-      if (closed(k)) call settle_bounce_series(scene, mode, k, f, df, closed, acc, entry_scale, s, event_log, &
-        work, sink, stats)
+    ! A bound on any row's gap acceleration in a mode, |n . a| <= 2 (sum |f| + friction) /
+    ! least mass, doubled for rounding, friction at most the static bound (none with moving
+    ! grounds, whose rows follow w''; nor with rigid links, whose impulses' union-find steps
+    ! must all be taken; nor under Stribeck's law, whose viscous part has no bound)
+    accel_bound = huge(1.0_wp)
+    if (work%n_closed > 0 .and. scene%drives%n == 0 .and. .not. work%any_rigid .and. .not. scene%stribeck) &
+      accel_bound = 4.0_wp * (sum(abs(f)) + sum(max(scene%body_friction, scene%body_static))) / &
+      minval(scene%body_mass)
+    do p = 1, work%n_closed
+      k = work%closed_rows(p)
+      ! (its tests that need no mode first, here: settle_bounce_series' N-long scratch is a
+      ! heap allocation a call)
+      u = row_velocity(scene, k, s%v, s%t)
+      if (u <= u_tolerance(scene, k, s%v, acc, entry_scale)) cycle
+      ! The series lasts at least u / |a_up|: one that cannot end within the clock's
+      ! resolution needs no mode solved (settle_bounce_series would return).
+      if (u > time_rounding * max(abs(s%t), scene%dt) * accel_bound) cycle
+      call settle_bounce_series(scene, mode, k, u, f, df, closed, acc, entry_scale, s, event_log, work, sink, stats)
     end do
     call zero_stopped(scene, s, acc, entry_scale)
-    do k = 1, scene%n_rows
-      if (.not. closed(k) .or. scene%row_body(1, k) == 0) cycle
+    do p = 1, work%n_closed
+      k = work%closed_rows(p)
+      if (scene%row_body(1, k) == 0) cycle
       if (abs(row_velocity(scene, k, s%v)) > u_tolerance(scene, k, s%v, acc, entry_scale)) cycle
       do e = 1, 2
         if (s%v(scene%row_body(e, k)) == rest_velocity(scene, scene%row_body(e, k)) .and. &
@@ -792,10 +939,11 @@ contains
   !> rising (a_up) and falling back (a_down) from the mode with k left free. If what remains
   !> of the series is below the clock's resolution, the row rests now, logged at the
   !> series' accumulation time (the two-body engine's settle_bounce_series).
-  subroutine settle_bounce_series(scene, mode, k, f, df, closed, acc, entry_scale, s, event_log, work, sink, stats)
+  subroutine settle_bounce_series(scene, mode, k, u, f, df, closed, acc, entry_scale, s, event_log, work, sink, stats)
     type(scene_type), intent(in) :: scene
     type(body_mode_type), intent(in) :: mode
     integer, intent(in) :: k
+    real(wp), intent(in) :: u    !< its normal velocity, separating beyond rounding (settle)
     real(wp), intent(in) :: f(:), df(:), acc(:), entry_scale(:)
     logical, intent(in) :: closed(:)
     type(state_type), intent(inout) :: s
@@ -803,10 +951,8 @@ contains
     type(point_work_type), intent(inout) :: work
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
-    real(wp) :: u, a_up, a_down, remaining, v_bounce(scene%n_bodies)
+    real(wp) :: a_up, a_down, remaining, v_bounce(scene%n_bodies)
     type(error_type), allocatable :: unchecked
-    u = row_velocity(scene, k, s%v, s%t)
-    if (u <= u_tolerance(scene, k, s%v, acc, entry_scale)) return
     a_up = free_gap_acceleration(s%v)
     if (a_up >= 0.0_wp) return
     call impulse(scene, work, k, 1.0_wp, s%t, s%v, v_bounce)
@@ -832,9 +978,11 @@ contains
     real(wp) function free_gap_acceleration(v) result(a_gap)
       real(wp), intent(in) :: v(:)
       type(body_mode_type) :: free
-      logical :: candidate(scene%n_rows)
+      logical :: candidate(scene%n_rows), scoped
       real(wp) :: a(scene%n_bodies)
       integer :: j, status
+      call scoped_gap_acceleration(scene, work, k, closed, s%t, v, f, df, acc, entry_scale, a_gap, scoped)
+      if (scoped) return
       do j = 1, scene%n_rows
         candidate(j) = closed(j) .and. j /= k
         if (candidate(j)) candidate(j) = abs(row_velocity(scene, j, v, s%t)) <= &
@@ -848,6 +996,291 @@ contains
       a_gap = row_velocity(scene, k, a) + ground_motion(scene, k, s%t, 2)
     end function free_gap_acceleration
   end subroutine settle_bounce_series
+
+  !> settle_bounce_series' free gap acceleration of row k at velocities v from the clusters
+  !> of k's ends alone (scoped), not from the mode solve of all N bodies: the solve is per
+  !> cluster and the accelerations per group, each a sum in body order, so these are the
+  !> same numbers. Not scoped (the caller solves every cluster): moving grounds, or a
+  !> cluster of more than max_scope bodies. A cluster whose solve fails gives 0, as the
+  !> solve of all does (which also gives 0 when another cluster fails: one the event point's
+  !> own mode solve then fails on).
+  subroutine scoped_gap_acceleration(scene, work, k, closed, t, v, f, df, acc, entry_scale, a_gap, scoped)
+    type(scene_type), intent(in) :: scene
+    type(point_work_type), intent(inout) :: work
+    integer, intent(in) :: k
+    logical, intent(in) :: closed(:)
+    real(wp), intent(in) :: t, v(:), f(:), df(:), acc(:), entry_scale(:)
+    real(wp), intent(out) :: a_gap
+    logical, intent(out) :: scoped
+    real(wp) :: a_end(2)
+    integer :: e, status
+    a_gap = 0.0_wp
+    a_end = 0.0_wp
+    scoped = scene%drives%n == 0
+    if (.not. scoped) return
+    do e = 1, 2
+      if (scene%row_body(e, k) == 0) cycle
+      call cluster_acceleration(scene, work, k, scene%row_body(e, k), closed, t, v, f, df, acc, entry_scale, &
+        a_end(e), status, scoped)
+      if (.not. scoped .or. status /= mode_solved) return
+    end do
+    ! (row_velocity's sum, and free_gap_acceleration's ground term, 0 here)
+    a_gap = scene%row_normal(2, k) * a_end(2)
+    if (scene%row_body(1, k) > 0) a_gap = a_gap + scene%row_normal(1, k) * a_end(1)
+    a_gap = a_gap + 0.0_wp
+  end subroutine scoped_gap_acceleration
+
+  !> Body i's acceleration in the mode of its cluster (the bodies joined to it by candidate
+  !> rows: closed, other than row k, normal velocity within rounding at v), the cluster
+  !> found breadth first over the rows on its bodies and solved as solve_body_mode solves
+  !> it (members in body order, rows in row order, into work%scratch). fits: the cluster has
+  !> at most max_scope bodies and max_scope_rows rows.
+  subroutine cluster_acceleration(scene, work, k, i, closed, t, v, f, df, acc, entry_scale, a_i, status, fits)
+    type(scene_type), intent(in) :: scene
+    type(point_work_type), intent(inout) :: work
+    integer, intent(in) :: k, i
+    logical, intent(in) :: closed(:)
+    real(wp), intent(in) :: t, v(:), f(:), df(:), acc(:), entry_scale(:)
+    real(wp), intent(out) :: a_i
+    integer, intent(out) :: status
+    logical, intent(out) :: fits
+    integer :: body(max_scope), rows(max_scope_rows), nb, nr, j
+    logical :: needs_solve
+    a_i = 0.0_wp
+    status = mode_solved
+    call cluster_of(scene, work%incidence, k, i, closed, t, v, acc, entry_scale, body, nb, rows, nr, fits)
+    if (.not. fits) return
+    needs_solve = nr > 0
+    do j = 1, nb
+      associate (b => body(j))
+        work%scratch%stuck(b) = .false.
+        work%scratch%sgn(b) = 0.0_wp
+        if (v(b) /= 0.0_wp .and. scene%body_friction(b) > 0.0_wp) work%scratch%sgn(b) = sign(1.0_wp, v(b))
+        if (scene%body_static(b) > 0.0_wp .and. v(b) == 0.0_wp) needs_solve = .true.
+      end associate
+    end do
+    if (needs_solve) then
+      work%mode%first(1:2) = [1, nb + 1]
+      work%mode%member(1:nb) = body(:nb)
+      work%mode%first_row(1:2) = [1, nr + 1]
+      work%mode%row(1:nr) = rows(:nr)
+      call solve_cluster(scene, work%mode, 1, f, df, v, work%scratch, status)
+      if (status /= mode_solved) return
+    end if
+    do j = 1, nb
+      associate (b => body(j))
+        if (work%scratch%sgn(b) == 0.0_wp .and. v(b) /= 0.0_wp .and. scene%body_static(b) > 0.0_wp) &
+          work%scratch%sgn(b) = sign(1.0_wp, v(b))
+      end associate
+    end do
+    a_i = group_acceleration(scene, work%scratch, work%mode%local, body(:nb), rows(:nr), i, f)
+  end subroutine cluster_acceleration
+
+  !> Body i's acceleration in mode (its stuck, sgn, active read for the cluster's bodies and
+  !> rows): set_groups' groups and acceleration's sums over i's group, in body order. local:
+  !> scratch, (0:N).
+  real(wp) function group_acceleration(scene, mode, local, body, rows, i, f) result(a_i)
+    type(scene_type), intent(in) :: scene
+    type(body_mode_type), intent(in) :: mode
+    integer, intent(inout) :: local(0:)
+    integer, intent(in) :: body(:), rows(:), i
+    real(wp), intent(in) :: f(:)
+    integer :: root(0:size(body)), j, p, group
+    real(wp) :: load, mass
+    logical :: joined
+    local(0) = 0
+    do j = 1, size(body)
+      local(body(j)) = j
+      root(j) = j
+      if (mode%stuck(body(j))) root(j) = 0
+    end do
+    root(0) = 0
+    do p = 1, size(rows)
+      if (mode%active(rows(p))) joined = uf_join(root, local(scene%row_body(1, rows(p))), &
+        local(scene%row_body(2, rows(p))))
+    end do
+    a_i = 0.0_wp
+    group = uf_find(root, local(i))
+    if (group == 0) return
+    load = 0.0_wp
+    mass = 0.0_wp
+    do j = 1, size(body)
+      if (uf_find(root, j) /= group) cycle
+      mass = mass + scene%body_mass(body(j))
+      load = load + (f(body(j)) + (-scene%body_friction(body(j)) * mode%sgn(body(j))))
+    end do
+    a_i = load / mass
+  end function group_acceleration
+
+  !> The cluster of body i (cluster_acceleration): its bodies and its candidate rows, each in
+  !> increasing order (fits: no more than max_scope, max_scope_rows of them).
+  subroutine cluster_of(scene, set, k, i, closed, t, v, acc, entry_scale, body, nb, rows, nr, fits)
+    type(scene_type), intent(in) :: scene
+    type(cluster_set_type), intent(inout) :: set
+    integer, intent(in) :: k, i
+    logical, intent(in) :: closed(:)
+    real(wp), intent(in) :: t, v(:), acc(:), entry_scale(:)
+    integer, intent(out) :: body(:), nb, rows(:), nr
+    logical, intent(out) :: fits
+    integer :: head, b, p, j, other
+    set%stamp = set%stamp + 1
+    set%mark(i) = set%stamp
+    body(1) = i
+    nb = 1
+    nr = 0
+    head = 0
+    fits = .true.
+    do while (head < nb)
+      head = head + 1
+      b = body(head)
+      do p = set%row_start(b), set%row_start(b + 1) - 1
+        j = set%row_list(p)
+        if (.not. closed(j) .or. j == k) cycle
+        if (abs(row_velocity(scene, j, v, t)) > u_tolerance(scene, j, v, acc, entry_scale)) cycle
+        ! (each row once: from its b end, which every row has)
+        if (scene%row_body(2, j) == b) then
+          fits = nr < size(rows)
+          if (.not. fits) return
+          nr = nr + 1
+          rows(nr) = j
+        end if
+        other = scene%row_body(1, j) + scene%row_body(2, j) - b
+        if (scene%row_body(1, j) == 0 .or. set%mark(other) == set%stamp) cycle
+        fits = nb < size(body)
+        if (.not. fits) return
+        set%mark(other) = set%stamp
+        nb = nb + 1
+        body(nb) = other
+      end do
+    end do
+    call sort_increasing(body(:nb))
+    call sort_increasing(rows(:nr))
+  end subroutine cluster_of
+
+  !> The mode of a scene without friction or moving grounds as solve_body_mode solves it, at
+  !> the cost of the clusters that need a solve (those of candidate rows: closed rows listed
+  !> in work%closed_rows) and of the ones solved last time: every other body is alone (not
+  !> stuck, no sliding direction, its own group), every other row free. Each cluster is found
+  !> breadth first (cluster_of: the candidate predicate of nbody_event_point), solved by
+  !> solve_cluster and grouped as set_groups groups it (cluster_groups). A cluster past
+  !> max_scope bodies, or a failed solve, takes solve_body_mode over all, which sets every
+  !> entry (and its status is the run's).
+  subroutine scoped_mode(scene, work, closed, f, df, acc, entry_scale, t, v, candidate, mode, status)
+    type(scene_type), intent(in) :: scene
+    type(point_work_type), intent(inout) :: work
+    logical, intent(in) :: closed(:), candidate(:)
+    real(wp), intent(in) :: f(:), df(:), acc(:), entry_scale(:), t, v(:)
+    type(body_mode_type), intent(inout) :: mode
+    integer, intent(out) :: status
+    integer :: body(max_scope), rows(max_scope_rows), nb, nr, p, i, k
+    logical :: fits
+    if (work%mode_tracked) then
+      do p = 1, work%n_mode_bodies
+        call alone(work%mode_bodies(p))
+      end do
+      mode%active(work%mode_rows(:work%n_mode_rows)) = .false.
+    else
+      do i = 1, scene%n_bodies
+        call alone(i)
+      end do
+      mode%active = .false.
+    end if
+    work%n_mode_bodies = 0
+    work%n_mode_rows = 0
+    work%mode_tracked = .true.
+    mode%held = .false.
+    status = mode_solved
+    do p = 1, work%n_closed
+      k = work%closed_rows(p)
+      if (.not. candidate(k)) cycle
+      ! (a cluster already solved: its bodies are listed)
+      if (any(work%mode_bodies(:work%n_mode_bodies) == scene%row_body(2, k))) cycle
+      call cluster_of(scene, work%incidence, 0, scene%row_body(2, k), closed, t, v, acc, entry_scale, body, nb, &
+        rows, nr, fits)
+      if (fits) then
+        work%mode_bodies(work%n_mode_bodies + 1:work%n_mode_bodies + nb) = body(:nb)
+        work%mode_rows(work%n_mode_rows + 1:work%n_mode_rows + nr) = rows(:nr)
+        work%n_mode_bodies = work%n_mode_bodies + nb
+        work%n_mode_rows = work%n_mode_rows + nr
+        work%mode%first(1:2) = [1, nb + 1]
+        work%mode%member(1:nb) = body(:nb)
+        work%mode%first_row(1:2) = [1, nr + 1]
+        work%mode%row(1:nr) = rows(:nr)
+        call solve_cluster(scene, work%mode, 1, f, df, v, mode, status)
+      end if
+      if (.not. fits .or. status /= mode_solved) then
+        call solve_body_mode(scene, work%mode, f, df, v, candidate, mode, status)
+        work%mode_tracked = .false.
+        return
+      end if
+      call cluster_groups(scene, mode, body(:nb), rows(:nr))
+    end do
+
+  contains
+
+    !> Body j as solve_body_mode leaves a body in no cluster, without friction.
+    subroutine alone(j)
+      integer, intent(in) :: j
+      mode%stuck(j) = .false.
+      mode%sgn(j) = 0.0_wp
+      mode%group(j) = j
+      mode%group_mass(j) = 0.0_wp + scene%body_mass(j)
+      mode%f_slide(j) = -scene%body_friction(j) * mode%sgn(j)
+    end subroutine alone
+  end subroutine scoped_mode
+
+  !> set_groups over one solved cluster (its bodies and rows in increasing order): a group's
+  !> id is its least body (0: joined to the ground or a stuck body), as set_groups' union-find
+  !> leaves it; its mass summed in body order; the sliding forces; held.
+  subroutine cluster_groups(scene, mode, body, rows)
+    type(scene_type), intent(in) :: scene
+    type(body_mode_type), intent(inout) :: mode
+    integer, intent(in) :: body(:), rows(:)
+    integer :: root(0:size(body)), j, p, r
+    logical :: joined
+    root = [(j, j = 0, size(body))]
+    do j = 1, size(body)
+      if (mode%stuck(body(j))) root(j) = 0
+      mode%group_mass(body(j)) = 0.0_wp
+    end do
+    do p = 1, size(rows)
+      if (mode%active(rows(p))) joined = uf_join(root, local_of(scene%row_body(1, rows(p))), &
+        local_of(scene%row_body(2, rows(p))))
+    end do
+    do j = 1, size(body)
+      r = uf_find(root, j)
+      mode%group(body(j)) = 0
+      if (r > 0) mode%group(body(j)) = body(r)
+      if (r > 0) mode%group_mass(body(r)) = mode%group_mass(body(r)) + scene%body_mass(body(j))
+      mode%f_slide(body(j)) = -scene%body_friction(body(j)) * mode%sgn(body(j))
+    end do
+    mode%held = mode%held .or. any(mode%active(rows)) .or. any(mode%stuck(body))
+
+  contains
+
+    !> Body i's number in the cluster (0: the ground).
+    integer function local_of(i)
+      integer, intent(in) :: i
+      local_of = 0
+      if (i > 0) local_of = findloc(body, i, 1)
+    end function local_of
+  end subroutine cluster_groups
+
+  !> Insertion sort (a cluster's few bodies or rows).
+  pure subroutine sort_increasing(list)
+    integer, intent(inout) :: list(:)
+    integer :: j, p, item
+    do j = 2, size(list)
+      item = list(j)
+      p = j - 1
+      do while (p >= 1)
+        if (list(p) <= item) exit
+        list(p + 1) = list(p)
+        p = p - 1
+      end do
+      list(p + 1) = item
+    end do
+  end subroutine sort_increasing
 
   !> Bodies whose velocity is below the rounding of what a step changes it by, or of the
   !> velocities this event point started from, are at rest.
@@ -945,18 +1378,18 @@ contains
     type(run_stats), intent(inout) :: stats
     real(wp), dimension(scene%n_bodies) :: acc, tol_a, acc_rate
     real(wp) :: rate_tol, direction
-    logical :: leaving, resting_now
+    logical :: leaving, resting_now, ready
     integer :: k, i
 
-    call mode_acceleration(scene, new, s%t, f, acc)
-    call new%rate_response(df, acc_rate)
-    if (scene%drives%n > 0) call drive_accelerations(scene, new, s%t, 3, acc_rate)
-    tol_a = 1.0e3_wp * eps_wp * force_scale(scene, f, df) / scene%body_mass
-    rate_tol = 1.0e3_wp * eps_wp * sum(abs(df))
+    ! (the accelerations, their rates and tolerances only where a row leaves contact or a
+    ! body has static friction: an event of frictionless bodies that no contact held needs
+    ! none of these O(N) sums)
+    ready = .false.
     do k = 1, scene%n_rows
       if (new%active(k) .and. .not. event_log%in_contact(k)) then
         call event_log%begin_rest(scene, k, s%t, s%t, s%v, sink, stats)
       else if (event_log%in_contact(k) .and. .not. new%active(k)) then
+        call prepare()
         if (.not. candidate(k) .or. row_acceleration(k, acc, 2) > row_abs_tol(k, tol_a) .or. &
             (row_acceleration(k, acc, 2) >= -row_abs_tol(k, tol_a) .and. &
             row_acceleration(k, acc_rate, 3) > rate_tol / minval(scene%body_mass))) then
@@ -972,6 +1405,7 @@ contains
     end do
     do i = 1, scene%n_bodies
       if (scene%body_static(i) == 0.0_wp) cycle
+      call prepare()
       ! Its sliding direction; a body that breaks away with no sliding friction has none
       ! (sgn 0): the way it accelerates.
       direction = new%sgn(i)
@@ -993,6 +1427,17 @@ contains
     end do
 
   contains
+
+    !> acc, acc_rate, tol_a and rate_tol, once.
+    subroutine prepare()
+      if (ready) return
+      ready = .true.
+      call mode_acceleration(scene, new, s%t, f, acc)
+      call new%rate_response(df, acc_rate)
+      if (scene%drives%n > 0) call drive_accelerations(scene, new, s%t, 3, acc_rate)
+      tol_a = 1.0e3_wp * eps_wp * force_scale(scene, f, df) / scene%body_mass
+      rate_tol = 1.0e3_wp * eps_wp * sum(abs(df))
+    end subroutine prepare
 
     !> Row j's gap acceleration (order 2) or its rate (3) at the bodies' a (with its moving
     !> ground end's).
