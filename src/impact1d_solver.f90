@@ -9,7 +9,7 @@ module impact1d_solver
   use, intrinsic :: iso_fortran_env, only: int64
   use impact1d_kinds, only: wp
   use impact1d_error, only: error_type, raise, status_simulation, fmt
-  use impact1d_scene, only: scene_type, sample_time, step_length
+  use impact1d_scene, only: scene_type, sample_time, step_length, runs_nbody
   use impact1d_modes, only: mode_type
   use impact1d_impacts, only: normal_velocity, kinetic_energy
   use impact1d_output, only: sink_type, run_stats, emit_sample, checkpoint, start_counts
@@ -83,7 +83,7 @@ contains
       call run_vissim(scene, sink, stats, error)
       return
     end if
-    if (scene%n_bodies > max_lanes .or. scene%drives%n > 0 .or. scene%belts .or. scene%stribeck) then
+    if (runs_nbody(scene)) then
       call run_nbody(scene, sink, stats, error)
       return
     end if
