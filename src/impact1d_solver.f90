@@ -206,7 +206,7 @@ contains
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
     type(error_type), allocatable, intent(inout) :: error
-    real(wp) :: h, h_event
+    real(wp) :: h, h_event, h_taken
     integer :: halvings
 
     h = step_toward(scene, s, t_stop)
@@ -224,9 +224,10 @@ contains
       call watch%locate(scene, mode, rk%constant_forcing, rk%polynomial_forcing, s, trial, h, h_event, watched)
       located = h_event <= h
       if (located) then
+        h_taken = h
         h = h_event
         if (h > 0.0_wp) then
-          call refine(rk, scene, mode, s, h, watched, trial)
+          call refine(rk, scene, mode, s, h, watched, trial, h_taken)
         else
           trial = s     ! the event is at the step's start: nothing to step
           exit
