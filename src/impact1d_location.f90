@@ -288,8 +288,10 @@ contains
 
   !> Re-take the step to the located time and polish it by Newton's method on the watched
   !> function evaluated on the integrator's own state: under polynomial forcing the dense
-  !> output is exact and the first check passes; under a sine it is approximate.
-  subroutine refine(rk, scene, mode, a, step, which, b)
+  !> output is exact and the first check passes; under a sine it is approximate. A sliding
+  !> body's stop under such forcing was located on the cubic's velocity, whose root may come
+  !> before the exact one: Newton may then go on up to the step taken (taken).
+  subroutine refine(rk, scene, mode, a, step, which, b, taken)
     type(rk4_type), intent(inout) :: rk
     type(scene_type), intent(in) :: scene
     type(mode_type), intent(in) :: mode
@@ -297,9 +299,11 @@ contains
     real(wp), intent(inout) :: step
     type(located_type), intent(in) :: which
     type(lane_state_type), intent(inout) :: b
+    real(wp), intent(in) :: taken
     real(wp) :: value, slope, tol, located_step, f(max_lanes), acc(max_lanes)
     integer :: iteration
     located_step = step
+    if (which%kind == located_body .and. .not. rk%polynomial_forcing) located_step = taken
     call rk%step(scene, mode, a, step, b)
     if (which%kind /= located_row .and. which%kind /= located_body .and. which%kind /= located_stop) return
     do iteration = 1, 8

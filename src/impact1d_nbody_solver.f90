@@ -182,7 +182,7 @@ contains
         h_taken = h
         h = theta
         if (h > 0.0_wp) then
-          call refine_nbody(scene, r%mode, s, h, found, index, trial, h_taken)
+          call refine_nbody(scene, r%mode, r%polynomial, s, h, found, index, trial, h_taken)
         else
           trial = s
           exit

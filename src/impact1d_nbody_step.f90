@@ -612,10 +612,12 @@ contains
   !> Re-take the step to the located time and polish it by Newton's method on the watched
   !> function on the integrator's own state (exact under polynomial forcing at once). A row
   !> with a moving ground end was located on its cubic, whose root may come before the
-  !> exact one: Newton may then go on up to the step taken (limit).
-  subroutine refine_nbody(scene, mode, a, step, found, index, b, limit)
+  !> exact one, and so was a sliding body's stop under forcing that is not polynomial (the
+  !> cubic's velocity): Newton may then go on up to the step taken (limit).
+  subroutine refine_nbody(scene, mode, polynomial, a, step, found, index, b, limit)
     type(scene_type), intent(in) :: scene
     type(body_mode_type), intent(in) :: mode
+    logical, intent(in) :: polynomial     !< the motion is a cubic: the dense output is exact
     type(state_type), intent(in) :: a
     real(wp), intent(inout) :: step
     integer, intent(in) :: found, index
@@ -627,6 +629,7 @@ contains
     if (present(limit) .and. found == found_row .and. scene%drives%n > 0) then
       if (scene%row_drive(index) > 0) located_step = limit
     end if
+    if (present(limit) .and. found == found_body .and. .not. polynomial) located_step = limit
     call nbody_step(scene, mode, a, step, b)
     if (found /= found_row .and. found /= found_body .and. found /= found_stop) return
     do iteration = 1, 8

@@ -8,6 +8,7 @@ module impact1d_scene
   use impact1d_forcing, only: forcing_type, table_type, angular_frequency
   use impact1d_springs, only: springs_type, pair_elements, assemble, rate_bound
   use impact1d_modes, only: pair_type, pair_rows
+  use impact1d_lanes, only: max_lanes
   use impact1d_drives, only: drive_type
   use impact1d_fields, only: chain_input, mechanism_records, r_k, r_c, r_stop_k, r_stop_c, r_ground_v, &
     r_spring_ground_v, n_ground_fields, array_value, a_m, &
@@ -23,6 +24,7 @@ module impact1d_scene
     i_f1_phase, i_f2_amp, i_f2_period, i_f2_phase, i_t_end, i_dt, i_dt_out, i_mus1, i_mus2, &
     i_k1, i_x1_rest, i_c1, i_k2, i_x2_rest, i_c2, i_k12, i_d_rest, i_c12, i_max_events
   public :: sample_time, step_length, set_text, events_kept, name_of, is_nbody, value_or, ground_named
+  public :: runs_nbody
   public :: positive_value, nonnegative_value, unit_interval, resolvable, unresolved
   public :: i_x_left_v, i_x_right_v
   public :: i_title, i_f1_table, i_f2_table, i_method, i_substeps, i_events, default_gravity
@@ -491,6 +493,15 @@ contains
     type(scene_input), intent(in) :: input
     is_nbody = input%chain%n_bodies > 2
   end function is_nbody
+
+  !> Whether the N-body engine runs the built scene (run's dispatch): more bodies than the
+  !> two-body kernels' lanes, a moving ground, or a friction law (belt_v, v_s, c_v). Only
+  !> the other scenes are held to the kernels' room (pair_rows, pair_elements). Known once
+  !> build_scene has set the laws and the records' drives.
+  pure logical function runs_nbody(scene)
+    type(scene_type), intent(in) :: scene
+    runs_nbody = scene%n_bodies > max_lanes .or. scene%drives%n > 0 .or. scene%belts .or. scene%stribeck
+  end function runs_nbody
 
   !> What the event log of a run of this input keeps (&run events; all by default).
   pure integer function events_kept(input)
@@ -988,7 +999,7 @@ contains
     type(error_type), allocatable, intent(inout) :: error
     integer :: ne
     ne = scene%n_elements
-    if (scene%n_bodies > 2) then
+    if (runs_nbody(scene)) then
       ! The N-body engine reads the element records themselves (impact1d_elements), and the
       ! compliant stops' rows as elements of the same kind.
       scene%springs%present = ne > 0 .or. scene%n_stops > 0
@@ -1062,7 +1073,7 @@ contains
     real(wp) :: sgn
     logical :: suffix
     nr = count(scene%contact_has)
-    if (nr > pair_rows .and. scene%n_bodies <= 2) then
+    if (nr > pair_rows .and. .not. runs_nbody(scene)) then
       call raise(error, status_input, 'the contacts have ' // trim(fmt(nr)) // ' limits: a scene of one or ' // &
         'two bodies has at most ' // trim(fmt(pair_rows)) // ' (the two-body kernels'' rows)')
       return
@@ -1106,7 +1117,7 @@ contains
     ! The two-body kernels' view: each row's coefficients on the pair's lanes (body i in
     ! lane i). The N-body engine reads the rows themselves. The mode solve sees the rigid
     ! rows only.
-    if (scene%n_bodies > 2) return
+    if (runs_nbody(scene)) return
     scene%pair%n_rows = scene%n_rows
     scene%pair%normal = 0.0_wp
     do r = 1, nr

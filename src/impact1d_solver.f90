@@ -9,7 +9,7 @@ module impact1d_solver
   use, intrinsic :: iso_fortran_env, only: int64
   use impact1d_kinds, only: wp
   use impact1d_error, only: error_type, raise, status_simulation, fmt
-  use impact1d_scene, only: scene_type, sample_time, step_length
+  use impact1d_scene, only: scene_type, sample_time, step_length, runs_nbody
   use impact1d_modes, only: mode_type
   use impact1d_impacts, only: normal_velocity, kinetic_energy
   use impact1d_output, only: sink_type, run_stats, emit_sample, checkpoint, start_counts
@@ -83,7 +83,7 @@ contains
       call run_vissim(scene, sink, stats, error)
       return
     end if
-    if (scene%n_bodies > max_lanes .or. scene%drives%n > 0 .or. scene%belts .or. scene%stribeck) then
+    if (runs_nbody(scene)) then
       call run_nbody(scene, sink, stats, error)
       return
     end if
@@ -206,7 +206,7 @@ contains
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
     type(error_type), allocatable, intent(inout) :: error
-    real(wp) :: h, h_event
+    real(wp) :: h, h_event, h_taken
     integer :: halvings
 
     h = step_toward(scene, s, t_stop)
@@ -224,9 +224,10 @@ contains
       call watch%locate(scene, mode, rk%constant_forcing, rk%polynomial_forcing, s, trial, h, h_event, watched)
       located = h_event <= h
       if (located) then
+        h_taken = h
         h = h_event
         if (h > 0.0_wp) then
-          call refine(rk, scene, mode, s, h, watched, trial)
+          call refine(rk, scene, mode, s, h, watched, trial, h_taken)
         else
           trial = s     ! the event is at the step's start: nothing to step
           exit
