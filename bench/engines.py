@@ -29,7 +29,7 @@ import numpy as np
 BENCH = Path(__file__).resolve().parent
 REPO = BENCH.parent
 RESULTS = BENCH / "results"
-DISPATCH = "if (scene%n_bodies > max_lanes .or. scene%drives%n > 0) then"
+DISPATCH = "if (runs_nbody(scene)) then"
 # The scenes of input/ the two-body engine runs (N <= 2, no moving ground, the event method).
 SCENES = ("case1", "case2", "case3", "case4", "case5", "case6", "impact_oscillator", "stick_slip",
           "gear_rattle", "breakaway", "mounted_stop", "inner_stop")
