@@ -27,9 +27,12 @@ module impact1d_body_mode
   private
   public :: body_mode_type, mode_work_type, new_mode, solve_body_mode, same_mode, mode_solved
   public :: mode_reserve, gathered_mode
-  public :: drive_accelerations, shift_to_drives, drive_components
+  public :: drive_accelerations, shift_to_drives, drive_components, relative_velocity, mode_relative_rest
 
   integer, parameter :: mode_solved = cluster_solved   !< otherwise an impact1d_lcp status
+  !> A friction contact between two bodies (&friction) at relative rest with static friction:
+  !> its stick is not solved yet (a status apart from the LCP's).
+  integer, parameter :: mode_relative_rest = -101
   !> The largest cluster problem solved densely (rows + 2 bodies' unknowns): its matrices take
   !> about 24 n^2 bytes, 2.4 GB here. A cluster whose rows form a path (a train) is solved
   !> in O(n) by impact1d_path_mode, whatever its size.
@@ -49,6 +52,10 @@ module impact1d_body_mode
     integer, allocatable :: drive(:)
     !> Some row is held or some body stuck: conditions that forces can break.
     logical :: held = .false.
+    !> (nf) friction contacts between bodies (&friction): the direction of the relative
+    !> velocity v_b - v_a they slide in (the force -F sgn on b, +F sgn on a), 0 for none.
+    !> Allocated by the first solve of a scene that has such contacts.
+    real(wp), allocatable :: friction_sgn(:)
   contains
     procedure :: acceleration
     procedure :: rate_response
@@ -134,6 +141,8 @@ contains
   pure logical function same_mode(a, b)
     type(body_mode_type), intent(in) :: a, b
     same_mode = all(a%active .eqv. b%active) .and. all(a%stuck .eqv. b%stuck) .and. all(a%sgn == b%sgn)
+    if (same_mode .and. allocated(a%friction_sgn) .and. allocated(b%friction_sgn)) &
+      same_mode = all(a%friction_sgn == b%friction_sgn)
   end function same_mode
 
   !> The mode at an instant: forces f and their rate df, velocities v, candidate rows (closed,
@@ -170,8 +179,37 @@ contains
       if (mode%sgn(i) == 0.0_wp .and. slip(scene, i, v(i)) /= 0.0_wp .and. scene%body_static(i) > 0.0_wp) &
         mode%sgn(i) = sign(1.0_wp, slip(scene, i, v(i)))
     end do
+    if (scene%n_frictions > 0) call friction_directions(scene, v, mode, status)
+    if (status /= mode_solved) return
     call set_groups(scene, mode, work%root)
   end subroutine solve_body_mode
+
+  !> The friction contacts' sliding directions: the sign of their relative velocity;
+  !> status mode_relative_rest when one with static friction has none (its stick is not
+  !> solved yet), its sign then 0.
+  subroutine friction_directions(scene, v, mode, status)
+    type(scene_type), intent(in) :: scene
+    real(wp), intent(in) :: v(:)
+    type(body_mode_type), intent(inout) :: mode
+    integer, intent(inout) :: status
+    integer :: j
+    real(wp) :: u
+    if (.not. allocated(mode%friction_sgn)) allocate(mode%friction_sgn(scene%n_frictions))
+    do j = 1, scene%n_frictions
+      u = relative_velocity(scene, j, v)
+      mode%friction_sgn(j) = 0.0_wp
+      if (u /= 0.0_wp) mode%friction_sgn(j) = sign(1.0_wp, u)
+      if (u == 0.0_wp .and. scene%friction_static(j) > 0.0_wp) status = mode_relative_rest
+    end do
+  end subroutine friction_directions
+
+  !> Friction contact j's relative velocity v_b - v_a (or its acceleration, given a).
+  pure real(wp) function relative_velocity(scene, j, v)
+    type(scene_type), intent(in) :: scene
+    integer, intent(in) :: j
+    real(wp), intent(in) :: v(:)
+    relative_velocity = v(scene%friction_body(2, j)) - v(scene%friction_body(1, j))
+  end function relative_velocity
 
   !> The clusters (module header): bodies joined by candidate rows between bodies, listed by
   !> root (members in body order, rows in row order), and which need a solve.
@@ -405,6 +443,13 @@ contains
       mode%group_mass(mode%group(i)) = mode%group_mass(mode%group(i)) + scene%body_mass(i)
     end do
     mode%f_slide = -scene%body_friction * mode%sgn
+    ! A friction contact sliding: -F sgn on b, its opposite on a.
+    do k = 1, scene%n_frictions
+      associate (a => scene%friction_body(1, k), b => scene%friction_body(2, k))
+        mode%f_slide(b) = mode%f_slide(b) - scene%friction_slide(k) * mode%friction_sgn(k)
+        mode%f_slide(a) = mode%f_slide(a) + scene%friction_slide(k) * mode%friction_sgn(k)
+      end associate
+    end do
     mode%held = any(mode%active) .or. any(mode%stuck)
     if (scene%drives%n > 0) call drive_components(scene, mode%active, mode%drive)
   end subroutine set_groups

@@ -21,9 +21,9 @@ module impact1d_nbody_event
   use impact1d_path_impact, only: path_impact_reserve, path_projection
   use impact1d_lcp, only: lcp_solved, lcp_too_large
   use impact1d_body_mode, only: body_mode_type, mode_work_type, solve_body_mode, mode_solved, max_dense_unknowns, &
-    drive_accelerations, shift_to_drives, drive_components
+    drive_accelerations, shift_to_drives, drive_components, mode_relative_rest
   use impact1d_nbody_step, only: nbody_force, nbody_rate, row_gap, row_velocity, row_gap_tolerance, &
-    found_row, found_body, mode_acceleration, ground_motion
+    found_row, found_body, mode_acceleration, ground_motion, found_friction
   implicit none
   private
   public :: point_work_type, new_point_work, nbody_event_point
@@ -85,6 +85,7 @@ contains
         .and. index == i) .or. abs(slip(scene, i, s%v(i))) <= velocity_rounding * abs(acc(i)) * scene%dt)
       if (stopped(i)) call zero_velocity(scene, s, i)
     end do
+    if (found == found_friction) call relative_rest(scene, index, s)
     call lock_rigid(scene, closed, stopped, s, work, sink, stats)
     call impacts(scene, closed, entry_scale, acc, s, work, hit, sink, stats, error)
     if (allocated(error)) return
@@ -110,6 +111,13 @@ contains
         'contacts form a cluster too large for the dense mode solve (more than ' // &
         trim(fmt(max_dense_unknowns)) // ' unknowns: some 5000 bodies in contact, their contacts not ' // &
         'a path, such as rigid links with two closed limits)')
+      return
+    else if (status == mode_relative_rest) then
+      k = findloc(s%v(scene%friction_body(2, :)) - s%v(scene%friction_body(1, :)) == 0.0_wp .and. &
+        scene%friction_static > 0.0_wp, .true., 1)
+      call raise(error, status_simulation, 'at t = ' // trim(fmt(s%t)) // ': the bodies of the friction ' // &
+        'contact ''' // trim(scene%friction_name(k)) // ''' come to relative rest: stick between bodies ' // &
+        'is not supported yet')
       return
     else if (status /= mode_solved) then
       call raise(error, status_simulation, 'at t = ' // trim(fmt(s%t)) // &
@@ -797,6 +805,25 @@ contains
     s%v(i) = rest_velocity(scene, i)
     s%v_lo(i) = 0.0_wp
   end subroutine zero_velocity
+
+  !> Friction contact j's ends given their common velocity (momentum kept) at its located
+  !> relative stop: the kinetic energy of the relative velocity left (rounding) is friction's.
+  pure subroutine relative_rest(scene, j, s)
+    type(scene_type), intent(in) :: scene
+    integer, intent(in) :: j
+    type(state_type), intent(inout) :: s
+    real(wp) :: v
+    associate (ea => scene%friction_body(1, j), eb => scene%friction_body(2, j), &
+        ma => scene%body_mass(scene%friction_body(1, j)), mb => scene%body_mass(scene%friction_body(2, j)))
+      v = (ma * s%v(ea) + mb * s%v(eb)) / (ma + mb)
+      call add_compensated(s%friction_loss, s%friction_lo, 0.5_wp * (ma * s%v(ea)**2 + mb * s%v(eb)**2 - &
+        (ma + mb) * v**2))
+      s%v(ea) = v
+      s%v(eb) = v
+      s%v_lo(ea) = 0.0_wp
+      s%v_lo(eb) = 0.0_wp
+    end associate
+  end subroutine relative_rest
 
   !> Kinetic energy of the bodies at velocities v.
   pure real(wp) function kinetic(scene, v)

@@ -12,16 +12,17 @@ module impact1d_nbody_step
   use impact1d_elements, only: add_element_forces, add_moving_element_forces, add_element_rates, element_damping_power, &
     element_drive_power
   use impact1d_body_mode, only: body_mode_type, mode_work_type, solve_body_mode, same_mode, mode_solved, &
-    drive_accelerations, shift_to_drives
+    drive_accelerations, shift_to_drives, relative_velocity
   use impact1d_friction_laws, only: slip, add_stribeck_forces, law_powers
   implicit none
   private
   public :: nbody_force, nbody_rate, nbody_step, row_gap, row_velocity, row_gap_tolerance, locate_nbody, &
     refine_nbody, gaps_hold, mode_acceleration, ground_motion
-  public :: found_none, found_row, found_body, found_hold
+  public :: found_none, found_row, found_body, found_hold, found_friction
 
-  !> What a location found: a row's gap closing, a sliding body stopping, the mode failing.
-  integer, parameter :: found_none = 0, found_row = 1, found_body = 2, found_hold = 3
+  !> What a location found: a row's gap closing, a sliding body stopping, the mode failing,
+  !> a friction contact between bodies (&friction) coming to relative rest.
+  integer, parameter :: found_none = 0, found_row = 1, found_body = 2, found_hold = 3, found_friction = 4
 
 contains
 
@@ -401,10 +402,43 @@ contains
         index = i
       end if
     end do
+    if (scene%n_frictions > 0) call relative_stops(scene, mode, a, b, step, c, polynomial, acc0, theta, found, index)
     if (mode%held .and. (scene%forcing%varies .or. scene%springs%present .or. .not. scene%drives%polynomial &
         .or. scene%stribeck)) &
       call mode_crossing(scene, mode, work, a, c, min(theta, step), theta, found)
   end subroutine locate_nbody
+
+  !> The earliest relative stop of a friction contact between bodies that slides (its
+  !> relative velocity on the dense output c reaching 0), located as a body's stop is;
+  !> theta, found (found_friction) and index (the contact) updated when earlier.
+  subroutine relative_stops(scene, mode, a, b, step, c, polynomial, acc0, theta, found, index)
+    type(scene_type), intent(in) :: scene
+    type(body_mode_type), intent(in) :: mode
+    type(state_type), intent(in) :: a, b
+    real(wp), intent(in) :: step, c(:, :), acc0(:)
+    logical, intent(in) :: polynomial
+    real(wp), intent(inout) :: theta
+    integer, intent(inout) :: found, index
+    real(wp) :: p(0:3), q(0:3), candidate, u0, u1
+    integer :: j
+    do j = 1, scene%n_frictions
+      if (mode%friction_sgn(j) == 0.0_wp) cycle
+      associate (ea => scene%friction_body(1, j), eb => scene%friction_body(2, j), sgn => mode%friction_sgn(j))
+        p = sgn * [c(1, eb) - c(1, ea), 2.0_wp * (c(2, eb) - c(2, ea)), 3.0_wp * (c(3, eb) - c(3, ea)), 0.0_wp]
+        u0 = relative_velocity(scene, j, a%v)
+        u1 = relative_velocity(scene, j, b%v)
+        q = [velocity_rounding * max(abs(a%v(ea)) + abs(a%v(eb)), abs(b%v(ea)) + abs(b%v(eb)), abs(u1 - u0)), &
+          0.0_wp, 0.0_wp, 0.0_wp]
+        if (.not. polynomial) q(1) = q(1) + abs(p(1) - sgn * relative_velocity(scene, j, acc0))
+      end associate
+      candidate = earliest_crossing(p, step, q)
+      if (candidate < theta) then
+        theta = candidate
+        found = found_friction
+        index = j
+      end if
+    end do
+  end subroutine relative_stops
 
   !> The first instant in (0, until] at which the mode no longer holds (the mode solved anew
   !> with its held rows as the candidates differs), by bisection on the dense output c of
@@ -552,6 +586,13 @@ contains
       if (scene%body_static(i) == 0.0_wp .or. mode%sgn(i) == 0.0_wp) cycle
       if (mode%sgn(i) * slip(scene, i, b%v(i)) < -velocity_rounding * max(abs(s%v(i)), abs(b%v(i)), &
           abs(b%v(i) - s%v(i)))) gaps_hold = .false.
+    end do
+    do k = 1, scene%n_frictions
+      if (mode%friction_sgn(k) == 0.0_wp) cycle
+      associate (ea => scene%friction_body(1, k), eb => scene%friction_body(2, k))
+        if (mode%friction_sgn(k) * relative_velocity(scene, k, b%v) < -velocity_rounding * &
+          max(abs(s%v(ea)) + abs(s%v(eb)), abs(b%v(ea)) + abs(b%v(eb)))) gaps_hold = .false.
+      end associate
     end do
   end function gaps_hold
 end module impact1d_nbody_step

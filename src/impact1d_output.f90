@@ -10,7 +10,8 @@ module impact1d_output
   use impact1d_scene, only: scene_input, real_names, n_real, i_title, i_method, i_g, i_dt_out, &
     events_all, events_impacts, events_none, events_kept, name_len, &
     i_dt, default_gravity, i_m2, springs_named, is_nbody, ground_named
-  use impact1d_fields, only: n_contact_fields, contact_fields, spring_fields, sine_fields, r_name, record_input, &
+  use impact1d_fields, only: n_contact_fields, contact_fields, spring_fields, sine_fields, friction_fields, &
+    r_friction_name, r_name, record_input, &
     n_arrays, array_names, array_is_text
   use impact1d_files, only: output_target, make_temporary, resolve_output, lock_folders, unlock_folders, write_text, &
     lock_timed_out, lock_wait
@@ -888,47 +889,39 @@ contains
     end do
   end subroutine put_arrays
 
-  !> The scene's &contact, &spring and &sine records in the header, a line per given field in
-  !> the form of the others ('# contact.2.d_min = 0.5', '# spring.1.k = 40.0', '# sine.1.amp
-  !> = 2.0'), so that a reader rebuilds the scene (impact1d.read_output: Scene.contacts,
-  !> springs, sines).
+  !> The scene's &contact, &spring, &sine and &friction records in the header, a line per
+  !> given field in the form of the others ('# contact.2.d_min = 0.5', '# spring.1.k = 40.0',
+  !> '# sine.1.amp = 2.0', '# friction.1.name = pad'), so that a reader rebuilds the scene
+  !> (impact1d.read_output: Scene.contacts, springs, sines, frictions).
   subroutine put_records(self, input)
     class(file_sink), intent(inout) :: self
     type(scene_input), intent(in) :: input
-    integer :: r, f
-    character(len=32) :: key
-    if (allocated(input%chain%contacts)) then
-      do r = 1, size(input%chain%contacts)
-        associate (rec => input%chain%contacts(r))
-          do f = 1, n_contact_fields
-            write(key, '("contact.", i0, ".", a)') r, trim(contact_fields(f))
-            if (f /= r_name .and. rec%given(f)) call self%put_line(self%unit, '# ' // trim(key) // ' = ' // &
-              trim(fmt(rec%value(f))))
-          end do
-          if (allocated(rec%name)) then
-            write(key, '("contact.", i0, ".name")') r
-            if (len_trim(rec%name) > 0) call self%put_line(self%unit, '# ' // trim(key) // ' = ' // rec%name)
-          end if
-        end associate
-      end do
-    end if
-    if (allocated(input%chain%springs)) call put_numeric_records(self, 'spring', spring_fields, input%chain%springs)
-    if (allocated(input%chain%sines)) call put_numeric_records(self, 'sine', sine_fields, input%chain%sines)
+    if (allocated(input%chain%contacts)) call put_numeric_records(self, 'contact', contact_fields, &
+      input%chain%contacts, r_name)
+    if (allocated(input%chain%springs)) call put_numeric_records(self, 'spring', spring_fields, input%chain%springs, 0)
+    if (allocated(input%chain%sines)) call put_numeric_records(self, 'sine', sine_fields, input%chain%sines, 0)
+    if (allocated(input%chain%frictions)) call put_numeric_records(self, 'friction', friction_fields, &
+      input%chain%frictions, r_friction_name)
   end subroutine put_records
 
-  !> Records of numbers only, a line per given field ('# group.r.field = value').
-  subroutine put_numeric_records(self, group, fields, records)
+  !> Records, a line per given field ('# group.r.field = value'); field name_field (0: none)
+  !> is the record's name, written when not blank.
+  subroutine put_numeric_records(self, group, fields, records, name_field)
     class(file_sink), intent(inout) :: self
     character(len=*), intent(in) :: group, fields(:)
     type(record_input), intent(in) :: records(:)
+    integer, intent(in) :: name_field
     integer :: r, f
     character(len=32) :: key
     do r = 1, size(records)
       do f = 1, size(fields)
         write(key, '(a, ".", i0, ".", a)') group, r, trim(fields(f))
-        if (records(r)%given(f)) call self%put_line(self%unit, '# ' // trim(key) // ' = ' // &
+        if (f /= name_field .and. records(r)%given(f)) call self%put_line(self%unit, '# ' // trim(key) // ' = ' // &
           trim(fmt(records(r)%value(f))))
       end do
+      if (name_field == 0 .or. .not. allocated(records(r)%name)) cycle
+      write(key, '(a, ".", i0, ".name")') group, r
+      if (len_trim(records(r)%name) > 0) call self%put_line(self%unit, '# ' // trim(key) // ' = ' // records(r)%name)
     end do
   end subroutine put_numeric_records
 

@@ -150,6 +150,14 @@ module impact1d_scene
     real(wp), allocatable :: body_belt(:)            !< (N) its friction surface's velocity, m/s
     real(wp), allocatable :: body_v_s(:)             !< (N) Stribeck velocity, m/s (0: none)
     real(wp), allocatable :: body_viscous(:)         !< (N) viscous friction c_v m g, N s/m
+    ! friction contacts between two bodies (&friction records; docs/method.md section 13),
+    ! on the relative velocity v_b - v_a; allocated only in a scene that has one. Only the
+    ! N-body engine runs them.
+    integer :: n_frictions = 0
+    integer, allocatable :: friction_body(:, :)      !< (2, nf) ends a, b (bodies)
+    real(wp), allocatable :: friction_slide(:)       !< (nf) sliding bound mu normal, N
+    real(wp), allocatable :: friction_static(:)      !< (nf) static bound mus normal >= friction_slide, N
+    character(len=name_len), allocatable :: friction_name(:)   !< (nf) events stick_<name>, slip_<name>
     !> The N-body engine's RK4 stages book powers (moving grounds or a friction law: its
     !> nbody_step's moving_stage), set by build_scene: one test in the stage's hot path.
     logical :: stage_powers = .false.
@@ -707,6 +715,8 @@ contains
     if (allocated(error)) return
     call set_laws(input, scene, error)
     if (allocated(error)) return
+    call set_frictions(records, scene, error)
+    if (allocated(error)) return
     if (scene%belts .or. scene%stribeck) call refuse_stops(records, 'cannot be combined with belt_v, v_s ' // &
       'or c_v yet: such scenes run on the N-body engine, which has rigid contacts only', error)
     if (allocated(error)) return
@@ -765,6 +775,28 @@ contains
       scene%body_viscous = [(array_value(input%chain, a_c_v, i, 0.0_wp) * scene%body_mass(i) * g, i = 1, n)]
     end if
   end subroutine set_laws
+
+  !> The &friction records (friction contacts between two bodies), which only the N-body
+  !> engine runs (impact1d_solver's run): neither the vissim method nor compliant stops.
+  subroutine set_frictions(records, scene, error)
+    type(mechanism_records), intent(in) :: records
+    type(scene_type), intent(inout) :: scene
+    type(error_type), allocatable, intent(inout) :: error
+    scene%n_frictions = records%n_frictions
+    if (scene%n_frictions == 0) return
+    if (scene%method == 'vissim') then
+      call raise(error, status_input, "method = 'vissim' is the tutorial's fixed-step scheme: a scene " // &
+        'with friction between two bodies (&friction) runs with method = ''event''')
+      return
+    end if
+    call refuse_stops(records, 'cannot be combined with &friction records yet: such scenes run on the ' // &
+      'N-body engine, which has rigid contacts only', error)
+    if (allocated(error)) return
+    scene%friction_body = records%friction_body
+    scene%friction_slide = records%friction_slide
+    scene%friction_static = records%friction_static
+    scene%friction_name = records%friction_name
+  end subroutine set_frictions
 
   !> A scene with a moving ground runs on the N-body engine (whatever its N), which has
   !> neither the vissim method nor compliant stops.

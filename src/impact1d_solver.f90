@@ -77,13 +77,14 @@ contains
     call start_counts(stats, scene%n_rows + scene%n_stops, scene%n_bodies)
     ! The tutorial's scheme, for any number of bodies (build_scene refuses it moving grounds
     ! and the friction laws). The stepping kernels here take the bodies in lanes
-    ! (impact1d_lanes); more bodies, and scenes with a moving ground or a friction law
-    ! (belt_v, v_s, c_v), run on the N-body engine.
+    ! (impact1d_lanes); more bodies, and scenes with a moving ground, a friction law
+    ! (belt_v, v_s, c_v) or friction between bodies (&friction), run on the N-body engine.
     if (scene%method == 'vissim') then
       call run_vissim(scene, sink, stats, error)
       return
     end if
-    if (scene%n_bodies > max_lanes .or. scene%drives%n > 0 .or. scene%belts .or. scene%stribeck) then
+    if (scene%n_bodies > max_lanes .or. scene%drives%n > 0 .or. scene%belts .or. scene%stribeck .or. &
+        scene%n_frictions > 0) then
       call run_nbody(scene, sink, stats, error)
       return
     end if
