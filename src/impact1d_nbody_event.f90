@@ -9,7 +9,8 @@ module impact1d_nbody_event
   use impact1d_error, only: error_type, raise, status_simulation, fmt
   use impact1d_scene, only: scene_type
   use impact1d_state, only: state_type, add_compensated
-  use impact1d_output, only: sink_type, run_stats, class_impact, class_rest, class_stick, class_slip
+  use impact1d_output, only: sink_type, run_stats, class_impact, class_rest, class_stick, class_slip, &
+    class_pair_stick, class_pair_slip
   use impact1d_yardsticks, only: gap_rounding, velocity_rounding, time_rounding, energy_rounding, same_instant, &
     force_scale
   use impact1d_event_log, only: event_log_type, log_event
@@ -21,7 +22,7 @@ module impact1d_nbody_event
   use impact1d_path_impact, only: path_impact_reserve, path_projection
   use impact1d_lcp, only: lcp_solved, lcp_too_large
   use impact1d_body_mode, only: body_mode_type, mode_work_type, solve_body_mode, mode_solved, max_dense_unknowns, &
-    drive_accelerations, shift_to_drives, drive_components, mode_relative_rest
+    drive_accelerations, shift_to_drives, drive_components
   use impact1d_nbody_step, only: nbody_force, nbody_rate, row_gap, row_velocity, row_gap_tolerance, &
     found_row, found_body, mode_acceleration, ground_motion, found_friction
   implicit none
@@ -85,7 +86,7 @@ contains
         .and. index == i) .or. abs(slip(scene, i, s%v(i))) <= velocity_rounding * abs(acc(i)) * scene%dt)
       if (stopped(i)) call zero_velocity(scene, s, i)
     end do
-    if (found == found_friction) call relative_rest(scene, index, s)
+    if (found == found_friction) call relative_rest(scene, mode, index, s)
     call lock_rigid(scene, closed, stopped, s, work, sink, stats)
     call impacts(scene, closed, entry_scale, acc, s, work, hit, sink, stats, error)
     if (allocated(error)) return
@@ -112,19 +113,13 @@ contains
         trim(fmt(max_dense_unknowns)) // ' unknowns: some 5000 bodies in contact, their contacts not ' // &
         'a path, such as rigid links with two closed limits)')
       return
-    else if (status == mode_relative_rest) then
-      k = findloc(s%v(scene%friction_body(2, :)) - s%v(scene%friction_body(1, :)) == 0.0_wp .and. &
-        scene%friction_static > 0.0_wp, .true., 1)
-      call raise(error, status_simulation, 'at t = ' // trim(fmt(s%t)) // ': the bodies of the friction ' // &
-        'contact ''' // trim(scene%friction_name(k)) // ''' come to relative rest: stick between bodies ' // &
-        'is not supported yet')
-      return
     else if (status /= mode_solved) then
       call raise(error, status_simulation, 'at t = ' // trim(fmt(s%t)) // &
         ': no consistent contact and friction state (complementarity problem has no solution)')
       return
     end if
     call log_mode_change(scene, initial, f, df, candidate, new, s, event_log, sink, stats)
+    if (scene%n_frictions > 0 .and. .not. initial) call log_pairs(scene, mode, new, s, sink, stats)
     mode = new
   end subroutine nbody_event_point
 
@@ -806,23 +801,61 @@ contains
     s%v_lo(i) = 0.0_wp
   end subroutine zero_velocity
 
-  !> Friction contact j's ends given their common velocity (momentum kept) at its located
-  !> relative stop: the kinetic energy of the relative velocity left (rounding) is friction's.
-  pure subroutine relative_rest(scene, j, s)
+  !> The friction contacts between bodies that stick ('stick_<name>': stuck in the new mode,
+  !> not in the old) or slip ('slip_<name>': stuck in the old, not in the new).
+  subroutine log_pairs(scene, old, new, s, sink, stats)
     type(scene_type), intent(in) :: scene
+    type(body_mode_type), intent(in) :: old, new
+    type(state_type), intent(in) :: s
+    class(sink_type), intent(inout) :: sink
+    type(run_stats), intent(inout) :: stats
+    integer :: j
+    do j = 1, scene%n_frictions
+      if (new%friction_stuck(j) .eqv. old%friction_stuck(j)) cycle
+      call log_event(scene, sink, stats, s%t, merge(class_pair_stick, class_pair_slip, new%friction_stuck(j)), &
+        size(scene%row_name) + j, s%v, s%v)
+    end do
+  end subroutine log_pairs
+
+  !> Friction contact j's ends, with the bodies the mode moves with each (their groups),
+  !> given one velocity at its located relative stop: their common one (momentum kept), or
+  !> that of an end held still; the kinetic energy of the rounding left is friction's.
+  pure subroutine relative_rest(scene, mode, j, s)
+    type(scene_type), intent(in) :: scene
+    type(body_mode_type), intent(in) :: mode
     integer, intent(in) :: j
     type(state_type), intent(inout) :: s
-    real(wp) :: v
-    associate (ea => scene%friction_body(1, j), eb => scene%friction_body(2, j), &
-        ma => scene%body_mass(scene%friction_body(1, j)), mb => scene%body_mass(scene%friction_body(2, j)))
-      v = (ma * s%v(ea) + mb * s%v(eb)) / (ma + mb)
-      call add_compensated(s%friction_loss, s%friction_lo, 0.5_wp * (ma * s%v(ea)**2 + mb * s%v(eb)**2 - &
-        (ma + mb) * v**2))
-      s%v(ea) = v
-      s%v(eb) = v
-      s%v_lo(ea) = 0.0_wp
-      s%v_lo(eb) = 0.0_wp
-    end associate
+    real(wp) :: v, momentum, mass, before
+    integer :: i, ga, gb
+    ga = mode%group(scene%friction_body(1, j))
+    gb = mode%group(scene%friction_body(2, j))
+    momentum = 0.0_wp
+    mass = 0.0_wp
+    before = 0.0_wp
+    do i = 1, scene%n_bodies
+      if (.not. moved(i)) cycle
+      momentum = momentum + scene%body_mass(i) * s%v(i)
+      mass = mass + scene%body_mass(i)
+      before = before + 0.5_wp * scene%body_mass(i) * s%v(i)**2
+    end do
+    v = 0.0_wp
+    if (mass > 0.0_wp) v = momentum / mass
+    if (ga == 0) v = s%v(scene%friction_body(1, j))
+    if (gb == 0) v = s%v(scene%friction_body(2, j))
+    call add_compensated(s%friction_loss, s%friction_lo, before - 0.5_wp * mass * v**2)
+    do i = 1, scene%n_bodies
+      if (.not. moved(i)) cycle
+      s%v(i) = v
+      s%v_lo(i) = 0.0_wp
+    end do
+
+  contains
+
+    !> Whether body i moves with an end of the contact (not held still).
+    pure logical function moved(i)
+      integer, intent(in) :: i
+      moved = mode%group(i) /= 0 .and. (mode%group(i) == ga .or. mode%group(i) == gb)
+    end function moved
   end subroutine relative_rest
 
   !> Kinetic energy of the bodies at velocities v.

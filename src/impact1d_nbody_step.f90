@@ -440,6 +440,18 @@ contains
     end do
   end subroutine relative_stops
 
+  !> v with the ends of each stuck friction contact at one velocity (a's), as the mode moves
+  !> them: the dense output's rounding is no relative slip.
+  pure subroutine hold_pairs(scene, mode, v)
+    type(scene_type), intent(in) :: scene
+    type(body_mode_type), intent(in) :: mode
+    real(wp), intent(inout) :: v(:)
+    integer :: j
+    do j = 1, scene%n_frictions
+      if (mode%friction_stuck(j)) v(scene%friction_body(2, j)) = v(scene%friction_body(1, j))
+    end do
+  end subroutine hold_pairs
+
   !> The first instant in (0, until] at which the mode no longer holds (the mode solved anew
   !> with its held rows as the candidates differs), by bisection on the dense output c of
   !> the step from a: theta and found updated when there is one.
@@ -481,6 +493,7 @@ contains
       if (scene%belts) then
         where (mode%stuck) v = scene%body_belt
       end if
+      if (scene%n_frictions > 0) call hold_pairs(scene, mode, v)
       call nbody_force(scene, a%t + tau, a%x, dx, v, f)
       call nbody_rate(scene, a%t + tau, v, df)
       if (scene%drives%n > 0) call shift_to_drives(scene, a%t + tau, mode%active, f, df)
@@ -524,8 +537,32 @@ contains
       do k = 1, scene%n_rows
         if (mode%active(k) .and. .not. probe%active(k)) against = against .or. row_velocity(scene, k, acc) < 0.0_wp
       end do
+      if (scene%n_frictions > 0) call pairs_against(probe, lead, against)
       begun = begun .or. .not. against
     end function begun
+
+    !> begun's test for the friction contacts that break away (stuck in the mode, not in the
+    !> probe): each, at its static bound the way the probe slides it, must have its ends'
+    !> groups accelerate apart that way (lead: the probe's group loads, at sliding bounds).
+    subroutine pairs_against(probe, lead, against)
+      type(body_mode_type), intent(in) :: probe
+      real(wp), intent(inout) :: lead(0:)
+      logical, intent(inout) :: against
+      integer :: k
+      real(wp) :: rel
+      do k = 1, scene%n_frictions
+        if (.not. mode%friction_stuck(k) .or. probe%friction_stuck(k) .or. probe%friction_sgn(k) == 0.0_wp) cycle
+        associate (ga => probe%group(scene%friction_body(1, k)), gb => probe%group(scene%friction_body(2, k)), &
+            extra => (scene%friction_static(k) - scene%friction_slide(k)) * probe%friction_sgn(k))
+          lead(gb) = lead(gb) - extra
+          lead(ga) = lead(ga) + extra
+          rel = 0.0_wp
+          if (gb > 0) rel = lead(gb) / probe%group_mass(gb)
+          if (ga > 0) rel = rel - lead(ga) / probe%group_mass(ga)
+          against = against .or. probe%friction_sgn(k) * rel < 0.0_wp
+        end associate
+      end do
+    end subroutine pairs_against
   end subroutine mode_crossing
 
   !> Re-take the step to the located time and polish it by Newton's method on the watched

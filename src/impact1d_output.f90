@@ -20,6 +20,7 @@ module impact1d_output
   public :: sink_type, memory_sink, summary_sink, file_sink, n_columns, column_names, n_event_kinds, event_names
   public :: event_impact, event_rest, event_release, event_stick, event_slip, run_stats, checkpoint
   public :: class_impact, class_rest, class_release, class_stick, class_slip, event_name, start_counts, &
+    class_pair_stick, class_pair_slip, &
     count_event, event_count, impacts_on
   public :: emit_sample, emit_bodies, events_path, present_columns, i_pe, i_work, i_friction_loss, i_impact_loss, &
     i_damping_loss, i_drive_work, row_length, row_columns, column_word, bodies_of, row_ledger, check_bodies_out, final_row
@@ -40,11 +41,14 @@ module impact1d_output
   !> Events are (class, index): an impact, rest or release of row index, a stick or slip of
   !> body index; each carries the velocities of a pair of bodies (a, b; 0: none), before and
   !> after: [v_a-, v_b-, v_a+, v_b+] (docs/nbody-plan.md, "The event record"). Named
-  !> '<row>', 'rest_<row>', 'release_<row>' (the row's name), 'stick<i>', 'slip<i>'.
+  !> '<row>', 'rest_<row>', 'release_<row>' (the row's name), 'stick<i>', 'slip<i>'; a
+  !> friction contact between bodies (&friction j) sticks or slips as (class_pair_stick or
+  !> class_pair_slip, n_rows + j), named 'stick_<name>', 'slip_<name>' (the sink's row_names
+  !> then hold the contacts' names after the rows').
   integer, parameter :: class_impact = 1, class_rest = 2, class_release = 3, class_stick = 4, &
-    class_slip = 5
-  character(len=*), parameter :: class_prefix(5) = [character(len=8) :: '', 'rest_', 'release_', &
-    'stick', 'slip']
+    class_slip = 5, class_pair_stick = 6, class_pair_slip = 7
+  character(len=*), parameter :: class_prefix(7) = [character(len=8) :: '', 'rest_', 'release_', &
+    'stick', 'slip', 'stick_', 'slip_']
   !> Longest event name: a prefix and a row's name.
   integer, parameter :: event_name_len = 8 + name_len
   !> The event kinds of the tutorial's scenes (its walls and slot, one or two bodies), for
@@ -484,7 +488,7 @@ contains
     integer, intent(in) :: class, index
     character(len=event_name_len) :: name     ! blank padded: callers trim
     character(len=12) :: body
-    if (class >= class_stick) then
+    if (class == class_stick .or. class == class_slip) then
       write(body, '(i0)') index
       name = trim(class_prefix(class)) // body
     else
@@ -506,7 +510,9 @@ contains
   pure subroutine count_event(stats, class, index)
     type(run_stats), intent(inout) :: stats
     integer, intent(in) :: class, index
-    if (class >= class_stick) then
+    if (class >= class_pair_stick) then
+      ! (a friction contact's: counted in the total only)
+    else if (class >= class_stick) then
       stats%body_events(class, index) = stats%body_events(class, index) + 1
     else
       stats%row_events(class, index) = stats%row_events(class, index) + 1

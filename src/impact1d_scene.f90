@@ -792,6 +792,11 @@ contains
     call refuse_stops(records, 'cannot be combined with &friction records yet: such scenes run on the ' // &
       'N-body engine, which has rigid contacts only', error)
     if (allocated(error)) return
+    ! (the friction laws' ledger, law_powers, books the bodies' own friction only)
+    if (scene%belts .or. scene%stribeck) then
+      call raise(error, status_input, '&friction records cannot be combined with belt_v, v_s or c_v yet')
+      return
+    end if
     scene%friction_body = records%friction_body
     scene%friction_slide = records%friction_slide
     scene%friction_static = records%friction_static

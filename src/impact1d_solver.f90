@@ -74,6 +74,8 @@ contains
     end if
     ! What the sink calls the events on each row; nothing counted yet.
     sink%row_names = scene%row_name
+    ! (a friction contact's events are named after it: impact1d_output's class_pair_stick)
+    if (scene%n_frictions > 0) sink%row_names = [scene%row_name, scene%friction_name]
     call start_counts(stats, scene%n_rows + scene%n_stops, scene%n_bodies)
     ! The tutorial's scheme, for any number of bodies (build_scene refuses it moving grounds
     ! and the friction laws). The stepping kernels here take the bodies in lanes

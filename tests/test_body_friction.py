@@ -11,7 +11,11 @@ their relative velocity u = v_b - v_a. It runs on the N-body engine, whatever N.
         x2 = v0 t - F t^2 / (2 m2), v2 = v0 - F t / m2,
     so u = v0 - F t (1/m1 + 1/m2) reaches 0 at t* = v0 / (F (1/m1 + 1/m2)). Friction's loss is
     F times the distance slid, F (v0 t - F t^2 (1/m1 + 1/m2) / 2), which is the kinetic energy
-    lost: the ledger closes. Constant forces: RK4 is exact, at dt = 1e-3 and at a coarse dt.
+    lost: the ledger closes. At t* the contact sticks (it needs no force to keep u = 0) and
+    the pair moves on at m2 v0 / (m1 + m2). Constant forces: RK4 is exact, at dt = 1e-3 and
+    at a coarse dt.
+(b) Block on block under a ramp (above its test): the instant the upper block starts
+    slipping, t_s = mus N (m1 + m2) / (m2 K), in closed form.
 """
 
 from __future__ import annotations
@@ -67,21 +71,65 @@ def test_the_contact_acts_on_its_two_bodies_only():
         assert r.v[-1][order[1]] == pytest.approx(V0 - F * t / M2, abs=1e-15)
 
 
-def test_relative_rest_is_located_and_stick_not_yet_run():
-    """The relative velocity reaches 0 at t* (located as a body's stop is); the stick there is
-    not solved yet, and the run says so (SimulationError, naming the contact)."""
-    for dt in (1e-3, 0.05):
-        with pytest.raises(impact1d.SimulationError, match="friction contact 'pad' come to relative rest") as info:
-            impact1d.simulate(sliding_blocks(dt, 2 * T_STAR))
-        t = float(str(info.value).split("at t = ")[1].split(":")[0])
-        assert t == pytest.approx(T_STAR, abs=1e-15)
+@pytest.mark.parametrize("dt", [1e-3, 0.05])
+def test_sliding_blocks_stick_at_the_closed_form_instant_and_move_together(dt):
+    """(a) past t*: the relative stop is located at t* (as a body's stop is), the contact
+    sticks (|friction| = 0 <= mus N holds it), and the pair moves on at the common velocity
+    m2 v0 / (m1 + m2) (momentum kept); friction has then taken the kinetic energy
+    m2 v0^2 / 2 - (m1 + m2) v_c^2 / 2."""
+    r = impact1d.simulate(sliding_blocks(dt, 2 * T_STAR))
+    assert [e["kind"] for e in r.events] == ["stick_pad"]
+    assert r.events[0]["t"] == pytest.approx(T_STAR, abs=1e-15)
+    v_c = M2 * V0 / (M1 + M2)
+    after = r.t > T_STAR
+    np.testing.assert_allclose(r.v1[after], v_c, rtol=0, atol=1e-15)
+    np.testing.assert_allclose(r.v2[after], v_c, rtol=0, atol=1e-15)
+    x_star = F * T_STAR**2 / (2 * M1)
+    np.testing.assert_allclose(r.x1[after], x_star + v_c * (r.t[after] - T_STAR), rtol=0, atol=1e-15)
+    assert r.friction_loss[-1] == pytest.approx(0.5 * M2 * V0**2 - 0.5 * (M1 + M2) * v_c**2, abs=1e-15)
+    assert np.max(np.abs(r.residual)) < 1e-14
+
+
+# (b) Block on block under a ramp: the lower block (m1, frictionless ground) is pulled by
+#     f1 = K t (a force table), the upper block (m2) rides on it through the contact, both at
+#     rest at t = 0. Stuck, they move as one, a = K t / (m1 + m2), and the contact carries
+#     the upper block's m2 a = m2 K t / (m1 + m2); the upper block starts slipping when that
+#     reaches mus N:  t_s = mus N (m1 + m2) / (m2 K).  Then the upper block is pushed forward by
+#     F = mu N (u = v2 - v1 < 0) and the lower one held back by it:
+#         v2 = v_s + F (t - t_s) / m2,
+#         v1 = v_s + (K (t^2 - t_s^2) / 2 - F (t - t_s)) / m1,  v_s = K t_s^2 / (2 (m1 + m2)).
+#     An error d in the break-away instant moves v2 by (mus - mu) N d / m2: v2 at the end
+#     measures where the slip began. The upper block is placed apart (x2 = 10): neighbours meet.
+K_RAMP = 5.0
+T_SLIP = MUS * NORMAL * (M1 + M2) / (M2 * K_RAMP)
+
+
+@pytest.mark.parametrize("dt", [1e-3, 0.2])
+def test_block_on_block_under_a_ramp_slips_at_the_closed_form_instant(tmp_path, dt):
+    table = tmp_path / "ramp.tab"
+    table.write_text(f"0 0\n100 {100 * K_RAMP}\n")
+    t_end = 1.5 * T_SLIP
+    scene = impact1d.Scene(m=[M1, M2], x=[0.0, 10.0], v=[0.0, 0.0], t_end=t_end, dt=dt, f_table=[str(table), None],
+                           frictions=[{"a": 1, "b": 2, "mu": MU, "mus": MUS, "normal": NORMAL, "name": "pad"}])
+    r = impact1d.simulate(scene)
+    assert [e["kind"] for e in r.events] == ["slip_pad"]
+    assert r.events[0]["t"] == pytest.approx(T_SLIP, abs=1e-14)
+    stuck = r.t <= T_SLIP
+    np.testing.assert_array_equal(r.v1[stuck], r.v2[stuck])
+    np.testing.assert_allclose(r.v1[stuck], K_RAMP * r.t[stuck]**2 / (2 * (M1 + M2)), rtol=0, atol=1e-14)
+    v_s = K_RAMP * T_SLIP**2 / (2 * (M1 + M2))
+    v2 = v_s + F * (t_end - T_SLIP) / M2
+    v1 = v_s + (K_RAMP * (t_end**2 - T_SLIP**2) / 2 - F * (t_end - T_SLIP)) / M1
+    assert r.v1[-1] == pytest.approx(v1, abs=1e-14)
+    assert r.v2[-1] == pytest.approx(v2, abs=1e-14)     # the break-away within 1e-14 s of t_s
+    assert np.max(np.abs(r.residual)) < 1e-12
 
 
 def test_scene_file_cli_header_and_read_output_carry_the_record(tmp_path):
     nml = tmp_path / "blocks.nml"
     nml.write_text("&bodies m = 2.0, 1.0 /\n&initial x = 0.0, 0.0, v = 0.0, 1.0 /\n"
                    "&friction a = 1, b = 2, mu = 0.3, mus = 0.4, normal = 9.81, name = 'pad' /\n"
-                   "&run t_end = 0.2, dt = 1e-3 /\n")
+                   "&run t_end = 0.3, dt = 1e-3 /\n")
     scene = impact1d.load_scene(str(nml))
     assert scene.frictions == [{"a": 1, "b": 2, "mu": 0.3, "mus": 0.4, "normal": 9.81, "name": "pad"}]
     out = tmp_path / "blocks.dat"
@@ -90,15 +138,9 @@ def test_scene_file_cli_header_and_read_output_carry_the_record(tmp_path):
     assert "# friction.1.normal = 9.81" in header and "# friction.1.name = pad" in header
     back = impact1d.read_output(str(out))
     assert back.scene.frictions == scene.frictions
+    assert [e["kind"] for e in back.events] == ["stick_pad"]
     mine = impact1d.simulate(scene)
     assert np.array_equal(back.x2, mine.x2) and np.array_equal(back.v1, mine.v1)
-
-
-def test_unnamed_record_takes_its_place_as_name():
-    scene = sliding_blocks(1e-3, 2 * T_STAR)
-    scene.frictions = [{"a": 1, "b": 2, "mu": MU, "normal": NORMAL}]
-    with pytest.raises(impact1d.SimulationError, match="'friction1'"):
-        impact1d.simulate(scene)
 
 
 @pytest.mark.parametrize("record, words", [
@@ -123,3 +165,22 @@ def test_vissim_and_compliant_stops_refuse_the_record():
         impact1d.simulate(sliding_blocks(1e-3, 0.1, method="vissim"))
     with pytest.raises(impact1d.InputError, match="cannot be combined with &friction records"):
         impact1d.simulate(sliding_blocks(1e-3, 0.1, contacts=[{"a": 0, "b": 1, "d_min": -1.0, "k": 1e4}]))
+
+
+def test_a_stuck_pair_stays_stuck_while_another_contact_sticks():
+    """Three bodies: 2 and 3 start together (contact friction1, stuck), 2 slides on 1
+    (friction2, unnamed: named by its place). Friction2 pulls the stuck pair (m2 + m3) back
+    with F, which needs m3 F / (m2 + m3) < mus N on body 3 (friction1 holds); its relative
+    velocity V0 - F t (1/m1 + 1/(m2 + m3)) reaches 0 at t2, where all three move on at the
+    common velocity (m2 + m3) V0 / (m1 + m2 + m3). One event: friction1 never slips."""
+    m3 = 1.5
+    frictions = [{"a": 2, "b": 3, "mu": MU, "normal": NORMAL}, {"a": 1, "b": 2, "mu": MU, "normal": NORMAL}]
+    scene = impact1d.Scene(m=[M1, M2, m3], x=[0.0, 0.0, 5.0], v=[0.0, V0, V0], t_end=1.0, dt=1e-3,
+                           frictions=frictions)
+    r = impact1d.simulate(scene)
+    t2 = V0 / (F * (1.0 / M1 + 1.0 / (M2 + m3)))
+    assert [(e["kind"], e["a"], e["b"]) for e in r.events] == [("stick_friction2", 1, 2)]
+    assert r.events[0]["t"] == pytest.approx(t2, abs=1e-15)
+    np.testing.assert_array_equal(r.v[:, 1], r.v[:, 2])
+    np.testing.assert_allclose(r.v[-1], (M2 + m3) * V0 / (M1 + M2 + m3), rtol=0, atol=1e-15)
+    assert np.max(np.abs(r.residual)) < 1e-14
