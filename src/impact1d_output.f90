@@ -66,9 +66,10 @@ module impact1d_output
   type :: run_stats
     integer(int64) :: steps = 0
     !> Events counted: every one, per row (impacts, rests, releases: (3, nr)) and per body
-    !> (sticks, slips: (2, N)); start_counts allocates them.
+    !> (sticks, slips: (2, N)) and per friction contact (its sticks, slips: (2, nf), the
+    !> contact j's events at index nr + j); start_counts allocates them.
     integer :: n_events = 0
-    integer, allocatable :: row_events(:, :), body_events(:, :)
+    integer, allocatable :: row_events(:, :), body_events(:, :), pair_events(:, :)
     real(wp) :: last_row(n_columns) = 0.0_wp
     !> An N-body run's last full row (emit_bodies; row_length(N) long), in place of last_row.
     real(wp), allocatable :: row(:)
@@ -497,10 +498,16 @@ contains
   end function event_name
 
   !> Counts for a run of n_rows rows and n_bodies bodies, none yet.
-  pure subroutine start_counts(stats, n_rows, n_bodies)
+  pure subroutine start_counts(stats, n_rows, n_bodies, n_pairs)
     type(run_stats), intent(inout) :: stats
     integer, intent(in) :: n_rows, n_bodies
-    allocate(stats%row_events(class_impact:class_release, n_rows), stats%body_events(class_stick:class_slip, n_bodies))
+    integer, intent(in), optional :: n_pairs     !< friction contacts between bodies (none: 0)
+    integer :: np
+    np = 0
+    if (present(n_pairs)) np = n_pairs
+    allocate(stats%row_events(class_impact:class_release, n_rows), stats%body_events(class_stick:class_slip, n_bodies), &
+      stats%pair_events(class_pair_stick:class_pair_slip, np))
+    stats%pair_events = 0
     stats%row_events = 0
     stats%body_events = 0
     stats%n_events = 0
@@ -511,7 +518,9 @@ contains
     type(run_stats), intent(inout) :: stats
     integer, intent(in) :: class, index
     if (class >= class_pair_stick) then
-      ! (a friction contact's: counted in the total only)
+      associate (j => index - size(stats%row_events, 2))
+        stats%pair_events(class, j) = stats%pair_events(class, j) + 1
+      end associate
     else if (class >= class_stick) then
       stats%body_events(class, index) = stats%body_events(class, index) + 1
     else
@@ -524,7 +533,9 @@ contains
   pure integer function event_count(stats, class, index)
     type(run_stats), intent(in) :: stats
     integer, intent(in) :: class, index
-    if (class >= class_stick) then
+    if (class >= class_pair_stick) then
+      event_count = stats%pair_events(class, index - size(stats%row_events, 2))
+    else if (class >= class_stick) then
       event_count = stats%body_events(class, index)
     else
       event_count = stats%row_events(class, index)
