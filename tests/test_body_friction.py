@@ -133,7 +133,10 @@ def test_scene_file_cli_header_and_read_output_carry_the_record(tmp_path):
     scene = impact1d.load_scene(str(nml))
     assert scene.frictions == [{"a": 1, "b": 2, "mu": 0.3, "mus": 0.4, "normal": 9.81, "name": "pad"}]
     out = tmp_path / "blocks.dat"
-    subprocess.run([tools.find_tool("impact1d"), str(nml), "-o", str(out)], check=True, capture_output=True)
+    proc = subprocess.run([tools.find_tool("impact1d"), str(nml), "-o", str(out)], check=True, capture_output=True,
+                          text=True)
+    # (the summary counts the contact's events by name)
+    assert "events    stick_pad 1" in proc.stdout
     header = out.read_text()
     assert "# friction.1.normal = 9.81" in header and "# friction.1.name = pad" in header
     back = impact1d.read_output(str(out))
@@ -184,3 +187,35 @@ def test_a_stuck_pair_stays_stuck_while_another_contact_sticks():
     np.testing.assert_array_equal(r.v[:, 1], r.v[:, 2])
     np.testing.assert_allclose(r.v[-1], (M2 + m3) * V0 / (M1 + M2 + m3), rtol=0, atol=1e-15)
     assert np.max(np.abs(r.residual)) < 1e-14
+
+
+# (c) A friction damper: block 1 (m1, frictionless ground) on a spring k to the ground (rest
+#     at 0), block 2 (m2) rubbing on it through the contact, both at rest, x1 = X0. Stuck, the
+#     contact would need m2 k X0 / (m1 + m2) > mus N: it slips at once, block 2 dragged by -F
+#     (u = v2 - v1 > 0 as block 1 leaves), block 1 held back by +F:
+#         x1 = F / k + (X0 - F / k) cos(w1 t),  w1 = sqrt(k / m1);   v2 = -F t / m2,
+#     so u(t) = -F t / m2 + (X0 - F / k) w1 sin(w1 t), whose first root t1 > 0 is the stick
+#     (an mpmath root). There the contact needs m2 k |x1(t1)| / (m1 + m2) <= mus N: the pair
+#     moves as one, x = x1(t1) cos(w0 s) + (v2(t1) / w0) sin(w0 s), w0 = sqrt(k / (m1 + m2)),
+#     until |x| reaches mus N (m1 + m2) / (m2 k): the slip at t2 (the first root in s). RK4
+#     on the harmonic motions: (w dt)^4 (measured 8e-11 s at dt = 1e-3, 1.2e-6 s at 0.02).
+@pytest.mark.parametrize("dt, tol, residual", [(1e-3, 2e-10, 1e-10), (0.02, 3e-6, 5e-6)])
+def test_friction_damper_sticks_and_slips_at_the_closed_form_instants(dt, tol, residual):
+    import mpmath as mp
+    mp.mp.dps = 40
+    k, x0 = 100.0, 0.2
+    S = MUS * NORMAL
+    w1, w0 = mp.sqrt(k / M1), mp.sqrt(k / (M1 + M2))
+    t1 = mp.findroot(lambda t: -F * t / M2 + (x0 - F / k) * w1 * mp.sin(w1 * t), 0.3)
+    x_1, v_1 = F / k + (x0 - F / k) * mp.cos(w1 * t1), -F * t1 / M2
+    assert M2 * k * abs(x_1) / (M1 + M2) <= S < M2 * k * x0 / (M1 + M2)
+    limit = S * (M1 + M2) / (M2 * k)
+    s = mp.findroot(lambda s: x_1 * mp.cos(w0 * s) + v_1 / w0 * mp.sin(w0 * s) + limit, 0.04)
+    scene = impact1d.Scene(m=[M1, M2], x=[x0, 10.0], v=[0.0, 0.0], k=[k, 0.0], x_rest=[0.0, 0.0],
+                           t_end=float(t1 + s) + 0.05, dt=dt,
+                           frictions=[{"a": 1, "b": 2, "mu": MU, "mus": MUS, "normal": NORMAL, "name": "pad"}])
+    r = impact1d.simulate(scene)
+    assert [e["kind"] for e in r.events] == ["stick_pad", "slip_pad"]
+    assert abs(r.events[0]["t"] - float(t1)) < tol
+    assert abs(r.events[1]["t"] - float(t1 + s)) < tol
+    assert np.max(np.abs(r.residual)) < residual
