@@ -8,9 +8,10 @@ program impact1d_cli
   use impact1d_kinds, only: wp
   use impact1d_error, only: error_type, status_input, status_simulation, fmt
   use impact1d_scene, only: scene_input, scene_type, set_text, i_t_end, i_dt, i_dt_out, i_max_events, i_method, &
-    i_events, i_title, events_none, events_impacts, i_f1_table, i_f2_table
+    i_events, i_title, events_none, events_impacts, i_f1_table, i_f2_table, name_len
   use impact1d_io, only: read_scene_file, prepare_scene, lower, read_body_list
   use impact1d_output, only: file_sink, events_path, class_impact, class_stick, class_slip, event_name, event_count, &
+    class_pair_stick, class_pair_slip, &
     check_bodies_out, row_ledger, final_row
   use impact1d_files, only: make_folders, resolve, write_text
   use impact1d_solver, only: run, run_stats
@@ -271,42 +272,63 @@ contains
   end function event_log_text
 
   !> The summary's events line: each row's impacts, rests, releases, then each body's sticks
-  !> and slips, by name; past max_named names (a long chain has thousands) each kind's total
-  !> and on how many rows or bodies, which a line can hold (the event log has the rest).
+  !> and slips, then each friction contact's (&friction), by name; past max_named names (a
+  !> long chain has thousands) each kind's total and on how many rows, bodies or contacts,
+  !> which a line can hold (the event log has the rest).
   subroutine events_line(line)
     character(len=:), allocatable, intent(out) :: line
     integer, parameter :: max_named = 16
-    character(len=*), parameter :: kinds(class_impact:class_slip) = &
-      [character(len=8) :: 'impacts', 'rests', 'releases', 'sticks', 'slips']
+    character(len=*), parameter :: kinds(class_impact:class_pair_slip) = &
+      [character(len=8) :: 'impacts', 'rests', 'releases', 'sticks', 'slips', 'sticks', 'slips']
+    character(len=*), parameter :: counted_on(class_impact:class_pair_slip) = [character(len=9) :: &
+      ' rows', ' rows', ' rows', ' bodies', ' bodies', ' contacts', ' contacts']
     integer :: c, k, named, total, on
     named = 0
-    do c = class_impact, class_slip
+    do c = class_impact, class_pair_slip
       do k = 1, entries(c)
-        if (event_count(stats, c, k) > 0) named = named + 1
+        if (event_count(stats, c, first(c) + k) > 0) named = named + 1
       end do
     end do
     line = ''
-    do c = class_impact, class_slip
+    do c = class_impact, class_pair_slip
       total = 0
       on = 0
       do k = 1, entries(c)
-        if (event_count(stats, c, k) == 0) cycle
-        if (named <= max_named) line = line // ' ' // trim(event_name(scene%row_name, c, k)) // ' ' // &
-          trim(fmt(event_count(stats, c, k)))
-        total = total + event_count(stats, c, k)
+        if (event_count(stats, c, first(c) + k) == 0) cycle
+        if (named <= max_named) line = line // ' ' // trim(event_name(row_names(c), c, first(c) + k)) // ' ' // &
+          trim(fmt(event_count(stats, c, first(c) + k)))
+        total = total + event_count(stats, c, first(c) + k)
         on = on + 1
       end do
       if (named > max_named .and. on > 0) line = line // ' ' // trim(kinds(c)) // ' ' // trim(fmt(total)) // &
-        ' on ' // trim(fmt(on)) // trim(merge(' rows  ', ' bodies', c < class_stick))
+        ' on ' // trim(fmt(on)) // trim(counted_on(c))
     end do
     if (len(line) == 0) line = ' none'
   end subroutine events_line
 
-  !> How many rows (impacts, rests, releases) or bodies (sticks, slips) an event class counts on.
+  !> How many rows (impacts, rests, releases), bodies (sticks, slips) or friction contacts
+  !> (theirs) an event class counts on.
   integer function entries(class)
     integer, intent(in) :: class
     entries = merge(scene%n_rows + scene%n_stops, scene%n_bodies, class < class_stick)
+    if (class >= class_pair_stick) entries = scene%n_frictions
   end function entries
+
+  !> The index before an event class's first (a friction contact's follow the rows).
+  integer function first(class)
+    integer, intent(in) :: class
+    first = 0
+    if (class >= class_pair_stick) first = scene%n_rows + scene%n_stops
+  end function first
+
+  !> The names an event class's events are named from (impact1d_output's event_name): the
+  !> rows', and the friction contacts' after them.
+  function row_names(class) result(names)
+    integer, intent(in) :: class
+    character(len=name_len), allocatable :: names(:)
+    names = scene%row_name
+    if (class >= class_pair_stick) names = [scene%row_name, scene%friction_name]
+  end function row_names
 
   !> The summary on stdout. Every number in ES with a three-digit exponent (7.73913E+157
   !> lost its E in ES12.5).

@@ -27,7 +27,7 @@ module impact1d_body_mode
   private
   public :: body_mode_type, mode_work_type, new_mode, solve_body_mode, same_mode, mode_solved
   public :: mode_reserve, gathered_mode, solve_cluster
-  public :: drive_accelerations, shift_to_drives, drive_components
+  public :: drive_accelerations, shift_to_drives, drive_components, relative_velocity
 
   integer, parameter :: mode_solved = cluster_solved   !< otherwise an impact1d_lcp status
   !> The largest cluster problem solved densely (rows + 2 bodies' unknowns): its matrices take
@@ -51,6 +51,12 @@ module impact1d_body_mode
     logical, allocatable :: engaged(:)
     !> Some row is held or some body stuck: conditions that forces can break.
     logical :: held = .false.
+    !> (nf) friction contacts between bodies (&friction): the direction of the relative
+    !> velocity v_b - v_a they slide in (the force -F sgn on b, +F sgn on a), 0 for none;
+    !> stuck: at relative rest, held there by static friction (its ends in one group).
+    !> Allocated by the first solve of a scene that has such contacts.
+    real(wp), allocatable :: friction_sgn(:)
+    logical, allocatable :: friction_stuck(:)
   contains
     procedure :: acceleration
     procedure :: rate_response
@@ -74,6 +80,8 @@ module impact1d_body_mode
     logical, allocatable :: candidate(:), active(:), stuck(:)
     integer, allocatable :: row_body(:, :)
     real(wp), allocatable :: row_normal(:, :)
+    !> (N) the force of the friction contacts that slide on each body (scenes with &friction)
+    real(wp), allocatable :: pair_force(:)
   end type mode_work_type
 
 contains
@@ -136,6 +144,8 @@ contains
   pure logical function same_mode(a, b)
     type(body_mode_type), intent(in) :: a, b
     same_mode = all(a%active .eqv. b%active) .and. all(a%stuck .eqv. b%stuck) .and. all(a%sgn == b%sgn)
+    if (same_mode .and. allocated(a%friction_sgn) .and. allocated(b%friction_sgn)) &
+      same_mode = all(a%friction_sgn == b%friction_sgn) .and. all(a%friction_stuck .eqv. b%friction_stuck)
   end function same_mode
 
   !> The mode at an instant: forces f and their rate df, velocities v, candidate rows (closed,
@@ -159,6 +169,7 @@ contains
       if (slip(scene, i, v(i)) /= 0.0_wp .and. scene%body_friction(i) > 0.0_wp) &
         mode%sgn(i) = sign(1.0_wp, slip(scene, i, v(i)))
     end do
+    if (scene%n_frictions > 0) call friction_directions(scene, work, v, mode)
     call partition(scene, work, v, candidate)
     do c = 1, scene%n_bodies
       if (.not. work%needs_solve(c)) cycle
@@ -175,6 +186,49 @@ contains
     call set_groups(scene, mode, work%root)
   end subroutine solve_body_mode
 
+  !> The friction contacts' sliding directions (the sign of their relative velocity; 0 at
+  !> relative rest, which the cluster solve decides) and the force of those that slide on
+  !> each body (work%pair_force, which the cluster solves add to the applied forces).
+  subroutine friction_directions(scene, work, v, mode)
+    type(scene_type), intent(in) :: scene
+    type(mode_work_type), intent(inout) :: work
+    real(wp), intent(in) :: v(:)
+    type(body_mode_type), intent(inout) :: mode
+    integer :: j
+    real(wp) :: u
+    if (.not. allocated(mode%friction_sgn)) allocate(mode%friction_sgn(scene%n_frictions), &
+      mode%friction_stuck(scene%n_frictions))
+    if (.not. allocated(work%pair_force)) allocate(work%pair_force(scene%n_bodies))
+    work%pair_force = 0.0_wp
+    do j = 1, scene%n_frictions
+      u = relative_velocity(scene, j, v)
+      mode%friction_stuck(j) = .false.
+      mode%friction_sgn(j) = 0.0_wp
+      if (u /= 0.0_wp) mode%friction_sgn(j) = sign(1.0_wp, u)
+      associate (a => scene%friction_body(1, j), b => scene%friction_body(2, j))
+        work%pair_force(b) = work%pair_force(b) - scene%friction_slide(j) * mode%friction_sgn(j)
+        work%pair_force(a) = work%pair_force(a) + scene%friction_slide(j) * mode%friction_sgn(j)
+      end associate
+    end do
+  end subroutine friction_directions
+
+  !> Whether friction contact j is at relative rest with static friction (its ends then in
+  !> one cluster, its stick the cluster solve's).
+  pure logical function resting_pair(scene, j, v)
+    type(scene_type), intent(in) :: scene
+    integer, intent(in) :: j
+    real(wp), intent(in) :: v(:)
+    resting_pair = relative_velocity(scene, j, v) == 0.0_wp .and. scene%friction_static(j) > 0.0_wp
+  end function resting_pair
+
+  !> Friction contact j's relative velocity v_b - v_a (or its acceleration, given a).
+  pure real(wp) function relative_velocity(scene, j, v)
+    type(scene_type), intent(in) :: scene
+    integer, intent(in) :: j
+    real(wp), intent(in) :: v(:)
+    relative_velocity = v(scene%friction_body(2, j)) - v(scene%friction_body(1, j))
+  end function relative_velocity
+
   !> The clusters (module header): bodies joined by candidate rows between bodies, listed by
   !> root (members in body order, rows in row order), and which need a solve.
   subroutine partition(scene, work, v, candidate)
@@ -190,6 +244,9 @@ contains
       if (candidate(k) .and. scene%row_body(1, k) > 0) joined = uf_join(work%root, scene%row_body(1, k), &
         scene%row_body(2, k))
     end do
+    do k = 1, scene%n_frictions
+      if (resting_pair(scene, k, v)) joined = uf_join(work%root, scene%friction_body(1, k), scene%friction_body(2, k))
+    end do
     work%needs_solve = .false.
     work%first = 0
     do i = 1, n
@@ -198,6 +255,9 @@ contains
       r = work%root(i)
       work%first(r + 1) = work%first(r + 1) + 1
       if (scene%body_static(i) > 0.0_wp .and. slip(scene, i, v(i)) == 0.0_wp) work%needs_solve(r) = .true.
+    end do
+    do k = 1, scene%n_frictions
+      if (resting_pair(scene, k, v)) work%needs_solve(work%root(scene%friction_body(1, k))) = .true.
     end do
     call bucket(work%first, work%member, work%root(1:n))
     work%first_row = 0
@@ -262,6 +322,7 @@ contains
       work%row_normal(1, j) = scene%row_normal(1, k)
       work%row_normal(2, j) = scene%row_normal(2, k)
     end do
+    if (scene%n_frictions > 0) call gather_pairs(scene, work, c, nb, nr, v)
     call gathered_mode(work, nb, nr, status)
     if (status /= cluster_solved) return
     do j = 1, nb
@@ -272,7 +333,64 @@ contains
     do j = 1, nr
       mode%active(work%row(work%first_row(c) + j - 1)) = work%active(j)
     end do
+    if (scene%n_frictions > 0) call scatter_pairs(scene, work, c, v, mode)
   end subroutine solve_cluster
+
+  !> Cluster c's friction contacts (&friction): the force of those that slide added to
+  !> their ends' applied forces, those at relative rest given to the dense solve as boxes
+  !> (impact1d_cluster_mode's pair_ inputs; O(nf) per cluster).
+  subroutine gather_pairs(scene, work, c, nb, nr, v)
+    type(scene_type), intent(in) :: scene
+    type(mode_work_type), intent(inout) :: work
+    integer, intent(in) :: c, nb, nr
+    real(wp), intent(in) :: v(:)
+    integer :: j, np
+    do j = 1, nb
+      work%force(j) = work%force(j) + work%pair_force(work%member(work%first(c) + j - 1))
+    end do
+    np = 0
+    do j = 1, scene%n_frictions
+      if (pair_of_cluster(scene, work, j, v, c)) np = np + 1
+    end do
+    call cluster_reserve(work%cluster, nb, max(nr, 1), np)
+    work%cluster%n_pairs = 0
+    do j = 1, scene%n_frictions
+      if (.not. pair_of_cluster(scene, work, j, v, c)) cycle
+      work%cluster%n_pairs = work%cluster%n_pairs + 1
+      associate (p => work%cluster%n_pairs)
+        work%cluster%pair_body(:, p) = work%local(scene%friction_body(:, j))
+        work%cluster%pair_static(p) = scene%friction_static(j)
+        work%cluster%pair_slide(p) = scene%friction_slide(j)
+      end associate
+    end do
+  end subroutine gather_pairs
+
+  !> Whether friction contact j is at relative rest in cluster c (partition's root).
+  logical function pair_of_cluster(scene, work, j, v, c)
+    type(scene_type), intent(in) :: scene
+    type(mode_work_type), intent(inout) :: work
+    integer, intent(in) :: j, c
+    real(wp), intent(in) :: v(:)
+    pair_of_cluster = resting_pair(scene, j, v)
+    if (pair_of_cluster) pair_of_cluster = uf_find(work%root, scene%friction_body(1, j)) == c
+  end function pair_of_cluster
+
+  !> Cluster c's friction contacts at relative rest: stuck, or the way they slide off.
+  subroutine scatter_pairs(scene, work, c, v, mode)
+    type(scene_type), intent(in) :: scene
+    type(mode_work_type), intent(inout) :: work
+    integer, intent(in) :: c
+    real(wp), intent(in) :: v(:)
+    type(body_mode_type), intent(inout) :: mode
+    integer :: j, p
+    p = 0
+    do j = 1, scene%n_frictions
+      if (.not. pair_of_cluster(scene, work, j, v, c)) cycle
+      p = p + 1
+      mode%friction_stuck(j) = work%cluster%pair_stuck(p)
+      mode%friction_sgn(j) = work%cluster%pair_sgn(p)
+    end do
+  end subroutine scatter_pairs
 
   !> The mode of the gathered problem of nb bodies and nr rows, every row a candidate (work's
   !> arrays; out: work%active, stuck, sgn): a path of rows by impact1d_path_mode, in O(nb);
@@ -283,7 +401,9 @@ contains
     integer, intent(in) :: nb, nr
     integer, intent(out) :: status
     work%candidate(1:nr) = .true.
-    if (.not. work%dense_only) then
+    ! (a cluster with friction contacts at relative rest takes the dense solve: the path
+    ! solve has no boxes on relative coordinates)
+    if (.not. work%dense_only .and. work%cluster%n_pairs == 0) then
       if (path_order(work%path, nb, work%row_body(:, 1:nr), work%row_normal(:, 1:nr))) then
         call path_mode(work%path, work%mass(1:nb), work%force(1:nb), work%rate(1:nb), work%friction(1:nb), &
           work%static(1:nb), work%velocity(1:nb), work%row_body(:, 1:nr), work%row_normal(:, 1:nr), &
@@ -403,13 +523,24 @@ contains
     do k = 1, scene%n_rows
       if (mode%active(k)) joined = uf_join(root, scene%row_body(1, k), scene%row_body(2, k))
     end do
+    do k = 1, scene%n_frictions
+      if (mode%friction_stuck(k)) joined = uf_join(root, scene%friction_body(1, k), scene%friction_body(2, k))
+    end do
     mode%group_mass = 0.0_wp
     do i = 1, scene%n_bodies
       mode%group(i) = uf_find(root, i)
       mode%group_mass(mode%group(i)) = mode%group_mass(mode%group(i)) + scene%body_mass(i)
     end do
     mode%f_slide = -scene%body_friction * mode%sgn
+    ! A friction contact sliding: -F sgn on b, its opposite on a.
+    do k = 1, scene%n_frictions
+      associate (a => scene%friction_body(1, k), b => scene%friction_body(2, k))
+        mode%f_slide(b) = mode%f_slide(b) - scene%friction_slide(k) * mode%friction_sgn(k)
+        mode%f_slide(a) = mode%f_slide(a) + scene%friction_slide(k) * mode%friction_sgn(k)
+      end associate
+    end do
     mode%held = any(mode%active) .or. any(mode%stuck)
+    if (scene%n_frictions > 0) mode%held = mode%held .or. any(mode%friction_stuck)
     if (scene%drives%n > 0) call drive_components(scene, mode%active, mode%drive)
   end subroutine set_groups
 

@@ -16,20 +16,22 @@ module impact1d_chain
     a_d_max, a_r_max, a_k_link, a_d_rest, a_c_link, r_a, r_b, r_d_min, r_r_min, r_d_max, r_r_max, r_k, r_d_rest, &
     r_c, contact_fields, spring_fields, r_name, n_contact_fields, n_spring_fields, written_array, text_item, &
     a_f_table, mechanism_records, n_sine_fields, sine_fields, r_body, r_amp, r_period, r_phase, r_stop_k, r_stop_c, &
-    r_ground_v, r_spring_ground_v, n_ground_fields, a_belt_v, a_v_s, a_c_v
+    r_ground_v, r_spring_ground_v, n_ground_fields, a_belt_v, a_v_s, a_c_v, n_friction_fields, friction_fields, &
+    r_mu, r_mus, r_normal, r_friction_name
   implicit none
   private
   public :: settle_chain, validate_chain, input_records, mechanism_records, n_bodies_of, slot_of, alias_slot
-  public :: id_arrays, id_r_meet, id_contact, id_spring, id_sine, id_bodies_out, n_ids, field_name, field_is_text, assign_number, &
+  public :: id_arrays, id_r_meet, id_contact, id_spring, id_sine, id_friction, id_bodies_out, n_ids, field_name, &
+    field_is_text, assign_number, &
     assign_text, scene_assignments
 
   !> The input fields' numbering (the namelist reader's and the flat API's): 1..n_real the
   !> tutorial's scalars, then its texts, the arrays (impact1d_fields' order), r_meet, the
-  !> &contact record fields, the &spring record fields, the &sine record fields, &run
-  !> bodies_out (element i: the i-th body written).
+  !> &contact record fields, the &spring record fields, the &sine record fields, the
+  !> &friction record fields, &run bodies_out (element i: the i-th body written).
   integer, parameter :: id_arrays = n_real + n_text, id_r_meet = id_arrays + n_arrays + 1, &
     id_contact = id_r_meet, id_spring = id_contact + n_contact_fields, id_sine = id_spring + n_spring_fields, &
-    id_bodies_out = id_sine + n_sine_fields + 1, n_ids = id_bodies_out
+    id_friction = id_sine + n_sine_fields, id_bodies_out = id_friction + n_friction_fields + 1, n_ids = id_bodies_out
 
 
   !> alias_slot(j, i) for i = 1, 2 (0: no such name), impact1d_fields' array order:
@@ -291,6 +293,8 @@ contains
     if (allocated(error)) return
     if (allocated(input%chain%sines)) call check_sines(input, error)
     if (allocated(error)) return
+    if (allocated(input%chain%frictions)) call check_frictions(input, error)
+    if (allocated(error)) return
     call wall_motion_terms(input, error)
     if (allocated(error)) return
     call input_records(input, records)
@@ -508,6 +512,63 @@ contains
       end associate
     end do
   end subroutine check_sines
+
+  !> Each &friction record: a, b, mu and normal given (mus optional: mu), each finite; a and
+  !> b two different bodies (friction against the ground is the body's own mu, mus: a
+  !> ground end is refused), mu and normal not negative, mus >= mu (static above sliding).
+  subroutine check_frictions(input, error)
+    type(scene_input), intent(in) :: input
+    type(error_type), allocatable, intent(inout) :: error
+    integer :: r, f
+    character(len=:), allocatable :: where
+    do r = 1, size(input%chain%frictions)
+      associate (rec => input%chain%frictions(r))
+        call record_place('&friction', rec, r, where)
+        do f = 1, r_normal
+          if (.not. rec%given(f) .and. f /= r_mus) then
+            call raise(error, status_input, where // trim(friction_fields(f)) // ' is required but not given ' // &
+              '(&friction a = 1, b = 2, mu = 0.3, mus = 0.4, normal = 9.81 /: mus may be left out)')
+          else if (rec%given(f) .and. .not. ieee_is_finite(rec%value(f))) then
+            call raise(error, status_input, where // trim(friction_fields(f)) // ' = ' // trim(fmt(rec%value(f))) // &
+              ' is not a finite number')
+          end if
+          if (allocated(error)) return
+        end do
+        call friction_ends(where, rec, n_bodies_of(input), error)
+        if (allocated(error)) return
+        call nonnegative_value(where // 'mu', rec%value(r_mu), error)
+        call nonnegative_value(where // 'normal', rec%value(r_normal), error)
+        if (allocated(error)) return
+        if (rec%given(r_mus) .and. rec%value(r_mus) < rec%value(r_mu)) call raise(error, status_input, where // &
+          'mus = ' // trim(fmt(rec%value(r_mus))) // ' is below mu = ' // trim(fmt(rec%value(r_mu))) // &
+          ': static friction is at least sliding friction')
+        if (allocated(error)) return
+      end associate
+    end do
+  end subroutine check_frictions
+
+  !> A &friction record's ends: two different bodies 1..n (not the ground).
+  subroutine friction_ends(where, rec, n, error)
+    character(len=*), intent(in) :: where
+    type(record_input), intent(in) :: rec
+    integer, intent(in) :: n
+    type(error_type), allocatable, intent(inout) :: error
+    integer :: e
+    do e = 1, 2
+      associate (body => rec%value(e))
+        if (body == 0.0_wp) then
+          call raise(error, status_input, where // trim(friction_fields(e)) // ' = 0 is the ground: friction ' // &
+            'against the ground is the body''s own mu and mus (&bodies)')
+        else if (body /= aint(body) .or. body < 1.0_wp .or. body > n) then
+          call raise(error, status_input, where // trim(friction_fields(e)) // ' = ' // trim(fmt(body)) // &
+            ' is not a body: the bodies are 1 to N = ' // trim(fmt(n)))
+        end if
+      end associate
+      if (allocated(error)) return
+    end do
+    if (rec%value(1) == rec%value(2)) call raise(error, status_input, where // 'a = b = ' // &
+      trim(fmt(rec%value(1))) // ': a friction contact is between two different bodies')
+  end subroutine friction_ends
 
   !> Name of field f of a &contact (contact true) or &spring record.
   pure function field_of(contact, f) result(name)
@@ -787,7 +848,32 @@ contains
     call element_records(input, n, records)
     call shrink(records)
     call sine_records(input, records)
+    call friction_records(input, records)
   end subroutine input_records
+
+  !> The &friction records in file order (mus = mu when not given; named 'friction<r>' when
+  !> not named).
+  pure subroutine friction_records(input, records)
+    type(scene_input), intent(in) :: input
+    type(mechanism_records), intent(inout) :: records
+    integer :: r, nf
+    nf = 0
+    if (allocated(input%chain%frictions)) nf = size(input%chain%frictions)
+    records%n_frictions = nf
+    allocate(records%friction_body(2, nf), records%friction_slide(nf), records%friction_static(nf), &
+      records%friction_name(nf))
+    do r = 1, nf
+      associate (rec => input%chain%frictions(r))
+        records%friction_body(:, r) = nint(rec%value(1:2))
+        records%friction_slide(r) = rec%value(r_mu) * rec%value(r_normal)
+        records%friction_static(r) = merge(rec%value(r_mus), rec%value(r_mu), rec%given(r_mus)) * rec%value(r_normal)
+        records%friction_name(r) = 'friction' // trim(fmt(r))
+        if (allocated(rec%name)) then
+          if (len_trim(rec%name) > 0) records%friction_name(r) = rec%name
+        end if
+      end associate
+    end do
+  end subroutine friction_records
 
   !> The &sine records in file order (phase 0 when not given).
   pure subroutine sine_records(input, records)
@@ -1011,8 +1097,10 @@ contains
       name = 'contact.' // contact_fields(id - id_contact)
     else if (id > id_spring .and. id <= id_sine) then
       name = 'spring.' // spring_fields(id - id_spring)
-    else if (id > id_sine .and. id < id_bodies_out) then
+    else if (id > id_sine .and. id <= id_friction) then
       name = 'sine.' // sine_fields(id - id_sine)
+    else if (id > id_friction .and. id < id_bodies_out) then
+      name = 'friction.' // friction_fields(id - id_friction)
     else if (id == id_bodies_out) then
       name = 'bodies_out'
     end if
@@ -1022,7 +1110,7 @@ contains
   pure logical function field_is_text(id)
     integer, intent(in) :: id
     field_is_text = (id > n_real .and. id <= id_arrays) .or. id == id_arrays + a_f_table .or. &
-      id == id_contact + r_name
+      id == id_contact + r_name .or. id == id_friction + r_friction_name
   end function field_is_text
 
   !> Field id := value: a scalar (index ignored), element index of an array, or the field
@@ -1045,8 +1133,10 @@ contains
       call set_record_field(input%chain%contacts, index, id - id_contact, value)
     else if (id > id_spring .and. id <= id_sine) then
       call set_record_field(input%chain%springs, index, id - id_spring, value)
-    else if (id > id_sine .and. id < id_bodies_out) then
+    else if (id > id_sine .and. id <= id_friction) then
       call set_record_field(input%chain%sines, index, id - id_sine, value)
+    else if (id > id_friction .and. id < id_bodies_out) then
+      call set_record_field(input%chain%frictions, index, id - id_friction, value)
     else if (id == id_bodies_out) then
       call set_body_out(input, index, value)
     end if
@@ -1096,6 +1186,10 @@ contains
       call grow_records(input%chain%contacts, index)
       input%chain%contacts(index)%name = text
       input%chain%contacts(index)%given(r_name) = .true.
+    else if (id == id_friction + r_friction_name) then
+      call grow_records(input%chain%frictions, index)
+      input%chain%frictions(index)%name = text
+      input%chain%frictions(index)%given(r_friction_name) = .true.
     end if
   end subroutine assign_text
 
@@ -1155,7 +1249,9 @@ contains
       if (id > id_arrays .and. id < id_r_meet) last = input%chain%array(id - id_arrays)%n
       if (id > id_contact .and. id <= id_spring .and. allocated(input%chain%contacts)) last = size(input%chain%contacts)
       if (id > id_spring .and. id <= id_sine .and. allocated(input%chain%springs)) last = size(input%chain%springs)
-      if (id > id_sine .and. id < id_bodies_out .and. allocated(input%chain%sines)) last = size(input%chain%sines)
+      if (id > id_sine .and. id <= id_friction .and. allocated(input%chain%sines)) last = size(input%chain%sines)
+      if (id > id_friction .and. id < id_bodies_out .and. allocated(input%chain%frictions)) &
+        last = size(input%chain%frictions)
       if (id == id_bodies_out .and. allocated(input%bodies_out)) last = size(input%bodies_out)
       if (id <= id_arrays .or. id == id_r_meet) then
         call put_field(input, id, 0, field, index, value, n_numbers, text_field, text_index, texts, n_texts)
@@ -1218,11 +1314,13 @@ contains
       given = input%chain%has_r_meet
       number = input%chain%r_meet
     else if (id <= id_spring) then
-      call record_value(input%chain%contacts(i), id - id_contact, given, number, text)
+      call record_value(input%chain%contacts(i), id - id_contact, r_name, given, number, text)
     else if (id <= id_sine) then
-      call record_value(input%chain%springs(i), id - id_spring, given, number, text)
+      call record_value(input%chain%springs(i), id - id_spring, 0, given, number, text)
+    else if (id <= id_friction) then
+      call record_value(input%chain%sines(i), id - id_sine, 0, given, number, text)
     else if (id < id_bodies_out) then
-      call record_value(input%chain%sines(i), id - id_sine, given, number, text)
+      call record_value(input%chain%frictions(i), id - id_friction, r_friction_name, given, number, text)
     else
       number = real(input%bodies_out(i), wp)
       given = .true.
@@ -1230,15 +1328,15 @@ contains
     if (field_is_text(id) .and. id /= id_arrays + a_f_table) given = len(text) > 0
   end subroutine field_value
 
-  !> Field f of a record.
-  subroutine record_value(rec, f, given, number, text)
+  !> Field f of a record whose name is field name_field (0: it has none).
+  subroutine record_value(rec, f, name_field, given, number, text)
     type(record_input), intent(in) :: rec
-    integer, intent(in) :: f
+    integer, intent(in) :: f, name_field
     logical, intent(out) :: given
     real(wp), intent(out) :: number
     character(len=:), allocatable, intent(inout) :: text
     given = rec%given(f)
     number = rec%value(f)
-    if (allocated(rec%name) .and. f == r_name) text = rec%name
+    if (allocated(rec%name) .and. f == name_field) text = rec%name
   end subroutine record_value
 end module impact1d_chain

@@ -57,27 +57,56 @@ module impact1d_cluster_mode
     integer, allocatable :: root(:)            !< (0:max_bodies) union-find parent; 0 is the ground
     logical, allocatable :: broken(:)          !< (max_bodies) at rest, broken away: bound c
     real(wp), allocatable :: group_mass(:), group_sum(:)   !< (0:max_bodies) per union-find root: sum m, sum m a
+    !> Friction contacts between two of the cluster's bodies at relative rest (&friction; the
+    !> caller sets n_pairs and the pair_ inputs, 0 by default): each a box on the relative
+    !> coordinate x_b - x_a (J = e_b - e_a), as a body's box is on x_i: the force on b within
+    !> [-static, static], its opposite on a, relative acceleration 0 inside the bound; broken
+    !> away, the bound is pair_slide. Out: pair_stuck, pair_sgn (the relative acceleration's
+    !> way when it slides: the force is -pair_slide pair_sgn on b).
+    integer :: max_pairs = 0, n_pairs = 0
+    integer, allocatable :: pair_body(:, :)    !< (2, max_pairs) local ends a, b
+    real(wp), allocatable :: pair_static(:), pair_slide(:), pair_sgn(:)   !< (max_pairs)
+    logical, allocatable :: pair_stuck(:)      !< (max_pairs)
+    real(wp), allocatable, private :: pair_beta(:)   !< (max_pairs) its bound in this solve
+    integer, allocatable, private :: pair_slot(:)    !< (max_pairs) its box slot (after the bodies'), else 0
+    logical, allocatable, private :: pair_broken(:)  !< (max_pairs) broken away: bound pair_slide
   end type cluster_work_type
 
 contains
 
-  !> Size the work for clusters of up to max_bodies bodies and max_rows rows.
-  subroutine cluster_reserve(work, max_bodies, max_rows)
+  !> Size the work for clusters of up to max_bodies bodies and max_rows rows (and max_pairs
+  !> friction contacts at relative rest, 0 when not given).
+  subroutine cluster_reserve(work, max_bodies, max_rows, max_pairs)
     type(cluster_work_type), intent(inout) :: work
     integer, intent(in) :: max_bodies, max_rows
-    integer :: s
+    integer, intent(in), optional :: max_pairs
+    integer :: s, np, mb, mr
+    np = 0
+    if (present(max_pairs)) np = max_pairs
+    if (np > work%max_pairs .or. .not. allocated(work%pair_body)) then
+      if (allocated(work%pair_body)) deallocate(work%pair_body, work%pair_static, work%pair_slide, work%pair_sgn, &
+        work%pair_stuck, work%pair_beta, work%pair_slot, work%pair_broken)
+      work%max_pairs = max(np, work%max_pairs)
+      allocate(work%pair_body(2, work%max_pairs), work%pair_static(work%max_pairs), work%pair_slide(work%max_pairs), &
+        work%pair_sgn(work%max_pairs), work%pair_stuck(work%max_pairs), work%pair_beta(work%max_pairs), &
+        work%pair_slot(work%max_pairs), work%pair_broken(work%max_pairs))
+      if (allocated(work%m)) deallocate(work%m)    ! (the matrix grows with the pairs' unknowns)
+    end if
     if (work%max_bodies >= max_bodies .and. work%max_rows >= max_rows .and. allocated(work%m)) return
-    if (allocated(work%m)) deallocate(work%m, work%q, work%dq, work%z, work%w, work%dz, work%dw, &
+    if (allocated(work%q)) deallocate(work%q, work%dq, work%z, work%w, work%dz, work%dw, &
       work%beta, work%base, work%da, work%row_var, work%slot, work%root, work%broken, &
       work%group_mass, work%group_sum)
-    s = max_rows + 2 * max_bodies
+    if (allocated(work%m)) deallocate(work%m)
+    mb = max(max_bodies, work%max_bodies)
+    mr = max(max_rows, work%max_rows)
+    s = mr + 2 * (mb + work%max_pairs)
     allocate(work%m(s, s), work%q(s), work%dq(s), work%z(s), work%w(s), work%dz(s), work%dw(s), &
-      work%beta(max_bodies), work%base(max_bodies), work%da(max_bodies), work%row_var(max_rows), &
-      work%slot(max_bodies), work%root(0:max_bodies), work%broken(max_bodies), &
-      work%group_mass(0:max_bodies), work%group_sum(0:max_bodies))
+      work%beta(mb), work%base(mb), work%da(mb), work%row_var(mr), &
+      work%slot(mb), work%root(0:mb), work%broken(mb), &
+      work%group_mass(0:mb), work%group_sum(0:mb))
     call lcp_reserve(work%lcp, s)
-    work%max_bodies = max_bodies
-    work%max_rows = max_rows
+    work%max_bodies = mb
+    work%max_rows = mr
   end subroutine cluster_reserve
 
   !> The mode of one cluster (module header). Bodies 1..n = size(mass) (the body arrays of
@@ -107,9 +136,11 @@ contains
     status = lcp_too_large
     if (n > work%max_bodies .or. size(candidate) > work%max_rows) return
     tol_f = rel_tol * (sum(abs(force(1:n))) + 2.0_wp * sum(static_friction(1:n))) + tiny(1.0_wp)
+    if (work%n_pairs > 0) tol_f = tol_f + rel_tol * 2.0_wp * sum(work%pair_static(1:work%n_pairs))
     tol_rate = rel_tol * sum(abs(rate(1:n)))
     work%broken(1:n) = .false.
-    do solves = 1, n + 1
+    if (work%n_pairs > 0) work%pair_broken(1:work%n_pairs) = .false.
+    do solves = 1, n + work%n_pairs + 1
       call build_lcp(work, mass, force, rate, friction, static_friction, velocity, row_body, row_normal, candidate)
       call lcp_solve(work%lcp, work%m(1:work%size, 1:work%size), work%q(1:work%size), work%z, work%w, &
         status, dq=work%dq(1:work%size))
@@ -117,10 +148,12 @@ contains
       call lcp_basis_values(work%lcp, work%dq(1:work%size), work%dz, work%dw)
       call accelerations(work, mass, rate, row_body, row_normal, candidate, acceleration)
       call break_away(work, mass, static_friction, velocity, acceleration, tol_f, tol_rate, more)
+      if (work%n_pairs > 0) call pairs_break_away(work, mass, acceleration, tol_f, tol_rate, more)
       if (.not. more) exit
     end do
     call mode_of(work, mass, friction, velocity, size(candidate), acceleration, tol_f, tol_rate, &
       stuck, sgn, contact_force, friction_force)
+    if (work%n_pairs > 0) call pairs_mode(work, mass, acceleration, tol_f, tol_rate)
     call hold_rows(work, mass, row_body, row_normal, candidate, contact_force, tol_f, tol_rate, &
       stuck, acceleration, active)
     status = cluster_solved
@@ -134,7 +167,7 @@ contains
     integer, intent(in) :: row_body(:, :)
     real(wp), intent(in) :: row_normal(:, :)
     logical, intent(in) :: candidate(:)
-    integer :: i, k, nc, nb, r
+    integer :: i, k, nc, nb, r, nbx
 
     nb = 0
     do i = 1, size(mass)
@@ -152,10 +185,12 @@ contains
       nb = nb + 1
       work%slot(i) = nb
     end do
+    nbx = nb
+    if (work%n_pairs > 0) call pair_slots(work, nbx)
     call row_coupling(mass, row_body, row_normal, candidate, work%row_var, nc, work%m)
     work%n_free_rows = nc
-    work%n_boxed = nb
-    work%size = nc + 2 * nb
+    work%n_boxed = nbx
+    work%size = nc + 2 * nbx
     associate (m => work%m, s => work%size)
       m(nc + 1:s, 1:s) = 0.0_wp
       m(1:nc, nc + 1:s) = 0.0_wp
@@ -168,11 +203,14 @@ contains
         r = work%slot(i)
         if (r == 0) cycle
         m(nc + r, nc + r) = 1.0_wp / mass(i)
-        m(nc + r, nc + nb + r) = 1.0_wp / mass(i)
-        m(nc + nb + r, nc + r) = -1.0_wp / mass(i)
+        m(nc + r, nc + nbx + r) = 1.0_wp / mass(i)
+        m(nc + nbx + r, nc + r) = -1.0_wp / mass(i)
         work%q(nc + r) = work%base(i) / mass(i)
         work%dq(nc + r) = rate(i) / mass(i)
-        work%q(nc + nb + r) = 2.0_wp * work%beta(i) / mass(i)
+        work%q(nc + nbx + r) = 2.0_wp * work%beta(i) / mass(i)
+      end do
+      do r = 1, work%n_pairs
+        if (work%pair_slot(r) > 0) call add_pair(work, r, mass, rate, row_body, row_normal, size(candidate))
       end do
     end associate
   end subroutine build_lcp
@@ -223,6 +261,15 @@ contains
         if (i == 0) cycle
         acceleration(i) = acceleration(i) + row_normal(e, k) * work%z(p)
         work%da(i) = work%da(i) + row_normal(e, k) * work%dz(p)
+      end do
+    end do
+    do k = 1, work%n_pairs
+      if (work%pair_slot(k) == 0) cycle
+      p = work%n_free_rows + work%pair_slot(k)
+      do e = 1, 2
+        i = work%pair_body(e, k)
+        acceleration(i) = acceleration(i) + pair_sign(e) * work%z(p)
+        work%da(i) = work%da(i) + pair_sign(e) * work%dz(p)
       end do
     end do
     acceleration(1:size(mass)) = acceleration(1:size(mass)) / mass
@@ -312,6 +359,9 @@ contains
     do i = 1, size(mass)
       if (stuck(i)) work%root(i) = 0
     end do
+    do k = 1, work%n_pairs
+      if (work%pair_stuck(k)) joined = uf_join(work%root, work%pair_body(1, k), work%pair_body(2, k))
+    end do
     active = .false.
     do pass = 1, 2
       do k = 1, size(candidate)
@@ -343,5 +393,137 @@ contains
       rigid_row = row_body(1, k) == 0 .or. row_body(2, k) == 0 .or. row_normal(1, k) == -row_normal(2, k)
     end function rigid_row
   end subroutine hold_rows
+
+  !> The coefficient of end e (1: a, 2: b) of a friction contact on its relative coordinate
+  !> x_b - x_a.
+  pure real(wp) function pair_sign(e)
+    integer, intent(in) :: e
+    pair_sign = merge(-1.0_wp, 1.0_wp, e == 1)
+  end function pair_sign
+
+  !> The friction contacts' boxes (cluster_work_type), numbered after the bodies' (nbx: the
+  !> boxes so far, then with the pairs'); each one's bound -beta on b and +beta on a moved
+  !> into base, as a body's is.
+  subroutine pair_slots(work, nbx)
+    type(cluster_work_type), intent(inout) :: work
+    integer, intent(inout) :: nbx
+    integer :: p
+    do p = 1, work%n_pairs
+      work%pair_slot(p) = 0
+      work%pair_beta(p) = merge(work%pair_slide(p), work%pair_static(p), work%pair_broken(p))
+      if (work%pair_beta(p) <= 0.0_wp) cycle     ! no friction (left): free
+      associate (ea => work%pair_body(1, p), eb => work%pair_body(2, p))
+        work%base(ea) = work%base(ea) + work%pair_beta(p)
+        work%base(eb) = work%base(eb) - work%pair_beta(p)
+      end associate
+      nbx = nbx + 1
+      work%pair_slot(p) = nbx
+    end do
+  end subroutine pair_slots
+
+  !> Friction contact p's box in the LCP (build_lcp's for a body, on J = e_b - e_a, D = J
+  !> M^-1 J): its rows (J . a^+ and (2 beta - rho) D), and its coupling J M^-1 J' with the
+  !> bodies' boxes, the other pairs' and the candidate rows that share an end.
+  subroutine add_pair(work, p, mass, rate, row_body, row_normal, n_rows)
+    type(cluster_work_type), intent(inout) :: work
+    integer, intent(in) :: p, row_body(:, :), n_rows
+    real(wp), intent(in) :: mass(:), rate(:), row_normal(:, :)
+    integer :: nc, nbx, r, e, i, p2, k, v
+    real(wp) :: d, coupling
+    nc = work%n_free_rows
+    nbx = (work%size - nc) / 2
+    r = nc + work%pair_slot(p)
+    d = 0.0_wp
+    work%q(r) = 0.0_wp
+    work%dq(r) = 0.0_wp
+    do e = 1, 2
+      i = work%pair_body(e, p)
+      d = d + 1.0_wp / mass(i)
+      work%q(r) = work%q(r) + pair_sign(e) * work%base(i) / mass(i)
+      work%dq(r) = work%dq(r) + pair_sign(e) * rate(i) / mass(i)
+      if (work%slot(i) > 0) then
+        work%m(r, nc + work%slot(i)) = pair_sign(e) / mass(i)
+        work%m(nc + work%slot(i), r) = pair_sign(e) / mass(i)
+      end if
+    end do
+    work%m(r, r) = d
+    work%m(r, r + nbx) = d
+    work%m(r + nbx, r) = -d
+    work%q(r + nbx) = 2.0_wp * work%pair_beta(p) * d
+    do p2 = 1, work%n_pairs
+      if (p2 == p .or. work%pair_slot(p2) == 0) cycle
+      coupling = 0.0_wp
+      do e = 1, 2
+        do v = 1, 2
+          i = work%pair_body(e, p)
+          if (work%pair_body(v, p2) == i) coupling = coupling + pair_sign(e) * pair_sign(v) / mass(i)
+        end do
+      end do
+      work%m(r, nc + work%pair_slot(p2)) = coupling
+    end do
+    do k = 1, n_rows
+      if (work%row_var(k) == 0) cycle
+      coupling = 0.0_wp
+      do e = 1, 2
+        do v = 1, 2
+          i = work%pair_body(e, p)
+          if (row_body(v, k) == i) coupling = coupling + pair_sign(e) * row_normal(v, k) / mass(i)
+        end do
+      end do
+      work%m(r, work%row_var(k)) = coupling
+      work%m(work%row_var(k), r) = coupling
+    end do
+  end subroutine add_pair
+
+  !> Friction contacts at relative rest that the last solve moves apart (relative
+  !> acceleration or its rate not zero) break away: bound pair_slide from now on. more: some did.
+  subroutine pairs_break_away(work, mass, acceleration, tol_f, tol_rate, more)
+    type(cluster_work_type), intent(inout) :: work
+    real(wp), intent(in) :: mass(:), acceleration(:), tol_f, tol_rate
+    logical, intent(inout) :: more
+    integer :: p
+    do p = 1, work%n_pairs
+      if (work%pair_static(p) <= 0.0_wp .or. work%pair_broken(p)) cycle
+      if (pair_still(work, p, mass, acceleration, tol_f, tol_rate)) cycle
+      work%pair_broken(p) = .true.
+      more = .true.
+    end do
+  end subroutine pairs_break_away
+
+  !> Whether friction contact p's relative acceleration and its rate are zero (in force
+  !> units of its reduced mass, within tol).
+  logical function pair_still(work, p, mass, acceleration, tol_f, tol_rate)
+    type(cluster_work_type), intent(in) :: work
+    integer, intent(in) :: p
+    real(wp), intent(in) :: mass(:), acceleration(:), tol_f, tol_rate
+    associate (ea => work%pair_body(1, p), eb => work%pair_body(2, p))
+      pair_still = still(1.0_wp / (1.0_wp / mass(ea) + 1.0_wp / mass(eb)), acceleration(eb) - acceleration(ea), &
+        work%da(eb) - work%da(ea), tol_f, tol_rate)
+    end associate
+  end function pair_still
+
+  !> The friction contacts' mode: stuck (their box holds the relative acceleration at 0), or
+  !> the way the relative acceleration (its rate at a tie) goes.
+  subroutine pairs_mode(work, mass, acceleration, tol_f, tol_rate)
+    type(cluster_work_type), intent(inout) :: work
+    real(wp), intent(in) :: mass(:), acceleration(:), tol_f, tol_rate
+    integer :: p
+    real(wp) :: rel
+    do p = 1, work%n_pairs
+      work%pair_stuck(p) = .false.
+      work%pair_sgn(p) = 0.0_wp
+      if (work%pair_static(p) <= 0.0_wp) cycle
+      if (pair_still(work, p, mass, acceleration, tol_f, tol_rate)) then
+        work%pair_stuck(p) = work%pair_slot(p) > 0
+        cycle
+      end if
+      associate (ea => work%pair_body(1, p), eb => work%pair_body(2, p))
+        rel = acceleration(eb) - acceleration(ea)
+        work%pair_sgn(p) = sign(1.0_wp, rel)
+        if (abs(rel) / (1.0_wp / mass(ea) + 1.0_wp / mass(eb)) <= tol_f) &
+          work%pair_sgn(p) = sign(1.0_wp, work%da(eb) - work%da(ea))
+      end associate
+    end do
+  end subroutine pairs_mode
 
 end module impact1d_cluster_mode

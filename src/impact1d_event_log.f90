@@ -6,7 +6,8 @@ module impact1d_event_log
   use impact1d_kinds, only: wp
   use impact1d_lanes, only: max_lanes
   use impact1d_scene, only: scene_type
-  use impact1d_output, only: sink_type, run_stats, class_rest, class_release, class_stick, class_slip, count_event
+  use impact1d_output, only: sink_type, run_stats, class_rest, class_release, class_stick, class_slip, count_event, &
+    class_pair_stick
   use impact1d_yardsticks, only: same_instant
   use impact1d_accumulation, only: cycle_history_type
   implicit none
@@ -76,6 +77,7 @@ contains
       ! N bodies: the event's own pair, the row's ends or (body, 0).
       ends = [index, 0]
       if (class /= class_stick .and. class /= class_slip) ends = scene%row_body(:, index)
+      if (class >= class_pair_stick) ends = scene%friction_body(:, index - size(scene%row_name))
       call pair_velocities(ends, v_before, v(1:2))
       call pair_velocities(ends, v_after, v(3:4))
       call sink%put_event(t, class, index, ends(1), ends(2), v)

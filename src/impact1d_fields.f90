@@ -1,6 +1,6 @@
 !> The scene as written for any number of bodies (issue 19, "Mechanisms as data"): the
 !> arrays of the chain shorthand (`m = 5*1.0`, `&link d_min = 4*0.25`), the repeatable
-!> `&contact`, `&spring` and `&sine` records, and the field table that says which group each name
+!> `&contact`, `&spring`, `&sine` and `&friction` records, and the field table that says which group each name
 !> belongs to and which tutorial name is an alias of which element (m1 -> m(1), k12 ->
 !> k_link(1)). The tutorial's n_real scalars stay in scene_input's slots; this is the rest.
 module impact1d_fields
@@ -13,6 +13,7 @@ module impact1d_fields
   public :: n_contact_fields, contact_fields, n_spring_fields, spring_fields, n_sine_fields, sine_fields
   public :: r_a, r_b, r_d_min, r_r_min, r_d_max, r_r_max, r_name, r_k, r_d_rest, r_c, r_stop_k, r_stop_c
   public :: r_body, r_amp, r_period, r_phase, r_ground_v, r_spring_ground_v, n_ground_fields
+  public :: n_friction_fields, friction_fields, r_mu, r_mus, r_normal, r_friction_name
   public :: name_len, text_item, written_array, record_input, chain_input, alias_name, mechanism_records, array_value
 
   !> Longest contact name a record may carry (names of events: '<name>', 'rest_<name>', ...).
@@ -64,6 +65,13 @@ module impact1d_fields
   integer, parameter :: r_body = 1, r_amp = 2, r_period = 3, r_phase = 4
   character(len=*), parameter :: sine_fields(n_sine_fields) = [character(len=6) :: &
     'body', 'amp', 'period', 'phase']
+  !> The fields of a &friction record: a friction contact between bodies a and b (on the
+  !> relative velocity v_b - v_a) under a given constant normal load `normal` (N), sliding
+  !> bound mu normal, static bound mus normal; `name` names its stick_/slip_ events.
+  integer, parameter :: n_friction_fields = 6
+  integer, parameter :: r_mu = 3, r_mus = 4, r_normal = 5, r_friction_name = 6
+  character(len=*), parameter :: friction_fields(n_friction_fields) = [character(len=6) :: &
+    'a', 'b', 'mu', 'mus', 'normal', 'name']
 
   !> One text, kept whole (an array of these, not of deferred-length strings: see
   !> impact1d_scene's scene_text).
@@ -94,7 +102,7 @@ module impact1d_fields
     type(written_array) :: array(n_arrays)
     real(wp) :: r_meet = 1.0_wp          !< &link r_meet: restitution where neighbours meet
     logical :: has_r_meet = .false.
-    type(record_input), allocatable :: contacts(:), springs(:), sines(:)
+    type(record_input), allocatable :: contacts(:), springs(:), sines(:), frictions(:)
   end type chain_input
 
   !> Contacts and elements as records, in the layout of the model's (scene_type, stage 2;
@@ -123,6 +131,10 @@ module impact1d_fields
     integer :: n_sines = 0                               !< the &sine records, in file order
     integer, allocatable :: sine_body(:)                 !< (ns) the body whose force it adds to
     real(wp), allocatable :: sine_amp(:), sine_period(:), sine_phase(:)   !< (ns) N, s, rad
+    integer :: n_frictions = 0                           !< the &friction records, in file order
+    integer, allocatable :: friction_body(:, :)          !< (2, nf) ends a < b, bodies
+    real(wp), allocatable :: friction_slide(:), friction_static(:)   !< (nf) mu normal, mus normal, N
+    character(len=name_len), allocatable :: friction_name(:)   !< (nf) 'friction1' unless named
   end type mechanism_records
 
 contains

@@ -10,18 +10,18 @@ module impact1d_io
     i_substeps, i_events
   use impact1d_forcing, only: table_type
   use impact1d_fields, only: n_arrays, array_names, array_groups, array_is_text, n_contact_fields, contact_fields, &
-    n_spring_fields, spring_fields, n_sine_fields, sine_fields, r_name, record_input, text_item, a_f_table
+    n_spring_fields, spring_fields, n_sine_fields, sine_fields, friction_fields, r_name, record_input, text_item, a_f_table
   use impact1d_chain, only: settle_chain, validate_chain, slot_of, mechanism_records, id_arrays, id_r_meet, &
-    id_contact, id_spring, id_sine, n_ids, n_bodies_of
+    id_contact, id_spring, id_sine, id_friction, n_ids, n_bodies_of
   use impact1d_files, only: check_input_file
   implicit none
   private
   public :: read_scene_file, prepare_scene, read_table, lower, read_body_list
 
-  character(len=*), parameter :: known_groups(11) = [character(len=7) :: &
-    'scene', 'bodies', 'walls', 'link', 'initial', 'forces', 'springs', 'run', 'contact', 'spring', 'sine']
+  character(len=*), parameter :: known_groups(12) = [character(len=8) :: &
+    'scene', 'bodies', 'walls', 'link', 'initial', 'forces', 'springs', 'run', 'contact', 'spring', 'sine', 'friction']
   !> The groups that may be given any number of times, each occurrence a record.
-  integer, parameter :: g_contact = 9, g_spring = 10, g_sine = 11, g_run = 8
+  integer, parameter :: g_contact = 9, g_spring = 10, g_sine = 11, g_friction = 12, g_run = 8
   !> Each group's variables: which group a name belongs to, and the message about a misspelt one.
   character(len=*), parameter :: group_variables(size(known_groups)) = [character(len=160) :: &
     'title', 'm1, m2, mu1, mu2, mus1, mus2, g', 'x_left, r_left, x_right, r_right, x_left_v, x_left_amp, ' // &
@@ -31,7 +31,8 @@ module impact1d_io
     't_end, dt, dt_out, method, zero_vel, max_rows, max_impulses, max_step_events, substeps, events, max_events, ' // &
     'bodies_out', &
     'a, b, d_min, r_min, d_max, r_max, name, k, c, ground_v, ground_amp, ground_period, ground_phase', &
-    'a, b, k, d_rest, c, ground_v, ground_amp, ground_period, ground_phase', 'body, amp, period, phase']
+    'a, b, k, d_rest, c, ground_v, ground_amp, ground_period, ground_phase', 'body, amp, period, phase', &
+    'a, b, mu, mus, normal, name']
 
   !> The tutorial's parameter files list these, in its Table 1 order; g is 10 there.
   integer, parameter :: dat_order(17) = [i_m1, i_m2, i_mu1, i_r_left, i_r_right, i_r_min, &
@@ -270,7 +271,7 @@ contains
     if (group == 0) then
       call raise(error, status_input, nml%path // ':' // trim(fmt(line)) // ': unknown group &' // name // &
         ' (groups: &scene &bodies &walls &link &initial &forces &springs &run, and as often as wanted ' // &
-        '&contact &spring &sine)')
+        '&contact &spring &sine &friction)')
     else if (group >= g_contact) then
       ! Each occurrence is a record of its own; "given twice" applies within it.
       call new_record(input, group, line)
@@ -454,7 +455,9 @@ contains
       call read_scalar(name, value, input%chain%r_meet, error)
       input%chain%has_r_meet = .true.
     else
-      if (field > id_sine) then
+      if (field > id_friction) then
+        call take_record_field(name, value, field - id_friction, input%chain%frictions, error)
+      else if (field > id_sine) then
         call take_record_field(name, value, field - id_sine, input%chain%sines, error)
       else if (field > id_spring) then
         call take_record_field(name, value, field - id_spring, input%chain%springs, error)
@@ -559,7 +562,7 @@ contains
     type(error_type), allocatable, intent(inout) :: error
     character(len=:), allocatable :: text
     associate (rec => records(size(records)))
-      if (f == r_name .and. name == 'name') then
+      if (name == 'name') then
         call read_text(name, value, text, error)
         if (allocated(error)) return
         rec%name = text
@@ -571,7 +574,7 @@ contains
     end associate
   end subroutine take_record_field
 
-  !> A record of group (&contact, &spring or &sine) opens at line.
+  !> A record of group (&contact, &spring, &sine or &friction) opens at line.
   pure subroutine new_record(input, group, line)
     type(scene_input), intent(inout) :: input
     integer, intent(in) :: group, line
@@ -579,8 +582,10 @@ contains
       call append_record(input%chain%contacts, line)
     else if (group == g_spring) then
       call append_record(input%chain%springs, line)
-    else
+    else if (group == g_sine) then
       call append_record(input%chain%sines, line)
+    else
+      call append_record(input%chain%frictions, line)
     end if
   end subroutine new_record
 
@@ -773,6 +778,9 @@ contains
       return
     else if (group == g_sine) then
       field_index = record_field(name, sine_fields, id_sine)
+      return
+    else if (group == g_friction) then
+      field_index = record_field(name, friction_fields, id_friction)
       return
     end if
     if (index(', ' // trim(group_variables(group)) // ',', ', ' // name // ',') > 0) then

@@ -9,7 +9,8 @@ module impact1d_nbody_event
   use impact1d_error, only: error_type, raise, status_simulation, fmt
   use impact1d_scene, only: scene_type
   use impact1d_state, only: state_type, add_compensated
-  use impact1d_output, only: sink_type, run_stats, class_impact, class_rest, class_stick, class_slip, class_release
+  use impact1d_output, only: sink_type, run_stats, class_impact, class_rest, class_stick, class_slip, class_release, &
+    class_pair_stick, class_pair_slip
   use impact1d_yardsticks, only: gap_rounding, velocity_rounding, time_rounding, energy_rounding, same_instant, &
     force_scale
   use impact1d_event_log, only: event_log_type, log_event
@@ -23,7 +24,8 @@ module impact1d_nbody_event
   use impact1d_body_mode, only: body_mode_type, mode_work_type, solve_body_mode, mode_solved, max_dense_unknowns, &
     drive_accelerations, shift_to_drives, drive_components, solve_cluster
   use impact1d_nbody_step, only: nbody_force, nbody_rate, row_gap, row_velocity, row_gap_tolerance, &
-    found_row, found_body, found_stop, mode_acceleration, ground_motion, stop_gap_band, stop_force_band
+    found_row, found_body, found_stop, mode_acceleration, ground_motion, stop_gap_band, stop_force_band, &
+    found_friction
   implicit none
   private
   public :: point_work_type, new_point_work, nbody_event_point
@@ -90,7 +92,8 @@ contains
     allocate(work%closed_rows(max(scene%n_rows, 1)), work%local(0:scene%n_bodies))
     work%local = 0
     work%any_rigid = any(scene%row_partner > 0)
-    work%frictionless = all(scene%body_static == 0.0_wp) .and. all(scene%body_friction == 0.0_wp)
+    work%frictionless = all(scene%body_static == 0.0_wp) .and. all(scene%body_friction == 0.0_wp) .and. &
+      scene%n_frictions == 0
     if (allocated(work%mode_bodies)) deallocate(work%mode_bodies, work%mode_rows)
     allocate(work%mode_bodies(scene%n_bodies), work%mode_rows(max(scene%n_rows, 1)))
     work%mode_tracked = .false.
@@ -115,6 +118,7 @@ contains
     type(error_type), allocatable, intent(inout) :: error
     real(wp), dimension(scene%n_bodies) :: f, df, acc, entry_scale
     logical :: closed(scene%n_rows), candidate(scene%n_rows), hit(scene%n_rows), stopped(scene%n_bodies)
+    logical :: pair_was_stuck(scene%n_frictions)
     integer :: k, i, p, status
 
     if (initial) call first_point(scene, mode, work)
@@ -144,6 +148,7 @@ contains
         .and. index == i) .or. abs(slip(scene, i, s%v(i))) <= velocity_rounding * abs(acc(i)) * scene%dt)
       if (stopped(i)) call zero_velocity(scene, s, i)
     end do
+    if (found == found_friction) call relative_rest(scene, mode, index, s)
     call lock_rigid(scene, closed, stopped, s, work, sink, stats)
     call impacts(scene, closed, entry_scale, acc, s, work, hit, sink, stats, error)
     if (allocated(error)) return
@@ -162,7 +167,9 @@ contains
       k = work%closed_rows(p)
       candidate(k) = abs(row_velocity(scene, k, s%v, s%t)) <= u_tolerance(scene, k, s%v, acc, entry_scale)
     end do
-    ! (solved in place: the old mode is not read past here, and a failed solve ends the run)
+    ! (solved in place: the old mode is not read past here but for its friction contacts'
+    ! stuck flags, kept for the log; a failed solve ends the run)
+    if (scene%n_frictions > 0 .and. .not. initial) pair_was_stuck = mode%friction_stuck
     if (initial .or. .not. work%frictionless .or. scene%drives%n > 0) then
       call solve_mode_at(scene, work%mode, s%t, f, df, s%v, candidate, mode, status)
       work%mode_tracked = .false.
@@ -181,6 +188,7 @@ contains
       return
     end if
     call log_mode_change(scene, initial, f, df, candidate, mode, s, event_log, sink, stats)
+    if (scene%n_frictions > 0 .and. .not. initial) call log_pairs(scene, pair_was_stuck, mode, s, sink, stats)
   end subroutine nbody_event_point
 
   !> The compliant stops at this instant (docs/method.md section 10; impact1d_event_point's
@@ -1016,7 +1024,8 @@ contains
     integer :: e, status
     a_gap = 0.0_wp
     a_end = 0.0_wp
-    scoped = scene%drives%n == 0
+    ! (friction contacts between bodies join clusters the rows' incidence lists do not see)
+    scoped = scene%drives%n == 0 .and. scene%n_frictions == 0
     if (.not. scoped) return
     do e = 1, 2
       if (scene%row_body(e, k) == 0) cycle
@@ -1321,6 +1330,64 @@ contains
     s%v(i) = rest_velocity(scene, i)
     s%v_lo(i) = 0.0_wp
   end subroutine zero_velocity
+
+  !> The friction contacts between bodies that stick ('stick_<name>': stuck in the new mode,
+  !> not in the old) or slip ('slip_<name>': stuck in the old, not in the new).
+  subroutine log_pairs(scene, was_stuck, new, s, sink, stats)
+    type(scene_type), intent(in) :: scene
+    logical, intent(in) :: was_stuck(:)
+    type(body_mode_type), intent(in) :: new
+    type(state_type), intent(in) :: s
+    class(sink_type), intent(inout) :: sink
+    type(run_stats), intent(inout) :: stats
+    integer :: j
+    do j = 1, scene%n_frictions
+      if (new%friction_stuck(j) .eqv. was_stuck(j)) cycle
+      call log_event(scene, sink, stats, s%t, merge(class_pair_stick, class_pair_slip, new%friction_stuck(j)), &
+        size(scene%row_name) + j, s%v, s%v)
+    end do
+  end subroutine log_pairs
+
+  !> Friction contact j's ends, with the bodies the mode moves with each (their groups),
+  !> given one velocity at its located relative stop: their common one (momentum kept), or
+  !> that of an end held still; the kinetic energy of the rounding left is friction's.
+  pure subroutine relative_rest(scene, mode, j, s)
+    type(scene_type), intent(in) :: scene
+    type(body_mode_type), intent(in) :: mode
+    integer, intent(in) :: j
+    type(state_type), intent(inout) :: s
+    real(wp) :: v, momentum, mass, before
+    integer :: i, ga, gb
+    ga = mode%group(scene%friction_body(1, j))
+    gb = mode%group(scene%friction_body(2, j))
+    momentum = 0.0_wp
+    mass = 0.0_wp
+    before = 0.0_wp
+    do i = 1, scene%n_bodies
+      if (.not. moved(i)) cycle
+      momentum = momentum + scene%body_mass(i) * s%v(i)
+      mass = mass + scene%body_mass(i)
+      before = before + 0.5_wp * scene%body_mass(i) * s%v(i)**2
+    end do
+    v = 0.0_wp
+    if (mass > 0.0_wp) v = momentum / mass
+    if (ga == 0) v = s%v(scene%friction_body(1, j))
+    if (gb == 0) v = s%v(scene%friction_body(2, j))
+    call add_compensated(s%friction_loss, s%friction_lo, before - 0.5_wp * mass * v**2)
+    do i = 1, scene%n_bodies
+      if (.not. moved(i)) cycle
+      s%v(i) = v
+      s%v_lo(i) = 0.0_wp
+    end do
+
+  contains
+
+    !> Whether body i moves with an end of the contact (not held still).
+    pure logical function moved(i)
+      integer, intent(in) :: i
+      moved = mode%group(i) /= 0 .and. (mode%group(i) == ga .or. mode%group(i) == gb)
+    end function moved
+  end subroutine relative_rest
 
   !> Kinetic energy of the bodies at velocities v.
   pure real(wp) function kinetic(scene, v)

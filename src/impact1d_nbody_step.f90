@@ -12,18 +12,20 @@ module impact1d_nbody_step
   use impact1d_elements, only: add_element_forces, add_moving_element_forces, add_element_rates, element_damping_power, &
     element_drive_power, add_stop_forces, add_stop_rates, stop_damping_power, stop_release_loss, stop_drive_power
   use impact1d_body_mode, only: body_mode_type, mode_work_type, solve_body_mode, same_mode, mode_solved, &
-    drive_accelerations, shift_to_drives
+    drive_accelerations, shift_to_drives, relative_velocity
   use impact1d_friction_laws, only: slip, add_stribeck_forces, law_powers
   implicit none
   private
   public :: nbody_force, nbody_rate, nbody_step, row_gap, row_velocity, row_gap_tolerance, locate_nbody, &
     refine_nbody, gaps_hold, mode_acceleration, ground_motion
-  public :: found_none, found_row, found_body, found_hold, found_stop, stop_gap_band, stop_force_band
+  public :: found_none, found_row, found_body, found_hold, found_stop, found_friction, stop_gap_band, stop_force_band
 
   !> What a location found: a row's gap closing (a compliant stop's too: its engagement), a
   !> sliding body stopping, the mode failing, a compliant stop's force crossing zero (its
-  !> release, or its engagement again while still inside).
-  integer, parameter :: found_none = 0, found_row = 1, found_body = 2, found_hold = 3, found_stop = 4
+  !> release, or its engagement again while still inside), a friction contact between bodies
+  !> (&friction) coming to relative rest.
+  integer, parameter :: found_none = 0, found_row = 1, found_body = 2, found_hold = 3, found_stop = 4, &
+    found_friction = 5
 
 contains
 
@@ -428,6 +430,7 @@ contains
       end if
     end do
     if (scene%n_stops > 0) call locate_stops(scene, mode, a, c, step, acc0, acc_rounding, theta, found, index)
+    if (scene%n_frictions > 0) call relative_stops(scene, mode, a, b, step, c, polynomial, acc0, theta, found, index)
     if (mode%held .and. (scene%forcing%varies .or. scene%springs%present .or. .not. scene%drives%polynomial &
         .or. scene%stribeck)) &
       call mode_crossing(scene, mode, work, a, c, min(theta, step), theta, found)
@@ -521,6 +524,50 @@ contains
       scene%row_c(r) * abs(row_velocity(scene, r, s%v, s%t))) + tiny(1.0_wp)
   end function stop_force_band
 
+  !> The earliest relative stop of a friction contact between bodies that slides (its
+  !> relative velocity on the dense output c reaching 0), located as a body's stop is;
+  !> theta, found (found_friction) and index (the contact) updated when earlier.
+  subroutine relative_stops(scene, mode, a, b, step, c, polynomial, acc0, theta, found, index)
+    type(scene_type), intent(in) :: scene
+    type(body_mode_type), intent(in) :: mode
+    type(state_type), intent(in) :: a, b
+    real(wp), intent(in) :: step, c(:, :), acc0(:)
+    logical, intent(in) :: polynomial
+    real(wp), intent(inout) :: theta
+    integer, intent(inout) :: found, index
+    real(wp) :: p(0:3), q(0:3), candidate, u0, u1
+    integer :: j
+    do j = 1, scene%n_frictions
+      if (mode%friction_sgn(j) == 0.0_wp) cycle
+      associate (ea => scene%friction_body(1, j), eb => scene%friction_body(2, j), sgn => mode%friction_sgn(j))
+        p = sgn * [c(1, eb) - c(1, ea), 2.0_wp * (c(2, eb) - c(2, ea)), 3.0_wp * (c(3, eb) - c(3, ea)), 0.0_wp]
+        u0 = relative_velocity(scene, j, a%v)
+        u1 = relative_velocity(scene, j, b%v)
+        q = [velocity_rounding * max(abs(a%v(ea)) + abs(a%v(eb)), abs(b%v(ea)) + abs(b%v(eb)), abs(u1 - u0)), &
+          0.0_wp, 0.0_wp, 0.0_wp]
+        if (.not. polynomial) q(1) = q(1) + abs(p(1) - sgn * relative_velocity(scene, j, acc0))
+      end associate
+      candidate = earliest_crossing(p, step, q)
+      if (candidate < theta) then
+        theta = candidate
+        found = found_friction
+        index = j
+      end if
+    end do
+  end subroutine relative_stops
+
+  !> v with the ends of each stuck friction contact at one velocity (a's), as the mode moves
+  !> them: the dense output's rounding is no relative slip.
+  pure subroutine hold_pairs(scene, mode, v)
+    type(scene_type), intent(in) :: scene
+    type(body_mode_type), intent(in) :: mode
+    real(wp), intent(inout) :: v(:)
+    integer :: j
+    do j = 1, scene%n_frictions
+      if (mode%friction_stuck(j)) v(scene%friction_body(2, j)) = v(scene%friction_body(1, j))
+    end do
+  end subroutine hold_pairs
+
   !> The first instant in (0, until] at which the mode no longer holds (the mode solved anew
   !> with its held rows as the candidates differs), by bisection on the dense output c of
   !> the step from a: theta and found updated when there is one.
@@ -562,6 +609,7 @@ contains
       if (scene%belts) then
         where (mode%stuck) v = scene%body_belt
       end if
+      if (scene%n_frictions > 0) call hold_pairs(scene, mode, v)
       call nbody_force(scene, a%t + tau, a%x, dx, v, f, mode%engaged)
       call nbody_rate(scene, a%t + tau, v, df, mode%engaged)
       if (scene%drives%n > 0) call shift_to_drives(scene, a%t + tau, mode%active, f, df)
@@ -605,8 +653,32 @@ contains
       do k = 1, scene%n_rows
         if (mode%active(k) .and. .not. probe%active(k)) against = against .or. row_velocity(scene, k, acc) < 0.0_wp
       end do
+      if (scene%n_frictions > 0) call pairs_against(probe, lead, against)
       begun = begun .or. .not. against
     end function begun
+
+    !> begun's test for the friction contacts that break away (stuck in the mode, not in the
+    !> probe): each, at its static bound the way the probe slides it, must have its ends'
+    !> groups accelerate apart that way (lead: the probe's group loads, at sliding bounds).
+    subroutine pairs_against(probe, lead, against)
+      type(body_mode_type), intent(in) :: probe
+      real(wp), intent(inout) :: lead(0:)
+      logical, intent(inout) :: against
+      integer :: k
+      real(wp) :: rel
+      do k = 1, scene%n_frictions
+        if (.not. mode%friction_stuck(k) .or. probe%friction_stuck(k) .or. probe%friction_sgn(k) == 0.0_wp) cycle
+        associate (ga => probe%group(scene%friction_body(1, k)), gb => probe%group(scene%friction_body(2, k)), &
+            extra => (scene%friction_static(k) - scene%friction_slide(k)) * probe%friction_sgn(k))
+          lead(gb) = lead(gb) - extra
+          lead(ga) = lead(ga) + extra
+          rel = 0.0_wp
+          if (gb > 0) rel = lead(gb) / probe%group_mass(gb)
+          if (ga > 0) rel = rel - lead(ga) / probe%group_mass(ga)
+          against = against .or. probe%friction_sgn(k) * rel < 0.0_wp
+        end associate
+      end do
+    end subroutine pairs_against
   end subroutine mode_crossing
 
   !> Re-take the step to the located time and polish it by Newton's method on the watched
@@ -678,6 +750,13 @@ contains
       if (scene%body_static(i) == 0.0_wp .or. mode%sgn(i) == 0.0_wp) cycle
       if (mode%sgn(i) * slip(scene, i, b%v(i)) < -velocity_rounding * max(abs(s%v(i)), abs(b%v(i)), &
           abs(b%v(i) - s%v(i)))) gaps_hold = .false.
+    end do
+    do k = 1, scene%n_frictions
+      if (mode%friction_sgn(k) == 0.0_wp) cycle
+      associate (ea => scene%friction_body(1, k), eb => scene%friction_body(2, k))
+        if (mode%friction_sgn(k) * relative_velocity(scene, k, b%v) < -velocity_rounding * &
+          max(abs(s%v(ea)) + abs(s%v(eb)), abs(b%v(ea)) + abs(b%v(eb)))) gaps_hold = .false.
+      end associate
     end do
 
   contains

@@ -10,7 +10,8 @@ module impact1d_output
   use impact1d_scene, only: scene_input, real_names, n_real, i_title, i_method, i_g, i_dt_out, &
     events_all, events_impacts, events_none, events_kept, name_len, &
     i_dt, default_gravity, i_m2, springs_named, is_nbody, ground_named
-  use impact1d_fields, only: n_contact_fields, contact_fields, spring_fields, sine_fields, r_name, record_input, &
+  use impact1d_fields, only: n_contact_fields, contact_fields, spring_fields, sine_fields, friction_fields, &
+    r_friction_name, r_name, record_input, &
     n_arrays, array_names, array_is_text
   use impact1d_files, only: output_target, make_temporary, resolve_output, lock_folders, unlock_folders, write_text, &
     lock_timed_out, lock_wait
@@ -19,6 +20,7 @@ module impact1d_output
   public :: sink_type, memory_sink, summary_sink, file_sink, n_columns, column_names, n_event_kinds, event_names
   public :: event_impact, event_rest, event_release, event_stick, event_slip, run_stats, checkpoint
   public :: class_impact, class_rest, class_release, class_stick, class_slip, event_name, start_counts, &
+    class_pair_stick, class_pair_slip, &
     count_event, event_count, impacts_on
   public :: emit_sample, emit_bodies, events_path, present_columns, i_pe, i_work, i_friction_loss, i_impact_loss, &
     i_damping_loss, i_drive_work, row_length, row_columns, column_word, bodies_of, row_ledger, check_bodies_out, final_row
@@ -39,11 +41,14 @@ module impact1d_output
   !> Events are (class, index): an impact, rest or release of row index, a stick or slip of
   !> body index; each carries the velocities of a pair of bodies (a, b; 0: none), before and
   !> after: [v_a-, v_b-, v_a+, v_b+] (docs/nbody-plan.md, "The event record"). Named
-  !> '<row>', 'rest_<row>', 'release_<row>' (the row's name), 'stick<i>', 'slip<i>'.
+  !> '<row>', 'rest_<row>', 'release_<row>' (the row's name), 'stick<i>', 'slip<i>'; a
+  !> friction contact between bodies (&friction j) sticks or slips as (class_pair_stick or
+  !> class_pair_slip, n_rows + j), named 'stick_<name>', 'slip_<name>' (the sink's row_names
+  !> then hold the contacts' names after the rows').
   integer, parameter :: class_impact = 1, class_rest = 2, class_release = 3, class_stick = 4, &
-    class_slip = 5
-  character(len=*), parameter :: class_prefix(5) = [character(len=8) :: '', 'rest_', 'release_', &
-    'stick', 'slip']
+    class_slip = 5, class_pair_stick = 6, class_pair_slip = 7
+  character(len=*), parameter :: class_prefix(7) = [character(len=8) :: '', 'rest_', 'release_', &
+    'stick', 'slip', 'stick_', 'slip_']
   !> Longest event name: a prefix and a row's name.
   integer, parameter :: event_name_len = 8 + name_len
   !> The event kinds of the tutorial's scenes (its walls and slot, one or two bodies), for
@@ -61,9 +66,10 @@ module impact1d_output
   type :: run_stats
     integer(int64) :: steps = 0
     !> Events counted: every one, per row (impacts, rests, releases: (3, nr)) and per body
-    !> (sticks, slips: (2, N)); start_counts allocates them.
+    !> (sticks, slips: (2, N)) and per friction contact (its sticks, slips: (2, nf), the
+    !> contact j's events at index nr + j); start_counts allocates them.
     integer :: n_events = 0
-    integer, allocatable :: row_events(:, :), body_events(:, :)
+    integer, allocatable :: row_events(:, :), body_events(:, :), pair_events(:, :)
     real(wp) :: last_row(n_columns) = 0.0_wp
     !> An N-body run's last full row (emit_bodies; row_length(N) long), in place of last_row.
     real(wp), allocatable :: row(:)
@@ -483,7 +489,7 @@ contains
     integer, intent(in) :: class, index
     character(len=event_name_len) :: name     ! blank padded: callers trim
     character(len=12) :: body
-    if (class >= class_stick) then
+    if (class == class_stick .or. class == class_slip) then
       write(body, '(i0)') index
       name = trim(class_prefix(class)) // body
     else
@@ -492,10 +498,16 @@ contains
   end function event_name
 
   !> Counts for a run of n_rows rows and n_bodies bodies, none yet.
-  pure subroutine start_counts(stats, n_rows, n_bodies)
+  pure subroutine start_counts(stats, n_rows, n_bodies, n_pairs)
     type(run_stats), intent(inout) :: stats
     integer, intent(in) :: n_rows, n_bodies
-    allocate(stats%row_events(class_impact:class_release, n_rows), stats%body_events(class_stick:class_slip, n_bodies))
+    integer, intent(in), optional :: n_pairs     !< friction contacts between bodies (none: 0)
+    integer :: np
+    np = 0
+    if (present(n_pairs)) np = n_pairs
+    allocate(stats%row_events(class_impact:class_release, n_rows), stats%body_events(class_stick:class_slip, n_bodies), &
+      stats%pair_events(class_pair_stick:class_pair_slip, np))
+    stats%pair_events = 0
     stats%row_events = 0
     stats%body_events = 0
     stats%n_events = 0
@@ -505,7 +517,11 @@ contains
   pure subroutine count_event(stats, class, index)
     type(run_stats), intent(inout) :: stats
     integer, intent(in) :: class, index
-    if (class >= class_stick) then
+    if (class >= class_pair_stick) then
+      associate (j => index - size(stats%row_events, 2))
+        stats%pair_events(class, j) = stats%pair_events(class, j) + 1
+      end associate
+    else if (class >= class_stick) then
       stats%body_events(class, index) = stats%body_events(class, index) + 1
     else
       stats%row_events(class, index) = stats%row_events(class, index) + 1
@@ -517,7 +533,9 @@ contains
   pure integer function event_count(stats, class, index)
     type(run_stats), intent(in) :: stats
     integer, intent(in) :: class, index
-    if (class >= class_stick) then
+    if (class >= class_pair_stick) then
+      event_count = stats%pair_events(class, index - size(stats%row_events, 2))
+    else if (class >= class_stick) then
       event_count = stats%body_events(class, index)
     else
       event_count = stats%row_events(class, index)
@@ -888,47 +906,39 @@ contains
     end do
   end subroutine put_arrays
 
-  !> The scene's &contact, &spring and &sine records in the header, a line per given field in
-  !> the form of the others ('# contact.2.d_min = 0.5', '# spring.1.k = 40.0', '# sine.1.amp
-  !> = 2.0'), so that a reader rebuilds the scene (impact1d.read_output: Scene.contacts,
-  !> springs, sines).
+  !> The scene's &contact, &spring, &sine and &friction records in the header, a line per
+  !> given field in the form of the others ('# contact.2.d_min = 0.5', '# spring.1.k = 40.0',
+  !> '# sine.1.amp = 2.0', '# friction.1.name = pad'), so that a reader rebuilds the scene
+  !> (impact1d.read_output: Scene.contacts, springs, sines, frictions).
   subroutine put_records(self, input)
     class(file_sink), intent(inout) :: self
     type(scene_input), intent(in) :: input
-    integer :: r, f
-    character(len=32) :: key
-    if (allocated(input%chain%contacts)) then
-      do r = 1, size(input%chain%contacts)
-        associate (rec => input%chain%contacts(r))
-          do f = 1, n_contact_fields
-            write(key, '("contact.", i0, ".", a)') r, trim(contact_fields(f))
-            if (f /= r_name .and. rec%given(f)) call self%put_line(self%unit, '# ' // trim(key) // ' = ' // &
-              trim(fmt(rec%value(f))))
-          end do
-          if (allocated(rec%name)) then
-            write(key, '("contact.", i0, ".name")') r
-            if (len_trim(rec%name) > 0) call self%put_line(self%unit, '# ' // trim(key) // ' = ' // rec%name)
-          end if
-        end associate
-      end do
-    end if
-    if (allocated(input%chain%springs)) call put_numeric_records(self, 'spring', spring_fields, input%chain%springs)
-    if (allocated(input%chain%sines)) call put_numeric_records(self, 'sine', sine_fields, input%chain%sines)
+    if (allocated(input%chain%contacts)) call put_numeric_records(self, 'contact', contact_fields, &
+      input%chain%contacts, r_name)
+    if (allocated(input%chain%springs)) call put_numeric_records(self, 'spring', spring_fields, input%chain%springs, 0)
+    if (allocated(input%chain%sines)) call put_numeric_records(self, 'sine', sine_fields, input%chain%sines, 0)
+    if (allocated(input%chain%frictions)) call put_numeric_records(self, 'friction', friction_fields, &
+      input%chain%frictions, r_friction_name)
   end subroutine put_records
 
-  !> Records of numbers only, a line per given field ('# group.r.field = value').
-  subroutine put_numeric_records(self, group, fields, records)
+  !> Records, a line per given field ('# group.r.field = value'); field name_field (0: none)
+  !> is the record's name, written when not blank.
+  subroutine put_numeric_records(self, group, fields, records, name_field)
     class(file_sink), intent(inout) :: self
     character(len=*), intent(in) :: group, fields(:)
     type(record_input), intent(in) :: records(:)
+    integer, intent(in) :: name_field
     integer :: r, f
     character(len=32) :: key
     do r = 1, size(records)
       do f = 1, size(fields)
         write(key, '(a, ".", i0, ".", a)') group, r, trim(fields(f))
-        if (records(r)%given(f)) call self%put_line(self%unit, '# ' // trim(key) // ' = ' // &
+        if (f /= name_field .and. records(r)%given(f)) call self%put_line(self%unit, '# ' // trim(key) // ' = ' // &
           trim(fmt(records(r)%value(f))))
       end do
+      if (name_field == 0 .or. .not. allocated(records(r)%name)) cycle
+      write(key, '(a, ".", i0, ".name")') group, r
+      if (len_trim(records(r)%name) > 0) call self%put_line(self%unit, '# ' // trim(key) // ' = ' // records(r)%name)
     end do
   end subroutine put_numeric_records
 

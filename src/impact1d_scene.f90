@@ -152,6 +152,14 @@ module impact1d_scene
     real(wp), allocatable :: body_belt(:)            !< (N) its friction surface's velocity, m/s
     real(wp), allocatable :: body_v_s(:)             !< (N) Stribeck velocity, m/s (0: none)
     real(wp), allocatable :: body_viscous(:)         !< (N) viscous friction c_v m g, N s/m
+    ! friction contacts between two bodies (&friction records; docs/method.md section 13),
+    ! on the relative velocity v_b - v_a; allocated only in a scene that has one. Only the
+    ! N-body engine runs them.
+    integer :: n_frictions = 0
+    integer, allocatable :: friction_body(:, :)      !< (2, nf) ends a, b (bodies)
+    real(wp), allocatable :: friction_slide(:)       !< (nf) sliding bound mu normal, N
+    real(wp), allocatable :: friction_static(:)      !< (nf) static bound mus normal >= friction_slide, N
+    character(len=name_len), allocatable :: friction_name(:)   !< (nf) events stick_<name>, slip_<name>
     !> The N-body engine's RK4 stages book powers (moving grounds, a friction law or compliant
     !> stops: its nbody_step's moving_stage), set by build_scene: one test in the stage's hot
     !> path (a second test there and gfortran no longer inlines the stage).
@@ -500,7 +508,8 @@ contains
   !> build_scene has set the laws and the records' drives.
   pure logical function runs_nbody(scene)
     type(scene_type), intent(in) :: scene
-    runs_nbody = scene%n_bodies > max_lanes .or. scene%drives%n > 0 .or. scene%belts .or. scene%stribeck
+    runs_nbody = scene%n_bodies > max_lanes .or. scene%drives%n > 0 .or. scene%belts .or. scene%stribeck .or. &
+      scene%n_frictions > 0
   end function runs_nbody
 
   !> What the event log of a run of this input keeps (&run events; all by default).
@@ -716,6 +725,8 @@ contains
     if (allocated(error)) return
     call set_laws(input, scene, error)
     if (allocated(error)) return
+    call set_frictions(records, scene, error)
+    if (allocated(error)) return
     if (scene%belts .or. scene%stribeck) call refuse_stops(records, 'cannot be combined with belt_v, v_s ' // &
       'or c_v yet (the two have not been tested together)', error)
     if (allocated(error)) return
@@ -774,6 +785,33 @@ contains
       scene%body_viscous = [(array_value(input%chain, a_c_v, i, 0.0_wp) * scene%body_mass(i) * g, i = 1, n)]
     end if
   end subroutine set_laws
+
+  !> The &friction records (friction contacts between two bodies), which only the N-body
+  !> engine runs (impact1d_solver's run): neither the vissim method nor compliant stops.
+  subroutine set_frictions(records, scene, error)
+    type(mechanism_records), intent(in) :: records
+    type(scene_type), intent(inout) :: scene
+    type(error_type), allocatable, intent(inout) :: error
+    scene%n_frictions = records%n_frictions
+    if (scene%n_frictions == 0) return
+    if (scene%method == 'vissim') then
+      call raise(error, status_input, "method = 'vissim' is the tutorial's fixed-step scheme: a scene " // &
+        'with friction between two bodies (&friction) runs with method = ''event''')
+      return
+    end if
+    call refuse_stops(records, 'cannot be combined with &friction records yet (the two have not ' // &
+      'been tested together)', error)
+    if (allocated(error)) return
+    ! (the friction laws' ledger, law_powers, books the bodies' own friction only)
+    if (scene%belts .or. scene%stribeck) then
+      call raise(error, status_input, '&friction records cannot be combined with belt_v, v_s or c_v yet')
+      return
+    end if
+    scene%friction_body = records%friction_body
+    scene%friction_slide = records%friction_slide
+    scene%friction_static = records%friction_static
+    scene%friction_name = records%friction_name
+  end subroutine set_frictions
 
   !> A scene with a moving ground runs on the N-body engine (whatever its N), which has no
   !> vissim method.

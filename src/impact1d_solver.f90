@@ -74,11 +74,13 @@ contains
     end if
     ! What the sink calls the events on each row; nothing counted yet.
     sink%row_names = scene%row_name
-    call start_counts(stats, scene%n_rows + scene%n_stops, scene%n_bodies)
+    ! (a friction contact's events are named after it: impact1d_output's class_pair_stick)
+    if (scene%n_frictions > 0) sink%row_names = [scene%row_name, scene%friction_name]
+    call start_counts(stats, scene%n_rows + scene%n_stops, scene%n_bodies, scene%n_frictions)
     ! The tutorial's scheme, for any number of bodies (build_scene refuses it moving grounds
     ! and the friction laws). The stepping kernels here take the bodies in lanes
-    ! (impact1d_lanes); more bodies, and scenes with a moving ground or a friction law
-    ! (belt_v, v_s, c_v), run on the N-body engine.
+    ! (impact1d_lanes); more bodies, and scenes with a moving ground, a friction law
+    ! (belt_v, v_s, c_v) or friction between bodies (&friction), run on the N-body engine.
     if (scene%method == 'vissim') then
       call run_vissim(scene, sink, stats, error)
       return

@@ -75,7 +75,7 @@ def test_scene_fields_follow_the_core():
     inputs = impact1d._scene.decode(impact1d._scene._api.input_field_names()).split()
     assert inputs[:len(tutorial)] == tutorial and tuple(inputs) == impact1d._scene.INPUT_FIELDS
     assert set(names[len(tutorial) + 1:]) == (set(inputs[len(tutorial):]) - set(tutorial)
-                                              - {n for n in inputs if "." in n}) | {"contacts", "springs", "sines"}
+                                              - {n for n in inputs if "." in n}) | {"contacts", "springs", "sines", "frictions"}
     assert impact1d._scene.REAL_FIELDS[:28] == tuple(
         "m1 m2 mu1 mu2 g x_left r_left x_right r_right d_min r_min d_max r_max x1 v1 x2 v2 "
         "f1 f2 f1_amp f1_period f1_phase f2_amp f2_period f2_phase t_end dt dt_out".split())

@@ -109,12 +109,12 @@ def read_output(path, scene=None) -> Result:
         for name in LAW_FIELDS:
             if name in header:
                 kwargs[name] = [float(value) for value in header[name].split()]
-    # The records: '# contact.2.d_min = 0.5', '# spring.1.k = 40.0', '# sine.1.amp = 2.0'
-    # (in record order).
+    # The records: '# contact.2.d_min = 0.5', '# spring.1.k = 40.0', '# sine.1.amp = 2.0',
+    # '# friction.1.normal = 9.81' (in record order).
     for key, value in header.items():
         group, _, rest = key.partition(".")
         number, _, field = rest.partition(".")
-        if group in ("contact", "spring", "sine") and number.isdigit() and field:
+        if group in ("contact", "spring", "sine", "friction") and number.isdigit() and field:
             _put(kwargs, f"{group}.{field}", int(number), value if field == "name" else float(value))
     header_scene = Scene(**kwargs, source=header.get("scene"))
 

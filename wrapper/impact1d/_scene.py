@@ -54,7 +54,7 @@ REAL_FIELDS = (
 TEXT_FIELDS = ("title", "f1_table", "f2_table", "method", "substeps", "events")
 # The N-body scene (DESIGN "Mechanisms as data"): arrays (body i's value at i; the &link
 # ones and k_link, d_rest, c_link one per neighbour pair), &link r_meet, and the fields of
-# the &contact, &spring and &sine records. Checked against _api.input_field_names() at import.
+# the &contact, &spring, &sine and &friction records. Checked against _api.input_field_names() at import.
 ARRAY_FIELDS = ("m", "mu", "mus", "x", "v", "f", "f_amp", "f_period", "f_phase", "k", "x_rest", "c",
                 "d_min", "r_min", "d_max", "r_max", "k_link", "d_rest", "c_link", "f_table",
                 "belt_v", "v_s", "c_v")
@@ -66,9 +66,11 @@ GROUND_FIELDS = ("ground_v", "ground_amp", "ground_period", "ground_phase")
 CONTACT_FIELDS = ("a", "b", "d_min", "r_min", "d_max", "r_max", "name", "k", "c") + GROUND_FIELDS
 SPRING_FIELDS = ("a", "b", "k", "d_rest", "c") + GROUND_FIELDS
 SINE_FIELDS = ("body", "amp", "period", "phase")
+# A friction contact between bodies a and b under a constant normal load (DESIGN "Laws added").
+FRICTION_FIELDS = ("a", "b", "mu", "mus", "normal", "name")
 # The record groups: Scene field, the core's prefix of its fields, the fields.
 _RECORD_GROUPS = (("contacts", "contact.", CONTACT_FIELDS), ("springs", "spring.", SPRING_FIELDS),
-                  ("sines", "sine.", SINE_FIELDS))
+                  ("sines", "sine.", SINE_FIELDS), ("frictions", "friction.", FRICTION_FIELDS))
 _RECORD_NAMES = tuple(group for group, _, _ in _RECORD_GROUPS)
 # Record fields that are body numbers (whole numbers, as ints in a Scene).
 _BODY_NUMBER_FIELDS = ("a", "b", "body")
@@ -87,9 +89,9 @@ class Scene:
 
     N bodies (docs/formats.md, "Scenes of N bodies"): the arrays (`m=[...]`, `x=[...]`,
     ..., and `d_min`, `r_min`, `d_max`, `r_max`, `d_rest` given as sequences), `r_meet`,
-    and `contacts` / `springs` / `sines`: lists of dicts with the &contact / &spring /
-    &sine fields (`{"a": 0, "b": 3, "d_min": -1.0, "name": "stop3"}`, `{"body": 1, "amp":
-    2.0, "period": 0.5}`). One or two bodies given so run as the tutorial's names, with
+    and `contacts` / `springs` / `sines` / `frictions`: lists of dicts with the &contact /
+    &spring / &sine / &friction fields (`{"a": 0, "b": 3, "d_min": -1.0, "name": "stop3"}`,
+    `{"body": 1, "amp": 2.0, "period": 0.5}`, `{"a": 1, "b": 2, "mu": 0.3, "normal": 9.81}`). One or two bodies given so run as the tutorial's names, with
     their records; more wait for the N-body engine (InputError).
     """
 
@@ -176,6 +178,7 @@ class Scene:
     contacts: Optional[Sequence[dict]] = None
     springs: Optional[Sequence[dict]] = None
     sines: Optional[Sequence[dict]] = None     # &sine records: {"body", "amp", "period", "phase"}
+    frictions: Optional[Sequence[dict]] = None  # &friction records: {"a", "b", "mu", "mus", "normal", "name"}
     bodies_out: Optional[Sequence[int]] = None  # &run bodies_out: the bodies whose x, v a run keeps
 
 
@@ -210,7 +213,7 @@ _check_field_order()
 _SCENE_FIELDS = tuple(f.name for f in dataclasses.fields(Scene))
 # (the N-body fields after source: positional Scene(...) calls keep their meaning)
 _NBODY_FIELDS = tuple(name for name in ARRAY_FIELDS if name not in _SHARED_FIELDS) + \
-    ("r_meet", "contacts", "springs", "sines")
+    ("r_meet", "contacts", "springs", "sines", "frictions")
 # (what a run writes, whatever the scene's form; it goes to the core with the records)
 _OUTPUT_FIELDS = ("bodies_out",)
 assert _SCENE_FIELDS == REAL_FIELDS + TEXT_FIELDS + ("source",) + _NBODY_FIELDS + _OUTPUT_FIELDS

@@ -540,6 +540,8 @@ def simulate(scene: Scene, *, progress: bool = False, _interrupt_epoch: Optional
     events = np.empty(n_events, dtype=event_dtype(n_bodies))
     if n_events > 0:
         _fill_events(events, buffers, n_events, n_rows, n_bodies)
+        if form.fields.get("frictions"):
+            _name_pair_events(events, buffers.event_int[:n_events], n_rows, form.fields["frictions"])
     if event_int.shape[0] > _EVENT_CAPACITY_KEPT:
         buffers.make(_EVENT_CAPACITY, row_name_codes.shape[1])
     # The Result and its scene made without their dataclass __init__ (every field set here,
@@ -588,6 +590,19 @@ def _prepared(form: CoreForm) -> int:
 def _codes_text(codes) -> bytes:
     """The api's character codes (int32) as bytes."""
     return codes.astype(np.uint8).tobytes()
+
+
+# The core's classes of a friction contact's stick and slip (&friction j: index n_rows + j).
+_PAIR_CLASSES = ((6, "stick_"), (7, "slip_"))
+
+
+def _name_pair_events(events, event_int, n_rows, frictions) -> None:
+    """The kinds of the friction contacts' events, 'stick_<name>' and 'slip_<name>' (the
+    record's name, else 'friction<j>')."""
+    names = [record.get("name") or f"friction{j}" for j, record in enumerate(frictions, 1)]
+    for event_class, prefix in _PAIR_CLASSES:
+        for k in np.flatnonzero(event_int[:, 0] == event_class):
+            events["kind"][k] = prefix + names[event_int[k, 1] - n_rows - 1]
 
 
 def _fill_events(events, buffers, n_events, n_rows, n_bodies) -> None:
