@@ -17,6 +17,7 @@ Measured, never asserted in tests. Raw numbers: bench/results/engines.json. Usag
 from __future__ import annotations
 
 import json
+from collections import Counter
 import re
 import shutil
 import subprocess
@@ -71,8 +72,7 @@ def compare(a: Path, b: Path) -> dict:
     ea, eb = table(a.with_suffix(".events.dat")), table(b.with_suffix(".events.dat"))
     same_kinds = [row[1] for row in ea] == [row[1] for row in eb]
     result = {"events": [len(ea), len(eb)], "same_kinds": same_kinds,
-              "kinds": [dict(zip(*np.unique([row[1] for row in e], return_counts=True))) for e in (ea, eb)]}
-    result["kinds"] = [{k: int(v) for k, v in counts.items()} for counts in result["kinds"]]
+              "kinds": [dict(Counter(row[1] for row in e)) for e in (ea, eb)]}
     if same_kinds and ea:
         result["event_time_difference"] = float(max(abs(float(p[0]) - float(q[0])) for p, q in zip(ea, eb)))
     if sa.shape == sb.shape:

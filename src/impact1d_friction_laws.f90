@@ -71,7 +71,6 @@ contains
     do i = 1, scene%n_bodies
       if (sgn(i) /= 0.0_wp) then
         friction = -sliding_bound(scene, i, slip(scene, i, v(i))) * sgn(i)
-        if (scene%body_friction(i) == 0.0_wp .and. .not. scene%stribeck) friction = 0.0_wp
         loss = loss - friction * slip(scene, i, v(i))
         if (scene%belts) belt = belt + friction * scene%body_belt(i)
       end if
