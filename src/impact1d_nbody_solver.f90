@@ -16,7 +16,7 @@ module impact1d_nbody_solver
   use impact1d_elements, only: element_potential, stop_potential
   use impact1d_body_mode, only: body_mode_type, new_mode
   use impact1d_nbody_step, only: nbody_step, nbody_force, locate_nbody, refine_nbody, gaps_hold, row_gap, &
-    row_velocity, row_gap_tolerance, found_none, found_row
+    row_velocity, row_gap_tolerance, found_none, found_row, clock_to_stop
   use impact1d_nbody_event, only: point_work_type, new_point_work, nbody_event_point
   implicit none
   private
@@ -202,10 +202,7 @@ contains
     end do
     at_stop = found == found_none .and. h == (t_stop - s%t) - s%t_lo
     s = trial
-    if (at_stop) then
-      s%t = t_stop
-      s%t_lo = 0.0_wp
-    end if
+    if (at_stop) call clock_to_stop(scene, r%mode, t_stop, s)
     stats%steps = stats%steps + 1
     if (iand(stats%steps, 4095_int64) == 0) then
       call checkpoint(sink, stats, s%t, scene%t_end, error)

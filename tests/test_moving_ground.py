@@ -473,6 +473,30 @@ def test_rattle_of_two_balls_keeps_its_events_on_a_moving_floor(u):
     np.testing.assert_allclose(moving["t"], still["t"], rtol=0, atol=1e-15)
 
 
+@pytest.mark.parametrize("u", [-7.3, -0.8, -0.3, -0.1, 0.1, 0.8])
+def test_elastic_pair_on_a_floor_at_constant_speed_keeps_the_still_floors_events(u):
+    """A ball lands elastically on another resting on a plastic floor: in the floor's frame
+    5 events (the lower ball's impact and rest, the swap, its impact, the pair at rest). On
+    the floor moving at u the lower ball, held to it, stood up to 5e-21 m above w(t) (v h
+    rounded at every step, and the clock set to each sample stop a rounding away from where
+    the steps took it), so the floor's row was not closed when the upper ball landed: the
+    two impacts fell to two event points, the upper ball kept -2.2e-16 m/s against the lower
+    one, and they met again twice (9 events at u = 0.8, -0.3, 0.1, -7.3; 7 at -0.1). Now the
+    same events at the same times (to 1e-15 s), velocities and positions shifted by u and u t."""
+    def run(u):
+        return impact1d.simulate(impact1d.Scene(
+            m=[1.0, 1.0], x=[0.5, 1.0], v=[u, u], f=[-G, -G], t_end=2.0, dt=1e-3,
+            contacts=[dict(a=0, b=1, d_min=0.0, r_min=0.0, ground_v=u), dict(a=1, b=2, d_min=0.1, r_min=1.0)]))
+    still, moving = run(0.0), run(u)
+    assert list(still.events["kind"]) == ["contact1", "rest_contact1", "contact2", "contact1", "rest_contact2"]
+    assert list(moving.events["kind"]) == list(still.events["kind"])
+    np.testing.assert_allclose(moving.events["t"], still.events["t"], rtol=0, atol=1e-15)
+    for name in ("v1_before", "v2_before", "v1_after", "v2_after"):
+        np.testing.assert_allclose(moving.events[name] - u, still.events[name], rtol=0, atol=1e-14)
+    for x_moving, x_still in ((moving.x1, still.x1), (moving.x2, still.x2)):
+        np.testing.assert_allclose(x_moving - u * moving.t, x_still, rtol=0, atol=4 * np.spacing(abs(u) * 2 + 1))
+
+
 def test_a_release_on_the_nbody_engine_logs_the_bodies_velocities():
     """With one or two bodies an event reports (v1, v2) (or (v1, 0)) whatever the row; the
     N-body engine's release of a ground row logged its row's ends instead, (0, v_b): the
