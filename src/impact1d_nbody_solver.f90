@@ -1,7 +1,7 @@
 !> The N-body engine's driver (docs/method.md section 9): the two-body engine's method on
 !> N-long arrays. From the current state it picks the next stop (sample time, table corner
 !> or pending rest), takes the steps before the mode's quiet time in closed form under
-!> constant forces (impact1d_nbody_glide), then one RK4 step toward it, locates the earliest
+!> constant forces or tables (impact1d_nbody_glide), then one RK4 step toward it, locates the earliest
 !> event inside the step on the dense output (impact1d_nbody_step), re-takes the step to it,
 !> and calls the event point (impact1d_nbody_event); samples go to the sink at sample times. impact1d_solver's
 !> run hands scenes of more than two bodies here.
@@ -34,7 +34,7 @@ module impact1d_nbody_solver
     !> Tables and constants only: the dense output is exact, so no root can be missed.
     logical :: polynomial = .false.
     real(wp) :: ke0 = 0.0_wp, pe0 = 0.0_wp
-    !> Constant forces: the steps before the mode's quiet time in closed form.
+    !> Constant forces or tables: the steps before the mode's quiet time without location.
     type(glide_type) :: glide
   end type nbody_run_type
 
@@ -59,7 +59,7 @@ contains
     if (present(closed_form)) r%glide%able = r%glide%able .and. closed_form
     call nbody_event_point(scene, .true., found_none, 0, s, r%mode, r%event_log, r%work, sink, stats, error)
     if (allocated(error)) return
-    call find_quiet_time(scene, r%mode, s, r%glide)
+    call find_quiet_time(scene, r%mode, r%work%mode, s, r%glide)
     j_sample = 0
     call emit(scene, s, r, j_sample, sink, stats, error)
     if (allocated(error)) return
@@ -74,7 +74,7 @@ contains
       t_stop = min(sample_t, t_break, t_rest)
       ! The steps that can meet no event in closed form; then one located step (advance).
       at_stop = .false.
-      if (r%glide%able) call glide(scene, r%mode, r%glide, t_stop, s, at_stop, sink, stats, error)
+      if (r%glide%able) call glide(scene, r%mode, r%glide, t_stop, s, trial, at_stop, sink, stats, error)
       if (allocated(error)) return
       found = found_none
       index = 0
@@ -101,7 +101,7 @@ contains
         call r%event_log%flush_pending_rest(scene, s%t, s%v, sink, stats)
         call nbody_event_point(scene, .false., found, index, s, r%mode, r%event_log, r%work, sink, stats, error)
         if (allocated(error)) return
-        call find_quiet_time(scene, r%mode, s, r%glide)
+        call find_quiet_time(scene, r%mode, r%work%mode, s, r%glide)
       end if
       if (at_stop .and. s%t == sample_t) then
         call emit(scene, s, r, j_sample, sink, stats, error)

@@ -2,18 +2,27 @@
 !> two-body scenes under constant forces glides (run_stats%glided) and gives the samples
 !> and events of the run that locates every step, bit for bit, at dt = 1e-3 and 0.1; a free
 !> flight glides every step and ends on its closed form; a body pushed onto a wall hits it
-!> at the closed form's instant and speed.
+!> at the closed form's instant and speed. Under force tables the same: case 6's triangle
+!> (the blocks rattling in their slot, sliding and sticking) and a ramp against two blocks
+!> held by static friction (the held mode checked once a segment, not every step) glide and
+!> give the located run's bits; a ramp's free flight ends on its cubic.
 program test_nbody_glide
   use, intrinsic :: iso_fortran_env, only: int64
   use impact1d_kinds, only: wp
   use impact1d_error, only: error_type
   use impact1d_scene, only: scene_type
+  use impact1d_forcing, only: table_type
   use impact1d_output, only: memory_sink, run_stats, start_counts, row_length
   use impact1d_nbody_solver, only: run_nbody
   use testing, only: check, finish, two_body
   implicit none
   character(len=*), parameter :: dts(2) = ['1e-3', '0.1 ']
   integer :: j
+  type(table_type) :: triangle, ramp
+  triangle%t = [0.0_wp, 1.0_wp, 2.0_wp, 3.0_wp, 4.0_wp]
+  triangle%f = [0.0_wp, 30.0_wp, 0.0_wp, -30.0_wp, 0.0_wp]
+  ramp%t = [0.0_wp, 10.0_wp]
+  ramp%f = [0.0_wp, 40.0_wp]
 
   do j = 1, size(dts)
     ! Two bodies: walls, the link's slot, friction, forces toward each other (case 5's
@@ -27,8 +36,15 @@ program test_nbody_glide
     ! One body between two walls under a force, bouncing to rest on one of them.
     call same_bits('x_left = -1, r_left = 0.5, x_right = 1, r_right = 0.9, v1 = 3, f1 = -2, mu1 = 0.05, g = 10, ' // &
       't_end = 4, dt = ' // trim(dts(j)), .true.)
+    ! Tables: case 6 (walls, the slot, friction, the triangle on body 1); the break-away
+    ! (stuck under the ramp until 3.25 s, then sliding together).
+    call same_bits('m2 = 2, mu1 = 1, mu2 = 1, g = 10, x_left = 0, r_left = 1, x_right = 10, r_right = 1, ' // &
+      'd_min = 0, r_min = 1, d_max = 2, r_max = 1, x1 = 1, x2 = 2, t_end = 5, dt = ' // trim(dts(j)), .false., triangle)
+    call same_bits('m2 = 2, mu1 = 0.3, mus1 = 0.5, mu2 = 0.2, mus2 = 0.4, g = 10, x1 = 0, x2 = 0, t_end = 5, dt = ' // &
+      trim(dts(j)), .false., ramp)
   end do
   call free_flight()
+  call ramp_flight(ramp)
   call wall_hit()
   call finish('test_nbody_glide')
 
@@ -51,13 +67,14 @@ contains
 
   !> With and without the closed-form steps: the same samples and events to the bit, the
   !> same steps, and some of them glided.
-  subroutine same_bits(assignments, one_body)
+  subroutine same_bits(assignments, one_body, f1_table)
     character(len=*), intent(in) :: assignments
     logical, intent(in) :: one_body
+    type(table_type), intent(in), optional :: f1_table
     type(scene_type) :: scene
     type(memory_sink) :: glided, located
     type(run_stats) :: with, without
-    call two_body(assignments, scene, one_body=one_body)
+    call two_body(assignments, scene, f1_table, one_body=one_body)
     call run_scene(scene, .true., glided, with)
     call run_scene(scene, .false., located, without)
     call check(with%glided > 0 .and. without%glided == 0, 'glides: ' // assignments)
@@ -117,4 +134,23 @@ contains
         abs(sink%event_v(3, 1) - sqrt(0.5_wp)) <= 1.0e-13_wp, 'at -sqrt(2) m/s, back at sqrt(1/2), dt = ' // dts(k))
     end do
   end subroutine wall_hit
+
+  !> One body of 1 kg from rest under the ramp f = 4 t N, nothing near: x = 2 t^3 / 3,
+  !> v = 2 t^2; all but the steps at the samples' and corners' ends glided.
+  subroutine ramp_flight(ramp)
+    type(table_type), intent(in) :: ramp
+    type(scene_type) :: scene
+    type(memory_sink) :: sink
+    type(run_stats) :: stats
+    real(wp), parameter :: t = 2.0_wp
+    call two_body('x1 = 0, t_end = 2, dt = 1e-3, dt_out = 0.5', scene, ramp, one_body=.true.)
+    call run_scene(scene, .true., sink, stats)
+    call check(stats%glided == stats%steps .and. stats%steps == 2000_int64, 'a ramp''s flight glides every step')
+    associate (last => sink%samples(sink%n_samples, :))
+      call check(last(1) == t, 'ramp: ends at t_end')
+      call check(abs(last(2) - 2.0_wp * t**3 / 3.0_wp) <= 8.0_wp * epsilon(1.0_wp) * 2.0_wp * t**3 / 3.0_wp, &
+        'ramp: x on the cubic')
+      call check(abs(last(3) - 2.0_wp * t**2) <= 8.0_wp * epsilon(1.0_wp) * 2.0_wp * t**2, 'ramp: v on the parabola')
+    end associate
+  end subroutine ramp_flight
 end program test_nbody_glide
