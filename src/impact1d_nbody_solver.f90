@@ -16,7 +16,7 @@ module impact1d_nbody_solver
   use impact1d_elements, only: element_potential, stop_potential
   use impact1d_body_mode, only: body_mode_type, new_mode
   use impact1d_nbody_step, only: nbody_step, nbody_force, locate_nbody, refine_nbody, gaps_hold, row_gap, &
-    row_velocity, row_gap_tolerance, found_none, found_row
+    row_velocity, row_gap_tolerance, found_none, found_row, kept_forces_type
   use impact1d_nbody_event, only: point_work_type, new_point_work, nbody_event_point
   implicit none
   private
@@ -29,6 +29,8 @@ module impact1d_nbody_solver
     type(body_mode_type) :: mode
     type(point_work_type) :: work
     type(event_log_type) :: event_log
+    !> The last step's end forces, for the next step's first stage (nbody_step).
+    type(kept_forces_type) :: kept
     !> Tables and constants only: the dense output is exact, so no root can be missed.
     logical :: polynomial = .false.
     real(wp) :: ke0 = 0.0_wp, pe0 = 0.0_wp
@@ -86,6 +88,7 @@ contains
         call r%event_log%flush_pending_rest(scene, s%t, s%v, sink, stats)
         call nbody_event_point(scene, .false., found, index, s, r%mode, r%event_log, r%work, sink, stats, error)
         if (allocated(error)) return
+        call r%kept%forget()
       end if
       if (at_stop .and. s%t == sample_t) then
         call emit(scene, s, r, j_sample, sink, stats, error)
@@ -112,6 +115,7 @@ contains
       r%mode%engaged = .false.
     end if
     call new_point_work(scene%n_bodies, r%work)
+    call r%kept%reserve(scene%n_bodies)
     call r%event_log%allocate_log(scene%n_rows, scene%n_bodies)
     r%polynomial = scene%forcing%is_polynomial() .and. .not. scene%springs%present .and. scene%drives%polynomial &
       .and. .not. scene%stribeck
@@ -174,17 +178,19 @@ contains
       index = 0
       if (h <= 0.0_wp) then
         trial = s
+        call r%kept%forget()
         exit
       end if
-      call nbody_step(scene, r%mode, s, h, trial)
+      call nbody_step(scene, r%mode, s, h, trial, r%kept)
       call locate_nbody(scene, r%mode, r%work%mode, r%polynomial, s, trial, h, theta, found, index)
       if (found /= found_none .and. theta <= h) then
         h_taken = h
         h = theta
         if (h > 0.0_wp) then
-          call refine_nbody(scene, r%mode, r%polynomial, s, h, found, index, trial, h_taken)
+          call refine_nbody(scene, r%mode, r%polynomial, s, h, found, index, trial, r%kept, h_taken)
         else
           trial = s
+          call r%kept%forget()
           exit
         end if
       else
@@ -202,6 +208,7 @@ contains
     end do
     at_stop = found == found_none .and. h == (t_stop - s%t) - s%t_lo
     s = trial
+    call r%kept%accept()
     if (at_stop) then
       s%t = t_stop
       s%t_lo = 0.0_wp

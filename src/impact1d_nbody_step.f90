@@ -27,7 +27,48 @@ module impact1d_nbody_step
   integer, parameter :: found_none = 0, found_row = 1, found_body = 2, found_hold = 3, found_stop = 4, &
     found_friction = 5
 
+  !> A step's end forces kept for the next step's first stage (the two-body engine's
+  !> end_force, FSAL-like): the external forces at the end's time t and the mode's
+  !> accelerations under all the applied forces there. Two slots: the run's state's
+  !> (`now`) and the end of the step last taken from it (3 - now), which becomes the run's
+  !> when advance takes that step (`accept`). A slot is used only at its own time t and
+  !> while valid: whatever changes the state or the mode without a step (an event point)
+  !> calls `forget`. Kept where the stages' forces are the external and the elements' only
+  !> (not scene%stage_powers): the same inputs and arithmetic as the stage it replaces.
+  type, public :: kept_forces_type
+    integer :: now = 1
+    logical :: valid(2) = .false.
+    real(wp) :: t(2) = 0.0_wp
+    real(wp), allocatable :: f(:, :), acc(:, :)      !< (N, 2)
+  contains
+    procedure :: reserve => reserve_kept
+    procedure :: accept => accept_kept
+    procedure :: forget => forget_kept
+  end type kept_forces_type
+
 contains
+
+  !> The slots of n bodies, both empty (the run's one allocation of them).
+  pure subroutine reserve_kept(self, n)
+    class(kept_forces_type), intent(inout) :: self
+    integer, intent(in) :: n
+    if (allocated(self%f)) deallocate(self%f, self%acc)
+    allocate(self%f(n, 2), self%acc(n, 2))
+    call self%forget()
+  end subroutine reserve_kept
+
+  !> The step last taken is the run's state now: its end's slot becomes the start's.
+  pure subroutine accept_kept(self)
+    class(kept_forces_type), intent(inout) :: self
+    self%now = 3 - self%now
+    self%valid(3 - self%now) = .false.
+  end subroutine accept_kept
+
+  !> The state or the mode changed without a step: nothing kept holds.
+  pure subroutine forget_kept(self)
+    class(kept_forces_type), intent(inout) :: self
+    self%valid = .false.
+  end subroutine forget_kept
 
   !> Applied forces f (external and elements') at time t, positions x + dx, velocities v;
   !> engaged: the compliant stops engaged (a mode's; absent: none).
@@ -117,23 +158,31 @@ contains
   !> forces may depend on the state); the ledger by Simpson's rule on the step's Hermite
   !> velocity (external work, sliding friction's loss, dampers' dissipation), exact where
   !> RK4 is. With a friction law (belt_v, v_s, c_v) friction's loss and the belts' work are
-  !> RK4's own quadrature of their power at the stages (law_ledger).
-  subroutine nbody_step(scene, mode, a, step, b)
+  !> RK4's own quadrature of their power at the stages (law_ledger). The first stage's
+  !> forces are kept's when it holds them for a (the last step's end), and the end's go
+  !> into kept for the next step.
+  subroutine nbody_step(scene, mode, a, step, b, kept)
     type(scene_type), intent(in) :: scene
     type(body_mode_type), intent(in) :: mode
     type(state_type), intent(in) :: a
     real(wp), intent(in) :: step
     type(state_type), intent(inout) :: b
+    type(kept_forces_type), intent(inout) :: kept
     real(wp), dimension(scene%n_bodies) :: v0, v1, vm, f, dx, kx1, kx2, kx3, kx4, kv1, kv2, kv3, kv4, &
       f0, fm, f1, acc_end
     real(wp) :: half, power(4), loss(4), belt(4)
     half = 0.5_wp * step
     v0 = a%v + a%v_lo
-    call scene%forcing%force_all(a%t, f0)
+    kx1 = v0
+    if (kept%valid(kept%now) .and. kept%t(kept%now) == a%t) then
+      f0 = kept%f(:, kept%now)
+      kv1 = kept%acc(:, kept%now)
+    else
+      call scene%forcing%force_all(a%t, f0)
+      call stage(f0, a%x_lo, kx1, kv1, 0.0_wp, 1)
+    end if
     call scene%forcing%force_all(a%t + half, fm)
     call scene%forcing%force_all(a%t + step, f1)
-    kx1 = v0
-    call stage(f0, a%x_lo, kx1, kv1, 0.0_wp, 1)
     kx2 = v0 + half * kv1
     call stage(fm, a%x_lo + half * kx1, kx2, kv2, half, 2)
     kx3 = v0 + half * kv2
@@ -147,11 +196,19 @@ contains
     if (scene%drives%n > 0) call hold_to_drives(scene, mode, a, step, b)
     v1 = b%v + b%v_lo
     f = f1
+    kept%valid(3 - kept%now) = .false.
     if (scene%stage_powers) then
       call drive_step_ledger()
     else
+      ! (stage 1's forces and arithmetic at b: the next step's first stage)
       if (scene%springs%present) call add_element_forces(scene, b%x, b%x_lo, v1, f)
       call mode%acceleration(f, acc_end)
+      associate (e => 3 - kept%now)
+        kept%f(:, e) = f1
+        kept%acc(:, e) = acc_end
+        kept%t(e) = a%t + step
+        kept%valid(e) = .true.
+      end associate
     end if
     vm = 0.5_wp * (v0 + v1) + 0.125_wp * step * (kv1 - acc_end)
     call add_compensated(b%work, b%work_lo, step / 6.0_wp * (dot_product(f0, v0) + &
@@ -686,7 +743,7 @@ contains
   !> with a moving ground end was located on its cubic, whose root may come before the
   !> exact one, and so was a sliding body's stop under forcing that is not polynomial (the
   !> cubic's velocity): Newton may then go on up to the step taken (limit).
-  subroutine refine_nbody(scene, mode, polynomial, a, step, found, index, b, limit)
+  subroutine refine_nbody(scene, mode, polynomial, a, step, found, index, b, kept, limit)
     type(scene_type), intent(in) :: scene
     type(body_mode_type), intent(in) :: mode
     logical, intent(in) :: polynomial     !< the motion is a cubic: the dense output is exact
@@ -694,6 +751,7 @@ contains
     real(wp), intent(inout) :: step
     integer, intent(in) :: found, index
     type(state_type), intent(inout) :: b
+    type(kept_forces_type), intent(inout) :: kept     !< nbody_step's
     real(wp), intent(in), optional :: limit
     real(wp) :: value, slope, tol, located_step, f(scene%n_bodies), acc(scene%n_bodies)
     integer :: iteration
@@ -702,7 +760,7 @@ contains
       if (scene%row_drive(index) > 0) located_step = limit
     end if
     if (present(limit) .and. found == found_body .and. .not. polynomial) located_step = limit
-    call nbody_step(scene, mode, a, step, b)
+    call nbody_step(scene, mode, a, step, b, kept)
     if (found /= found_row .and. found /= found_body .and. found /= found_stop) return
     do iteration = 1, 8
       if (found == found_body) then
@@ -728,7 +786,7 @@ contains
       if (abs(value) <= tol .or. slope == 0.0_wp) exit
       if (step - value / slope <= 0.0_wp .or. step - value / slope > located_step) exit
       step = step - value / slope
-      call nbody_step(scene, mode, a, step, b)
+      call nbody_step(scene, mode, a, step, b, kept)
     end do
   end subroutine refine_nbody
 
