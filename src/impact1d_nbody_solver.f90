@@ -9,7 +9,7 @@ module impact1d_nbody_solver
   use impact1d_kinds, only: wp
   use impact1d_error, only: error_type, raise, status_simulation, fmt
   use impact1d_scene, only: scene_type, sample_time, step_length
-  use impact1d_state, only: state_type, new_state, finite_state
+  use impact1d_state, only: state_type, new_state, take_state, finite_state
   use impact1d_output, only: sink_type, run_stats, emit_bodies, checkpoint
   use impact1d_event_log, only: event_log_type
   use impact1d_yardsticks, only: velocity_rounding
@@ -207,7 +207,7 @@ contains
       h = 0.5_wp * h
     end do
     at_stop = found == found_none .and. h == (t_stop - s%t) - s%t_lo
-    s = trial
+    call take_state(s, trial)
     call r%kept%accept()
     if (at_stop) then
       s%t = t_stop

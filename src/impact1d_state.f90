@@ -7,7 +7,7 @@ module impact1d_state
   use impact1d_lanes, only: max_lanes
   implicit none
   private
-  public :: state_type, lane_state_type, load_lanes, new_state, add_compensated, accumulate, &
+  public :: state_type, lane_state_type, load_lanes, new_state, take_state, add_compensated, accumulate, &
     renormalise, finite_state, constant_step, constant_steps
 
   !> Time, positions, velocities and the ledger integrals, compensated: a micrometre bounce
@@ -74,6 +74,33 @@ contains
       to%v(:) = from%v
       to%v_lo(:) = from%v_lo
     end if
+    call copy_scalars(to, from)
+  end subroutine copy_state
+
+  !> to = from without copying the arrays: they are swapped (from is left with to's old
+  !> arrays, its values not to be read: a trial step's end taken as the run's state).
+  pure subroutine take_state(to, from)
+    type(state_type), intent(inout) :: to, from
+    call swap(to%x, from%x)
+    call swap(to%x_lo, from%x_lo)
+    call swap(to%v, from%v)
+    call swap(to%v_lo, from%v_lo)
+    call copy_scalars(to, from)
+  end subroutine take_state
+
+  !> a and b swapped by moving their allocations (no element copied).
+  pure subroutine swap(a, b)
+    real(wp), allocatable, intent(inout) :: a(:), b(:)
+    real(wp), allocatable :: held(:)
+    call move_alloc(a, held)
+    call move_alloc(b, a)
+    call move_alloc(held, b)
+  end subroutine swap
+
+  !> The clock and the ledger of from into to.
+  pure subroutine copy_scalars(to, from)
+    class(state_type), intent(inout) :: to
+    type(state_type), intent(in) :: from
     to%t = from%t
     to%t_lo = from%t_lo
     to%work = from%work
@@ -85,7 +112,7 @@ contains
     to%damping_lo = from%damping_lo
     to%drive_work = from%drive_work
     to%drive_lo = from%drive_lo
-  end subroutine copy_state
+  end subroutine copy_scalars
 
   !> hi + lo += increment: the exact rounding error of hi + increment (Knuth's two-sum, valid
   !> whichever is larger) goes into lo; then hi takes what of lo it can hold (Fast2Sum), so
