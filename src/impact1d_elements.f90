@@ -93,20 +93,26 @@ contains
   end function tension_of
 
   !> f += the elements' forces at positions x + dx and velocities v (a still ground; moving
-  !> ones: add_moving_element_forces).
+  !> ones: add_moving_element_forces). Every stage of an N-body step calls it: its ends read
+  !> once, a ground end's zeros left out (x(b) - 0 is x(b): elongation's bits), the arrays
+  !> contiguous (no strides).
   pure subroutine add_element_forces(scene, x, dx, v, f)
     type(scene_type), intent(in) :: scene
-    real(wp), intent(in) :: x(:), dx(:), v(:)
-    real(wp), intent(inout) :: f(:)
+    real(wp), contiguous, intent(in) :: x(:), dx(:), v(:)
+    real(wp), contiguous, intent(inout) :: f(:)
     real(wp) :: tension
-    integer :: j
+    integer :: j, a, b
     do j = 1, scene%n_elements
-      associate (a => scene%element_body(1, j), b => scene%element_body(2, j))
-        tension = scene%element_k(j) * elongation(scene, j, x, dx) + &
-          scene%element_c(j) * (at_end(v, b) - at_end(v, a))
-        if (a > 0) f(a) = f(a) + tension
-        f(b) = f(b) - tension
-      end associate
+      a = scene%element_body(1, j)
+      b = scene%element_body(2, j)
+      if (a > 0) then
+        tension = scene%element_k(j) * (((x(b) - x(a)) - scene%element_rest(j)) + (dx(b) - dx(a))) + &
+          scene%element_c(j) * (v(b) - v(a))
+        f(a) = f(a) + tension
+      else
+        tension = scene%element_k(j) * ((x(b) - scene%element_rest(j)) + dx(b)) + scene%element_c(j) * v(b)
+      end if
+      f(b) = f(b) - tension
     end do
   end subroutine add_element_forces
 

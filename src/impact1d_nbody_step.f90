@@ -74,8 +74,9 @@ contains
   !> engaged: the compliant stops engaged (a mode's; absent: none).
   pure subroutine nbody_force(scene, t, x, dx, v, f, engaged)
     type(scene_type), intent(in) :: scene
-    real(wp), intent(in) :: t, x(:), dx(:), v(:)
-    real(wp), intent(out) :: f(:)
+    real(wp), intent(in) :: t
+    real(wp), contiguous, intent(in) :: x(:), dx(:), v(:)
+    real(wp), contiguous, intent(out) :: f(:)
     logical, intent(in), optional :: engaged(:)
     call scene%forcing%force_all(t, f)
     if (.not. scene%springs%present) return
