@@ -182,7 +182,7 @@ contains
         exit
       end if
       call nbody_step(scene, r%mode, s, h, trial, r%kept)
-      call locate_nbody(scene, r%mode, r%work%mode, r%polynomial, s, trial, h, theta, found, index)
+      call locate_nbody(scene, r%mode, r%work%mode, r%polynomial, s, trial, h, r%kept, theta, found, index)
       if (found /= found_none .and. theta <= h) then
         h_taken = h
         h = theta

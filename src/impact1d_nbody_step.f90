@@ -31,7 +31,9 @@ module impact1d_nbody_step
   !> end_force, FSAL-like): the external forces at the end's time t and the mode's
   !> accelerations under all the applied forces there. Two slots: the run's state's
   !> (`now`) and the end of the step last taken from it (3 - now), which becomes the run's
-  !> when advance takes that step (`accept`). A slot is used only at its own time t and
+  !> when advance takes that step (`accept`). A step that computed its first stage itself
+  !> keeps it in the run's slot too, for its retries and refinements from the same state and
+  !> for the location's external forces there. A slot is used only at its own time t and
   !> while valid: whatever changes the state or the mode without a step (an event point)
   !> calls `forget`. Kept where the stages' forces are the external and the elements' only
   !> (not scene%stage_powers): the same inputs and arithmetic as the stage it replaces.
@@ -44,6 +46,8 @@ module impact1d_nbody_step
     procedure :: reserve => reserve_kept
     procedure :: accept => accept_kept
     procedure :: forget => forget_kept
+    procedure :: holds => kept_holds
+    procedure :: keep => keep_forces
   end type kept_forces_type
 
 contains
@@ -70,15 +74,40 @@ contains
     self%valid = .false.
   end subroutine forget_kept
 
+  !> Whether the run's slot holds the forces at time t (of the run's state).
+  pure logical function kept_holds(self, t)
+    class(kept_forces_type), intent(in) :: self
+    real(wp), intent(in) :: t
+    kept_holds = self%valid(self%now)
+    if (kept_holds) kept_holds = self%t(self%now) == t
+  end function kept_holds
+
+  !> Slot e holds the external forces f at time t and the accelerations acc.
+  pure subroutine keep_forces(self, e, t, f, acc)
+    class(kept_forces_type), intent(inout) :: self
+    integer, intent(in) :: e
+    real(wp), intent(in) :: t, f(:), acc(:)
+    self%f(:, e) = f
+    self%acc(:, e) = acc
+    self%t(e) = t
+    self%valid(e) = .true.
+  end subroutine keep_forces
+
   !> Applied forces f (external and elements') at time t, positions x + dx, velocities v;
-  !> engaged: the compliant stops engaged (a mode's; absent: none).
-  pure subroutine nbody_force(scene, t, x, dx, v, f, engaged)
+  !> engaged: the compliant stops engaged (a mode's; absent: none); external: the external
+  !> forces at t when they are known (a kept step's).
+  pure subroutine nbody_force(scene, t, x, dx, v, f, engaged, external)
     type(scene_type), intent(in) :: scene
     real(wp), intent(in) :: t
     real(wp), contiguous, intent(in) :: x(:), dx(:), v(:)
     real(wp), contiguous, intent(out) :: f(:)
     logical, intent(in), optional :: engaged(:)
-    call scene%forcing%force_all(t, f)
+    real(wp), intent(in), optional :: external(:)
+    if (present(external)) then
+      f = external
+    else
+      call scene%forcing%force_all(t, f)
+    end if
     if (.not. scene%springs%present) return
     if (scene%drives%n > 0) then
       call add_moving_element_forces(scene, x, dx, v, f, t)
@@ -160,8 +189,8 @@ contains
   !> velocity (external work, sliding friction's loss, dampers' dissipation), exact where
   !> RK4 is. With a friction law (belt_v, v_s, c_v) friction's loss and the belts' work are
   !> RK4's own quadrature of their power at the stages (law_ledger). The first stage's
-  !> forces are kept's when it holds them for a (the last step's end), and the end's go
-  !> into kept for the next step.
+  !> forces are kept's when it holds them for a (the last step's end, or a step already
+  !> taken from a), and the end's go into kept for the next step.
   subroutine nbody_step(scene, mode, a, step, b, kept)
     type(scene_type), intent(in) :: scene
     type(body_mode_type), intent(in) :: mode
@@ -175,12 +204,14 @@ contains
     half = 0.5_wp * step
     v0 = a%v + a%v_lo
     kx1 = v0
-    if (kept%valid(kept%now) .and. kept%t(kept%now) == a%t) then
+    if (kept%holds(a%t)) then
       f0 = kept%f(:, kept%now)
       kv1 = kept%acc(:, kept%now)
     else
       call scene%forcing%force_all(a%t, f0)
       call stage(f0, a%x_lo, kx1, kv1, 0.0_wp, 1)
+      ! (for the retries and refinements of this step, and the location)
+      if (.not. scene%stage_powers) call kept%keep(kept%now, a%t, f0, kv1)
     end if
     call scene%forcing%force_all(a%t + half, fm)
     call scene%forcing%force_all(a%t + step, f1)
@@ -204,12 +235,7 @@ contains
       ! (stage 1's forces and arithmetic at b: the next step's first stage)
       if (scene%springs%present) call add_element_forces(scene, b%x, b%x_lo, v1, f)
       call mode%acceleration(f, acc_end)
-      associate (e => 3 - kept%now)
-        kept%f(:, e) = f1
-        kept%acc(:, e) = acc_end
-        kept%t(e) = a%t + step
-        kept%valid(e) = .true.
-      end associate
+      call kept%keep(3 - kept%now, a%t + step, f1, acc_end)
     end if
     vm = 0.5_wp * (v0 + v1) + 0.125_wp * step * (kv1 - acc_end)
     call add_compensated(b%work, b%work_lo, step / 6.0_wp * (dot_product(f0, v0) + &
@@ -431,12 +457,13 @@ contains
   !> Earliest event in (0, step] of the step from a to b: a gap of a row not held closing, a
   !> body sliding with friction stopping, or (forces that vary) the mode failing; found and
   !> index say what and where (found_none: theta past the step).
-  subroutine locate_nbody(scene, mode, work, polynomial, a, b, step, theta, found, index)
+  subroutine locate_nbody(scene, mode, work, polynomial, a, b, step, kept, theta, found, index)
     type(scene_type), intent(in) :: scene
     type(body_mode_type), intent(in) :: mode
     type(mode_work_type), intent(inout) :: work
     logical, intent(in) :: polynomial     !< the motion is a cubic: the dense output is exact
     type(state_type), intent(in) :: a, b
+    type(kept_forces_type), intent(in) :: kept      !< the step's (its external forces at a)
     real(wp), intent(in) :: step
     real(wp), intent(out) :: theta
     integer, intent(out) :: found, index
@@ -447,7 +474,11 @@ contains
     found = found_none
     index = 0
     call dense_output(a, b, step, c)
-    call nbody_force(scene, a%t, a%x, a%x_lo, a%v, f, mode%engaged)
+    if (kept%holds(a%t)) then
+      call nbody_force(scene, a%t, a%x, a%x_lo, a%v, f, mode%engaged, kept%f(:, kept%now))
+    else
+      call nbody_force(scene, a%t, a%x, a%x_lo, a%v, f, mode%engaged)
+    end if
     if (scene%stribeck) call add_stribeck_forces(scene, mode%sgn, a%v, f)
     call mode_acceleration(scene, mode, a%t, f, acc0)
     acc_rounding = 1.0e3_wp * eps_wp * sum(abs(f)) / minval(scene%body_mass)
