@@ -727,9 +727,6 @@ contains
     if (allocated(error)) return
     call set_frictions(records, scene, error)
     if (allocated(error)) return
-    if (scene%belts .or. scene%stribeck) call refuse_stops(records, 'cannot be combined with belt_v, v_s ' // &
-      'or c_v yet (the two have not been tested together)', error)
-    if (allocated(error)) return
     call set_records(input, records, scene)
     if (scene%drives%n > 0) call refuse_drives(scene, error)
     if (allocated(error)) return
