@@ -602,7 +602,7 @@ contains
     logical function holds_at(tau)
       real(wp), intent(in) :: tau
       type(body_mode_type) :: probe
-      real(wp), dimension(scene%n_bodies) :: f, df, dx, v
+      real(wp), dimension(scene%n_bodies) :: f, df, dx, v, sliding
       integer :: status
       dx = a%x_lo + tau * (c(1, :) + tau * (c(2, :) + tau * c(3, :)))
       v = c(1, :) + tau * (2.0_wp * c(2, :) + 3.0_wp * tau * c(3, :))
@@ -618,6 +618,13 @@ contains
       probe = mode
       call solve_body_mode(scene, work, f, df, v, mode%active, probe, status)
       holds_at = status == mode_solved
+      if (holds_at .and. scene%stribeck) then
+        ! begun weighs the probe's loads: on the bodies that slide in both modes they hold
+        ! Stribeck's part of sliding friction, beyond f_slide's -F sgn (without it a group
+        ! pushed by c(u) > F did not break a friction contact away at its bound)
+        sliding = merge(probe%sgn, 0.0_wp, .not. mode%stuck)
+        call add_stribeck_forces(scene, sliding, v, f)
+      end if
       if (holds_at) holds_at = same_mode(probe, mode) .or. .not. begun(probe, f)
     end function holds_at
 

@@ -44,12 +44,14 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import subprocess
 
 import numpy as np
 import pytest
 
 import impact1d
 import test_friction_laws as laws
+import tools
 
 M, MU, MUS, G = 1.0, 0.3, 0.5, 9.81
 F, S = MU * M * G, MUS * M * G
@@ -315,3 +317,62 @@ def test_stuck_pair_on_a_stribeck_belt_moves_as_one_body(dt, tol):
     np.testing.assert_allclose(b.v[:, 1], a.v[:, 0], rtol=0, atol=tol)
     np.testing.assert_allclose(b.x[:, 1], a.x[:, 0], rtol=0, atol=tol)
     assert abs(b.energy_residual) < residual_bound(dt)
+
+
+def test_cli_runs_and_reads_back_a_scene_with_every_law(tmp_path):
+    """A namelist naming a belt, Stribeck's law, a compliant stop and a friction contact at
+    once: the CLI runs it as Python does, its header writes them all, and read_output rebuilds
+    the scene (the same events again)."""
+    nml = tmp_path / "all.nml"
+    nml.write_text("&bodies m = 2.0, 1.0, mu = 0.5, 0.0, mus = 1.0, 0.0, g = 9.81, belt_v = 0.5, 0.0, "
+                   "v_s = 0.5, 0.5 /\n&initial x = 0.0, 10.0, v = 0.5, 0.5 /\n"
+                   "&contact a = 0, b = 1, d_max = 0.05, k = 100.0, c = 2.0, name = 'soft' /\n"
+                   "&friction a = 1, b = 2, mu = 0.3, mus = 0.4, normal = 9.81, name = 'pad' /\n"
+                   "&run t_end = 2.0, dt = 1.0e-3 /\n")
+    out = tmp_path / "all.dat"
+    subprocess.run([tools.find_tool("impact1d"), str(nml), "-o", str(out)], check=True, capture_output=True)
+    text = out.read_text()
+    for line in ("# belt_v = 0.5 0.0", "# v_s = 0.5 0.5", "# contact.1.k = 100.0", "# friction.1.name = pad"):
+        assert line in text
+    back = impact1d.read_output(out)
+    assert back.scene.belt_v == [0.5, 0.0] and back.scene.v_s == [0.5, 0.5]
+    assert back.scene.frictions[0]["name"] == "pad" and back.scene.contacts[0]["k"] == 100.0
+    kinds = list(back.events["kind"])
+    assert "soft" in kinds and "slip_pad" in kinds
+    mine = impact1d.simulate(impact1d.load_scene(str(nml)))
+    assert list(mine.events["kind"]) == kinds
+    np.testing.assert_allclose(mine.events["t"], back.events["t"], rtol=0, atol=1e-12)
+    again = impact1d.simulate(back.scene)
+    assert list(again.events["kind"]) == kinds
+    np.testing.assert_allclose(again.events["t"], back.events["t"], rtol=0, atol=1e-12)
+
+
+# (RK4 on the nonlinear drag: measured 1.2e-6 s at dt = 0.02)
+@pytest.mark.parametrize("dt, tol", [(1e-3, 1e-9), (0.02, 5e-6)])
+def test_stribeck_push_breaks_a_stuck_contact_away_at_its_bound(dt, tol):
+    """(h) Block 1 (m1, Stribeck's law, c_v = 0) starts at rest on a belt at V, block 2 (m2, no
+    friction of its own) stuck on it through 'pad'. The belt drags the pair, u = v1 - V < 0:
+    (m1 + m2) u' = c(u), c(u) = F + (S - F) exp(-(u / v_s)^2), which grows as u nears 0, and
+    the contact must give block 2 m2 c(u) / (m1 + m2): it breaks away where that reaches
+    mus N, c(u*) = mus N (m1 + m2) / m2, u* = -v_s sqrt(ln((S - F) / (c(u*) - F))), at
+        t* = integral from -V to u* of (m1 + m2) / c(u) du
+    (mpmath's quadrature at 50 digits), both at V + u*. Before the mend the mode's hold test
+    weighed the pair's load with F, not c(u): the contact held on until just before the
+    block's stick."""
+    v, vs, m1, mu1, mus1 = 0.5, 0.2, 2.0, 0.15, 1.0
+    f1, s1 = mu1 * m1 * G, mus1 * m1 * G
+    bound = S_P * (m1 + M2) / M2
+    assert f1 < bound < s1
+    scene = impact1d.Scene(m=[m1, M2], x=[-10.0, 0.0], v=[0.0, 0.0], g=G, mu=[mu1, 0.0], mus=[mus1, 0.0],
+                           belt_v=[v, 0.0], v_s=[vs, vs], t_end=0.6, dt=dt, frictions=pad())
+    result = impact1d.simulate(scene)
+    kinds, times = kinds_and_times(result)
+    assert kinds[0] == "slip_pad"
+    mp = pytest.importorskip("mpmath")
+    with mp.workdps(50):
+        c = lambda u: f1 + (s1 - f1) * mp.exp(-(u / vs) ** 2)  # noqa: E731
+        u_star = -vs * mp.sqrt(mp.log((s1 - f1) / (mp.mpf(bound) - f1)))
+        t_star = mp.quad(lambda u: (m1 + M2) / c(u), [-v, u_star])
+    assert times[0] == pytest.approx(float(t_star), abs=tol)
+    first = result.events[0]
+    assert first["v1_before"] == first["v2_before"] == pytest.approx(v + float(u_star), abs=tol * 10)
