@@ -17,7 +17,7 @@ module impact1d_nbody_step
   implicit none
   private
   public :: nbody_force, nbody_rate, nbody_step, row_gap, row_velocity, row_gap_tolerance, locate_nbody, &
-    refine_nbody, gaps_hold, mode_acceleration, ground_motion
+    refine_nbody, gaps_hold, mode_acceleration, ground_motion, row_abs
   public :: found_none, found_row, found_body, found_hold, found_stop, found_friction, stop_gap_band, stop_force_band
 
   !> What a location found: a row's gap closing (a compliant stop's too: its engagement), a
