@@ -148,6 +148,7 @@ contains
         .and. index == i) .or. abs(slip(scene, i, s%v(i))) <= velocity_rounding * abs(acc(i)) * scene%dt)
       if (stopped(i)) call zero_velocity(scene, s, i)
     end do
+    if (scene%n_frictions > 0 .and. .not. initial .and. any(stopped)) call carry_stopped(scene, mode, stopped, s)
     if (found == found_friction) call relative_rest(scene, mode, index, s)
     call lock_rigid(scene, closed, stopped, s, work, sink, stats)
     call impacts(scene, closed, entry_scale, acc, s, work, hit, sink, stats, error)
@@ -883,7 +884,7 @@ contains
     type(error_type), allocatable :: ignored
     integer :: k, e, p
     real(wp) :: accel_bound, u
-    call zero_stopped(scene, s, acc, entry_scale)
+    call zero_stopped(scene, mode, s, acc, entry_scale)
     associate (rows => work%closed_rows(:work%n_closed))
       call joint_projection(scene, work, closed, rows, s%t, s%v, spread(0.0_wp, 1, scene%n_rows), v_after, pushed, &
         ignored)
@@ -917,7 +918,7 @@ contains
       if (u > time_rounding * max(abs(s%t), scene%dt) * accel_bound) cycle
       call settle_bounce_series(scene, mode, k, u, f, df, closed, acc, entry_scale, s, event_log, work, sink, stats)
     end do
-    call zero_stopped(scene, s, acc, entry_scale)
+    call zero_stopped(scene, mode, s, acc, entry_scale)
     do p = 1, work%n_closed
       k = work%closed_rows(p)
       if (scene%row_body(1, k) == 0) cycle
@@ -1292,16 +1293,21 @@ contains
   end subroutine sort_increasing
 
   !> Bodies whose velocity is below the rounding of what a step changes it by, or of the
-  !> velocities this event point started from, are at rest.
-  pure subroutine zero_stopped(scene, s, acc, entry_scale)
+  !> velocities this event point started from, are at rest (and with friction contacts,
+  !> what moved with them in the mode: carry_stopped).
+  pure subroutine zero_stopped(scene, mode, s, acc, entry_scale)
     type(scene_type), intent(in) :: scene
+    type(body_mode_type), intent(in) :: mode
     type(state_type), intent(inout) :: s
     real(wp), intent(in) :: acc(:), entry_scale(:)
+    logical :: zeroed(scene%n_bodies)
     integer :: i
     do i = 1, scene%n_bodies
-      if (s%v(i) /= rest_velocity(scene, i) .and. abs(s%v(i) - rest_velocity(scene, i)) <= velocity_rounding * &
-          max(abs(acc(i)) * scene%dt, entry_scale(i))) call zero_velocity(scene, s, i)
+      zeroed(i) = s%v(i) /= rest_velocity(scene, i) .and. abs(s%v(i) - rest_velocity(scene, i)) <= &
+        velocity_rounding * max(abs(acc(i)) * scene%dt, entry_scale(i))
+      if (zeroed(i)) call zero_velocity(scene, s, i)
     end do
+    if (scene%n_frictions > 0 .and. any(zeroed)) call carry_stopped(scene, mode, zeroed, s)
   end subroutine zero_stopped
 
   !> The velocity at which body i rests: its belt's when it has one and friction to hold it
@@ -1388,6 +1394,34 @@ contains
       moved = mode%group(i) /= 0 .and. (mode%group(i) == ga .or. mode%group(i) == gb)
     end function moved
   end subroutine relative_rest
+
+  !> The bodies that moved in one group with a body friction has just stopped (joined by
+  !> friction contacts stuck in the old mode: their velocities were equal) take its velocity,
+  !> the rounding-level energy booked to friction. On a belt the stopped body is put at the
+  !> belt's speed, which its partners (not at rest on their own) would otherwise miss by
+  !> the rounding: the contact would then seem to slide, and slip and stick at once.
+  pure subroutine carry_stopped(scene, mode, stopped, s)
+    type(scene_type), intent(in) :: scene
+    type(body_mode_type), intent(in) :: mode
+    logical, intent(in) :: stopped(:)
+    type(state_type), intent(inout) :: s
+    real(wp) :: carried(0:scene%n_bodies)
+    logical :: halted(0:scene%n_bodies)
+    integer :: i
+    halted = .false.
+    do i = 1, scene%n_bodies
+      if (.not. stopped(i) .or. mode%group(i) == 0) cycle
+      halted(mode%group(i)) = .true.
+      carried(mode%group(i)) = s%v(i)
+    end do
+    do i = 1, scene%n_bodies
+      if (stopped(i) .or. .not. halted(mode%group(i))) cycle
+      call add_compensated(s%friction_loss, s%friction_lo, 0.5_wp * scene%body_mass(i) * &
+        (s%v(i)**2 - carried(mode%group(i))**2))
+      s%v(i) = carried(mode%group(i))
+      s%v_lo(i) = 0.0_wp
+    end do
+  end subroutine carry_stopped
 
   !> Kinetic energy of the bodies at velocities v.
   pure real(wp) function kinetic(scene, v)

@@ -13,7 +13,7 @@ module impact1d_nbody_step
     element_drive_power, add_stop_forces, add_stop_rates, stop_damping_power, stop_release_loss, stop_drive_power
   use impact1d_body_mode, only: body_mode_type, mode_work_type, solve_body_mode, same_mode, mode_solved, &
     drive_accelerations, shift_to_drives, relative_velocity
-  use impact1d_friction_laws, only: slip, add_stribeck_forces, law_powers
+  use impact1d_friction_laws, only: slip, add_stribeck_forces, law_powers, contact_loss
   implicit none
   private
   public :: nbody_force, nbody_rate, nbody_step, row_gap, row_velocity, row_gap_tolerance, locate_nbody, &
@@ -217,6 +217,8 @@ contains
       drive_power = drive_power + held_drive_power(scene, mode, t, f, acc)
       if (scene%belts .or. scene%stribeck) call law_powers(scene, mode%f_slide, mode%sgn, mode%group, &
         mode%drive, f, v, loss(k), belt(k))
+      if ((scene%belts .or. scene%stribeck) .and. scene%n_frictions > 0) &
+        loss(k) = loss(k) + contact_loss(scene, mode%friction_sgn, v)
     end subroutine moving_stage
 
     !> Friction's loss and the belts' work over the step, by RK4's quadrature of the stages'
@@ -600,7 +602,7 @@ contains
     logical function holds_at(tau)
       real(wp), intent(in) :: tau
       type(body_mode_type) :: probe
-      real(wp), dimension(scene%n_bodies) :: f, df, dx, v
+      real(wp), dimension(scene%n_bodies) :: f, df, dx, v, sliding
       integer :: status
       dx = a%x_lo + tau * (c(1, :) + tau * (c(2, :) + tau * c(3, :)))
       v = c(1, :) + tau * (2.0_wp * c(2, :) + 3.0_wp * tau * c(3, :))
@@ -616,6 +618,13 @@ contains
       probe = mode
       call solve_body_mode(scene, work, f, df, v, mode%active, probe, status)
       holds_at = status == mode_solved
+      if (holds_at .and. scene%stribeck) then
+        ! begun weighs the probe's loads: on the bodies that slide in both modes they hold
+        ! Stribeck's part of sliding friction, beyond f_slide's -F sgn (without it a group
+        ! pushed by c(u) > F did not break a friction contact away at its bound)
+        sliding = merge(probe%sgn, 0.0_wp, .not. mode%stuck)
+        call add_stribeck_forces(scene, sliding, v, f)
+      end if
       if (holds_at) holds_at = same_mode(probe, mode) .or. .not. begun(probe, f)
     end function holds_at
 

@@ -727,9 +727,6 @@ contains
     if (allocated(error)) return
     call set_frictions(records, scene, error)
     if (allocated(error)) return
-    if (scene%belts .or. scene%stribeck) call refuse_stops(records, 'cannot be combined with belt_v, v_s ' // &
-      'or c_v yet (the two have not been tested together)', error)
-    if (allocated(error)) return
     call set_records(input, records, scene)
     if (scene%drives%n > 0) call refuse_drives(scene, error)
     if (allocated(error)) return
@@ -787,7 +784,7 @@ contains
   end subroutine set_laws
 
   !> The &friction records (friction contacts between two bodies), which only the N-body
-  !> engine runs (impact1d_solver's run): neither the vissim method nor compliant stops.
+  !> engine runs (impact1d_solver's run): not the vissim method.
   subroutine set_frictions(records, scene, error)
     type(mechanism_records), intent(in) :: records
     type(scene_type), intent(inout) :: scene
@@ -797,14 +794,6 @@ contains
     if (scene%method == 'vissim') then
       call raise(error, status_input, "method = 'vissim' is the tutorial's fixed-step scheme: a scene " // &
         'with friction between two bodies (&friction) runs with method = ''event''')
-      return
-    end if
-    call refuse_stops(records, 'cannot be combined with &friction records yet (the two have not ' // &
-      'been tested together)', error)
-    if (allocated(error)) return
-    ! (the friction laws' ledger, law_powers, books the bodies' own friction only)
-    if (scene%belts .or. scene%stribeck) then
-      call raise(error, status_input, '&friction records cannot be combined with belt_v, v_s or c_v yet')
       return
     end if
     scene%friction_body = records%friction_body
