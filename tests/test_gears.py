@@ -343,3 +343,40 @@ def test_a_plastic_geared_impact_leaves_the_gears_turning_with_their_ratio(dt):
     lost = 0.5 * J1 * 1.0**2 - 0.5 * (J1 * v1**2 + J2 * (N * v1)**2)
     assert r.impact_loss[-1] == pytest.approx(lost, abs=1e-15)
     assert np.max(np.abs(r.residual)) < 1e-15
+
+
+def test_a_loop_of_gears_whose_ratios_do_not_multiply_to_one_jams():
+    """Three shafts meshing in a loop, x2 = 2 x1, x3 = 2 x2 and x3 = 3 x1 (4 /= 3), plastic
+    flanks, a torque on shaft 1: once the backlash is taken up the only motion the meshes
+    allow is none, so the train stops and stays still (its held group is held, not moved
+    at one common acceleration), the ledger closing on the impacts' loss."""
+    scene = impact1d.Scene(m=[1.0, 0.5, 0.25], x=[0.0, 0.0, 0.0], f=[2.0, 0.0, 0.0], t_end=2.0, dt=1e-3,
+                           contacts=[{"a": a, "b": b, "d_min": -0.01, "d_max": 0.01, "r_min": 0.0, "r_max": 0.0,
+                                      "ratio": n, "name": f"m{a}{b}"} for a, b, n in ((1, 2, 2.0), (2, 3, 2.0),
+                                                                                       (1, 3, 3.0))])
+    r = impact1d.simulate(scene)
+    last = max(e["t"] for e in r.events)
+    assert last < 1.0
+    late = r.t > last
+    assert np.all(r.v[late] == 0.0)
+    assert np.all(r.x[late] == r.x[-1])
+    assert np.max(np.abs(r.residual)) < 1e-14
+
+
+def test_a_geared_rattle_with_tooth_stiffness_closes_the_ledger():
+    """The rattle of input/gear_rattle.nml written with a ratio: a sine torque on gear 1
+    (on a shaft spring), a geared mesh with backlash and a geared tooth spring and damper on
+    the same x2 - 3 x1: impacts on both flanks, the springs' energy (pe) and the damper's
+    loss on the geared coordinate, and the ledger closes to rounding."""
+    scene = impact1d.Scene(m=[1.0, 0.5], x=[0.0, 0.0], f_amp=[5.0, 0.0], f_period=[0.5, 1.0], t_end=3.0, dt=1e-4,
+                           contacts=[{"a": 1, "b": 2, "d_min": -0.02, "d_max": 0.02, "r_min": 0.6, "r_max": 0.6,
+                                      "ratio": 3.0, "name": "mesh"}],
+                           springs=[{"a": 1, "b": 2, "k": 20.0, "d_rest": 0.0, "c": 0.2, "ratio": 3.0},
+                                    {"a": 0, "b": 1, "k": 200.0, "d_rest": 0.0}])
+    r = impact1d.simulate(scene)
+    kinds = {e["kind"] for e in r.events}
+    assert {"mesh_min", "mesh_max"} <= kinds
+    g = r.x[:, 1] - 3.0 * r.x[:, 0]
+    np.testing.assert_allclose(r.pe, 0.5 * 20.0 * g**2 + 0.5 * 200.0 * r.x[:, 0]**2, rtol=1e-12, atol=1e-15)
+    assert r.damping_loss[-1] > 0
+    assert np.max(np.abs(r.residual)) < 1e-12
