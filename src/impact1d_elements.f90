@@ -190,10 +190,7 @@ contains
     power = 0.0_wp
     if (present(t)) then
       do j = 1, scene%n_elements
-        associate (a => scene%element_body(1, j), b => scene%element_body(2, j))
-          power = power + scene%element_c(j) * ((at_end(v, b) - scene%element_ratio(j) * at_end(v, a)) - &
-            anchor(scene, j, 1, t))**2
-        end associate
+        power = power + scene%element_c(j) * elongation_rate(scene, j, v, t)**2
       end do
       return
     end if
