@@ -8,7 +8,7 @@ module impact1d_nbody_event
   use impact1d_kinds, only: wp, eps_wp
   use impact1d_error, only: error_type, raise, status_simulation, fmt
   use impact1d_scene, only: scene_type
-  use impact1d_state, only: state_type, add_compensated
+  use impact1d_state, only: state_type, add_compensated, product_error
   use impact1d_output, only: sink_type, run_stats, class_impact, class_rest, class_stick, class_slip, class_release, &
     class_pair_stick, class_pair_slip
   use impact1d_yardsticks, only: gap_rounding, velocity_rounding, time_rounding, energy_rounding, same_instant, &
@@ -171,7 +171,8 @@ contains
     ! (solved in place: the old mode is not read past here but for its friction contacts'
     ! stuck flags, kept for the log; a failed solve ends the run)
     if (scene%n_frictions > 0 .and. .not. initial) pair_was_stuck = mode%friction_stuck
-    if (initial .or. .not. work%frictionless .or. scene%drives%n > 0) then
+    ! (geared groups' scaled accelerations are set_groups' alone: no scoped shortcut)
+    if (initial .or. .not. work%frictionless .or. scene%drives%n > 0 .or. scene%geared) then
       call solve_mode_at(scene, work%mode, s%t, f, df, s%v, candidate, mode, status)
       work%mode_tracked = .false.
     else
@@ -348,6 +349,16 @@ contains
         associate (ea => scene%row_body(1, k), eb => scene%row_body(2, k))
           if (placed(ea) .eqv. placed(eb)) cycle
           limit = -scene%row_offset(k) / scene%row_normal(2, k)
+          if (scene%geared) then
+            ! (a geared row, x_b - n x_a = limit)
+            if (abs(scene%row_normal(1, k)) /= 1.0_wp) then
+              call place_geared(ea, eb, abs(scene%row_normal(1, k)), limit, placed(ea), s)
+              placed(ea) = .true.
+              placed(eb) = .true.
+              grew = .true.
+              cycle
+            end if
+          end if
           if (placed(ea)) then
             s%x(eb) = s%x(ea)
             s%x_lo(eb) = s%x_lo(ea)
@@ -376,6 +387,28 @@ contains
     end do
 
   contains
+
+    !> A geared row's ends on x_b - n x_a = limit, b placed from a (from_a) or a from b,
+    !> the products' rounding errors kept in the low parts (impact1d_state's product_error).
+    pure subroutine place_geared(a, b, n, limit, from_a, s)
+      integer, intent(in) :: a, b
+      real(wp), intent(in) :: n, limit
+      logical, intent(in) :: from_a
+      type(state_type), intent(inout) :: s
+      real(wp) :: y, y_lo
+      if (from_a) then
+        s%x(b) = n * s%x(a)
+        s%x_lo(b) = n * s%x_lo(a) + product_error(n, s%x(a))
+        call add_compensated(s%x(b), s%x_lo(b), limit)
+      else
+        y = s%x(b)
+        y_lo = s%x_lo(b)
+        call add_compensated(y, y_lo, -limit)
+        s%x(a) = y / n
+        ! (y - n x_a is exact: the two are within a rounding of each other)
+        s%x_lo(a) = (((y - n * s%x(a)) - product_error(n, s%x(a))) + y_lo) / n
+      end if
+    end subroutine place_geared
 
     !> Body b on row k's ground end: w(t + t_lo) as its two parts (impact1d_drives'
     !> position_parts).
@@ -478,7 +511,9 @@ contains
     tol = 0.0_wp
     do e = 1, 2
       i = scene%row_body(e, k)
-      if (i > 0) tol = tol + max(abs(v(i)) + abs(acc(i)) * scene%dt, entry_scale(i))
+      ! (|n_e| = 1 but on a geared row's a end)
+      if (i > 0) tol = tol + abs(scene%row_normal(e, k)) * max(abs(v(i)) + abs(acc(i)) * scene%dt, &
+        entry_scale(i))
     end do
     tol = velocity_rounding * tol
   end function u_tolerance
@@ -596,13 +631,17 @@ contains
 
   !> impact1d_accumulation's join_cycle (the bodies the rows marked join move as one, at rest
   !> when joined to the ground) at t: with moving grounds, moving with the ground they are
-  !> joined to.
+  !> joined to; geared rows (docs/method.md section 14) join nothing.
   subroutine join_moving(scene, rows, t, v)
     type(scene_type), intent(in) :: scene
     logical, intent(in) :: rows(:)
     real(wp), intent(in) :: t
     real(wp), intent(inout) :: v(:)
     real(wp) :: frame(scene%n_bodies)
+    if (scene%geared) then
+      call join_unit_rows(scene, rows, v)
+      return
+    end if
     if (scene%drives%n == 0) then
       call join_cycle(scene%row_body, rows, scene%body_mass, v)
       return
@@ -612,6 +651,17 @@ contains
     call join_cycle(scene%row_body, rows, scene%body_mass, v)
     v = v + frame
   end subroutine join_moving
+
+  !> join_moving in a geared scene: the rows marked that are walls or of unit ratio join
+  !> their ends; a geared row's do not move alike (its impulse left v_b - n v_a at 0 itself).
+  !> Apart from join_moving, so that the event point keeps it inlined.
+  subroutine join_unit_rows(scene, rows, v)
+    type(scene_type), intent(in) :: scene
+    logical, intent(in) :: rows(:)
+    real(wp), intent(inout) :: v(:)
+    call join_cycle(scene%row_body, rows .and. (scene%row_body(1, :scene%n_rows) == 0 .or. &
+      abs(scene%row_normal(1, :scene%n_rows)) == 1.0_wp), scene%body_mass, v)
+  end subroutine join_unit_rows
 
   !> Each body's moving ground's velocity at t through the rows marked (0: none).
   pure function frame_velocity(scene, rows, t) result(frame)
@@ -759,7 +809,12 @@ contains
       if (root(e) > 0) inverse(e) = 1.0_wp / work%rigid_mass(root(e))
     end do
     if (root(1) == root(2) .or. sum(inverse) == 0.0_wp) return
-    p = -(1.0_wp + r) * row_velocity(scene, k, v, t) / sum(inverse)
+    if (scene%geared) then
+      ! (a geared row's normal (-n, 1): its effective mass is 1 / (n^2 / m_a + 1 / m_b))
+      p = -(1.0_wp + r) * row_velocity(scene, k, v, t) / sum(inverse * scene%row_normal(:, k)**2)
+    else
+      p = -(1.0_wp + r) * row_velocity(scene, k, v, t) / sum(inverse)
+    end if
     if (.not. work%any_rigid) then
       ! (each body its own group: the row's ends alone)
       do e = 1, 2
@@ -904,7 +959,8 @@ contains
     ! grounds, whose rows follow w''; nor with rigid links, whose impulses' union-find steps
     ! must all be taken; nor under Stribeck's law, whose viscous part has no bound)
     accel_bound = huge(1.0_wp)
-    if (work%n_closed > 0 .and. scene%drives%n == 0 .and. .not. work%any_rigid .and. .not. scene%stribeck) &
+    if (work%n_closed > 0 .and. scene%drives%n == 0 .and. .not. work%any_rigid .and. .not. scene%stribeck .and. &
+        .not. scene%geared) &
       accel_bound = 4.0_wp * (sum(abs(f)) + sum(max(scene%body_friction, scene%body_static))) / &
       minval(scene%body_mass)
     do p = 1, work%n_closed
@@ -1026,7 +1082,7 @@ contains
     a_gap = 0.0_wp
     a_end = 0.0_wp
     ! (friction contacts between bodies join clusters the rows' incidence lists do not see)
-    scoped = scene%drives%n == 0 .and. scene%n_frictions == 0
+    scoped = scene%drives%n == 0 .and. scene%n_frictions == 0 .and. .not. scene%geared
     if (.not. scoped) return
     do e = 1, 2
       if (scene%row_body(e, k) == 0) cycle
@@ -1534,7 +1590,11 @@ contains
       if (ready) return
       ready = .true.
       call mode_acceleration(scene, new, s%t, f, acc)
-      call new%rate_response(df, acc_rate)
+      if (scene%geared) then
+        call new%geared_response(df, acc_rate)
+      else
+        call new%rate_response(df, acc_rate)
+      end if
       if (scene%drives%n > 0) call drive_accelerations(scene, new, s%t, 3, acc_rate)
       tol_a = 1.0e3_wp * eps_wp * force_scale(scene, f, df) / scene%body_mass
       rate_tol = 1.0e3_wp * eps_wp * sum(abs(df))

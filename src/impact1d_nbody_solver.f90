@@ -161,7 +161,7 @@ contains
     type(state_type), intent(in) :: s
     pe = 0.0_wp
     if (.not. scene%springs%present) return
-    if (scene%drives%n > 0) then
+    if (scene%gap_terms) then
       pe = element_potential(scene, s%x, s%x_lo, s%t)
     else
       pe = element_potential(scene, s%x, s%x_lo)
