@@ -1,8 +1,9 @@
 !> The N-body engine's driver (docs/method.md section 9): the two-body engine's method on
 !> N-long arrays. From the current state it picks the next stop (sample time, table corner
-!> or pending rest), takes one RK4 step toward it, locates the earliest event inside the step
-!> on the dense output (impact1d_nbody_step), re-takes the step to it, and calls the event
-!> point (impact1d_nbody_event); samples go to the sink at sample times. impact1d_solver's
+!> or pending rest), takes the steps before the mode's quiet time in closed form under
+!> constant forces (impact1d_nbody_glide), then one RK4 step toward it, locates the earliest
+!> event inside the step on the dense output (impact1d_nbody_step), re-takes the step to it,
+!> and calls the event point (impact1d_nbody_event); samples go to the sink at sample times. impact1d_solver's
 !> run hands scenes of more than two bodies here.
 module impact1d_nbody_solver
   use, intrinsic :: iso_fortran_env, only: int64
@@ -18,6 +19,7 @@ module impact1d_nbody_solver
   use impact1d_nbody_step, only: nbody_step, nbody_force, locate_nbody, refine_nbody, gaps_hold, row_gap, &
     row_velocity, row_gap_tolerance, found_none, found_row, kept_forces_type
   use impact1d_nbody_event, only: point_work_type, new_point_work, nbody_event_point
+  use impact1d_nbody_glide, only: glide_type, new_glide, find_quiet_time, glide
   implicit none
   private
   public :: run_nbody
@@ -34,16 +36,21 @@ module impact1d_nbody_solver
     !> Tables and constants only: the dense output is exact, so no root can be missed.
     logical :: polynomial = .false.
     real(wp) :: ke0 = 0.0_wp, pe0 = 0.0_wp
+    !> Constant forces: the steps before the mode's quiet time in closed form.
+    type(glide_type) :: glide
   end type nbody_run_type
 
 contains
 
   !> Run an N-body scene from t = 0 to t_end, every dt_out sample and every event to sink.
-  subroutine run_nbody(scene, sink, stats, error)
+  subroutine run_nbody(scene, sink, stats, error, closed_form)
     type(scene_type), intent(in) :: scene
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
     type(error_type), allocatable, intent(inout) :: error
+    !> .false.: every step taken with its location, none in closed form (tests compare the
+    !> two: the same bits); default .true.
+    logical, intent(in), optional :: closed_form
     type(state_type) :: s, trial
     type(nbody_run_type) :: r
     real(wp) :: sample_t, t_break, t_rest, t_stop, window_start
@@ -51,8 +58,10 @@ contains
     logical :: at_stop, event_due
 
     call start(scene, s, trial, r)
+    if (present(closed_form)) r%glide%able = r%glide%able .and. closed_form
     call nbody_event_point(scene, .true., found_none, 0, s, r%mode, r%event_log, r%work, sink, stats, error)
     if (allocated(error)) return
+    call find_quiet_time(scene, r%mode, s, r%glide)
     j_sample = 0
     call emit(scene, s, r, j_sample, sink, stats, error)
     if (allocated(error)) return
@@ -65,7 +74,16 @@ contains
       t_rest = huge(1.0_wp)
       if (scene%n_rows > 0) t_rest = minval(r%event_log%pending_rest)
       t_stop = min(sample_t, t_break, t_rest)
-      call advance(scene, r, t_stop, s, trial, found, index, at_stop, sink, stats, error)
+      ! The steps that can meet no event in closed form; then one located step (advance).
+      at_stop = .false.
+      if (r%glide%able) then
+        call glide(scene, r%mode, r%glide, t_stop, s, at_stop, sink, stats, error)
+        call r%kept%forget()     ! (the state moved without advance: nothing kept holds)
+      end if
+      if (allocated(error)) return
+      found = found_none
+      index = 0
+      if (.not. at_stop) call advance(scene, r, t_stop, s, trial, found, index, at_stop, sink, stats, error)
       if (allocated(error)) return
       event_due = found /= found_none
       if (.not. event_due .and. at_stop) event_due = t_stop == t_break .or. t_stop == t_rest .or. &
@@ -89,6 +107,7 @@ contains
         call nbody_event_point(scene, .false., found, index, s, r%mode, r%event_log, r%work, sink, stats, error)
         if (allocated(error)) return
         call r%kept%forget()
+        call find_quiet_time(scene, r%mode, s, r%glide)
       end if
       if (at_stop .and. s%t == sample_t) then
         call emit(scene, s, r, j_sample, sink, stats, error)
@@ -116,6 +135,7 @@ contains
     end if
     call new_point_work(scene%n_bodies, r%work)
     call r%kept%reserve(scene%n_bodies)
+    call new_glide(scene, r%glide)
     call r%event_log%allocate_log(scene%n_rows, scene%n_bodies)
     r%polynomial = scene%forcing%is_polynomial() .and. .not. scene%springs%present .and. scene%drives%polynomial &
       .and. .not. scene%stribeck
@@ -148,7 +168,7 @@ contains
     type(state_type), intent(in) :: s
     pe = 0.0_wp
     if (.not. scene%springs%present) return
-    if (scene%drives%n > 0) then
+    if (scene%gap_terms) then
       pe = element_potential(scene, s%x, s%x_lo, s%t)
     else
       pe = element_potential(scene, s%x, s%x_lo)

@@ -6,18 +6,18 @@
 module impact1d_nbody_step
   use impact1d_kinds, only: wp, eps_wp
   use impact1d_scene, only: scene_type
-  use impact1d_state, only: state_type, add_compensated
+  use impact1d_state, only: state_type, add_compensated, product_error
   use impact1d_events, only: hermite, earliest_crossing, stop_force_cubic
   use impact1d_yardsticks, only: gap_rounding, velocity_rounding, time_rounding
   use impact1d_elements, only: add_element_forces, add_moving_element_forces, add_element_rates, element_damping_power, &
     element_drive_power, add_stop_forces, add_stop_rates, stop_damping_power, stop_release_loss, stop_drive_power
   use impact1d_body_mode, only: body_mode_type, mode_work_type, solve_body_mode, same_mode, mode_solved, &
     drive_accelerations, shift_to_drives, relative_velocity
-  use impact1d_friction_laws, only: slip, add_stribeck_forces, law_powers
+  use impact1d_friction_laws, only: slip, add_stribeck_forces, law_powers, contact_loss
   implicit none
   private
   public :: nbody_force, nbody_rate, nbody_step, row_gap, row_velocity, row_gap_tolerance, locate_nbody, &
-    refine_nbody, gaps_hold, mode_acceleration, ground_motion
+    refine_nbody, gaps_hold, mode_acceleration, ground_motion, row_abs
   public :: found_none, found_row, found_body, found_hold, found_stop, found_friction, stop_gap_band, stop_force_band
 
   !> What a location found: a row's gap closing (a compliant stop's too: its engagement), a
@@ -109,7 +109,8 @@ contains
       call scene%forcing%force_all(t, f)
     end if
     if (.not. scene%springs%present) return
-    if (scene%drives%n > 0) then
+    ! (geared elements are the moving ones' loop too: add_moving_element_forces)
+    if (scene%gap_terms) then
       call add_moving_element_forces(scene, x, dx, v, f, t)
     else
       call add_element_forces(scene, x, dx, v, f)
@@ -125,8 +126,15 @@ contains
     type(body_mode_type), intent(in) :: mode
     real(wp), intent(in) :: t, f(:)
     real(wp), intent(out) :: a(:)
-    call mode%acceleration(f, a)
-    if (scene%drives%n > 0) call drive_accelerations(scene, mode, t, 2, a)
+    if (.not. scene%gap_terms) then
+      call mode%acceleration(f, a)
+    else if (scene%geared) then
+      ! (geared groups, docs/method.md section 14; no moving grounds with them)
+      call mode%geared_response(f + mode%f_slide, a)
+    else
+      call mode%acceleration(f, a)
+      call drive_accelerations(scene, mode, t, 2, a)
+    end if
   end subroutine mode_acceleration
 
   !> The part of row k's gap (order 0), its rate (1), acceleration (2) or jerk (3) at t
@@ -229,6 +237,7 @@ contains
     v1 = b%v + b%v_lo
     f = f1
     kept%valid(3 - kept%now) = .false.
+    ! (geared scenes take the stage_powers path, whose accelerations are mode_acceleration's)
     if (scene%stage_powers) then
       call drive_step_ledger()
     else
@@ -246,7 +255,7 @@ contains
       call add_compensated(b%friction_loss, b%friction_lo, step / 6.0_wp * &
         dot_product(-mode%f_slide, v0 + 4.0_wp * vm + v1))
     end if
-    if (scene%drives%n > 0) then
+    if (scene%gap_terms) then
       if (scene%springs%present) call add_compensated(b%damping_loss, b%damping_lo, step / 6.0_wp * &
         (element_damping_power(scene, v0, a%t) + 4.0_wp * element_damping_power(scene, vm, a%t + half) + &
         element_damping_power(scene, v1, a%t + step)))
@@ -301,6 +310,8 @@ contains
       drive_power = drive_power + held_drive_power(scene, mode, t, f, acc)
       if (scene%belts .or. scene%stribeck) call law_powers(scene, mode%f_slide, mode%sgn, mode%group, &
         mode%drive, f, v, loss(k), belt(k))
+      if ((scene%belts .or. scene%stribeck) .and. scene%n_frictions > 0) &
+        loss(k) = loss(k) + contact_loss(scene, mode%friction_sgn, v)
     end subroutine moving_stage
 
     !> Friction's loss and the belts' work over the step, by RK4's quadrature of the stages'
@@ -389,7 +400,10 @@ contains
       q = n(2) * s%x(b)
       low = low + n(2) * s%x_lo(b)
     end associate
-    if (scene%drives%n > 0) then
+    if (scene%gap_terms) then
+      ! (a gear ratio's n x_a is rounded: its exact error joins the low part)
+      if (scene%geared .and. scene%row_body(1, k) > 0) low = low + product_error(scene%row_normal(1, k), &
+        s%x(scene%row_body(1, k)))
       ! (the ground's place to the clock's low part, as snap_closed puts a body on it)
       if (scene%row_drive(k) > 0) then
         call scene%drives%position_parts(scene%row_drive(k), s%t, s%t_lo, w, w_lo)
@@ -417,7 +431,8 @@ contains
     end if
   end function row_velocity
 
-  !> n_k . y with |n| (row k's ends' sum of |y|).
+  !> n_k . y with |n| (row k's ends' sum of |y|; a geared row's a end counts once, not n
+  !> times: what it rounds is the low parts, far below the step's term).
   pure real(wp) function row_abs(scene, k, y)
     type(scene_type), intent(in) :: scene
     integer, intent(in) :: k
@@ -540,7 +555,7 @@ contains
       q(1:3) = gap_rounding * abs(c(:, eb))
       if (ea > 0) then
         p(1:3) = p(1:3) + n(1) * c(:, ea)
-        q(1:3) = q(1:3) + gap_rounding * abs(c(:, ea))
+        q(1:3) = q(1:3) + gap_rounding * abs(n(1) * c(:, ea))
       else if (scene%drives%n > 0) then
         ! A moving ground end on its own cubic over the step (exact for ground_v; the
         ! step's end is checked on the exact w: gaps_hold).
@@ -689,7 +704,7 @@ contains
     logical function holds_at(tau)
       real(wp), intent(in) :: tau
       type(body_mode_type) :: probe
-      real(wp), dimension(scene%n_bodies) :: f, df, dx, v
+      real(wp), dimension(scene%n_bodies) :: f, df, dx, v, sliding
       integer :: status
       dx = a%x_lo + tau * (c(1, :) + tau * (c(2, :) + tau * c(3, :)))
       v = c(1, :) + tau * (2.0_wp * c(2, :) + 3.0_wp * tau * c(3, :))
@@ -705,6 +720,13 @@ contains
       probe = mode
       call solve_body_mode(scene, work, f, df, v, mode%active, probe, status)
       holds_at = status == mode_solved
+      if (holds_at .and. scene%stribeck) then
+        ! begun weighs the probe's loads: on the bodies that slide in both modes they hold
+        ! Stribeck's part of sliding friction, beyond f_slide's -F sgn (without it a group
+        ! pushed by c(u) > F did not break a friction contact away at its bound)
+        sliding = merge(probe%sgn, 0.0_wp, .not. mode%stuck)
+        call add_stribeck_forces(scene, sliding, v, f)
+      end if
       if (holds_at) holds_at = same_mode(probe, mode) .or. .not. begun(probe, f)
     end function holds_at
 
@@ -721,7 +743,11 @@ contains
       real(wp) :: acc(scene%n_bodies), way(scene%n_bodies), lead(0:scene%n_bodies)
       logical :: against
       integer :: i, k
-      call probe%acceleration(f, acc)
+      if (scene%geared) then
+        call probe%geared_response(f + probe%f_slide, acc)
+      else
+        call probe%acceleration(f, acc)
+      end if
       begun = any(probe%active .and. .not. mode%active) .or. any(probe%stuck .and. .not. mode%stuck)
       lead = 0.0_wp
       do i = 1, scene%n_bodies

@@ -8,7 +8,7 @@ module impact1d_state
   implicit none
   private
   public :: state_type, lane_state_type, load_lanes, new_state, take_state, add_compensated, accumulate, &
-    renormalise, finite_state, constant_step, constant_steps
+    renormalise, finite_state, constant_step, constant_steps, product_error
 
   !> Time, positions, velocities and the ledger integrals, compensated: a micrometre bounce
   !> near a wall at x = 10 m keeps its digits, and 10^6 steps of 1e-5 s do not drift the clock
@@ -135,6 +135,22 @@ contains
     lo = lo + ((hi - (total - rounded)) + (increment - rounded))
     hi = total
   end subroutine accumulate
+
+  !> The exact rounding error of the product a b: a b - fl(a b) (Dekker's two-product with
+  !> Veltkamp's split, no fused multiply-add: the build passes -ffp-contract=off; exact
+  !> while a b neither overflows nor underflows). A gear ratio's gap x_b - n x_a needs it.
+  elemental real(wp) function product_error(a, b) result(error)
+    real(wp), intent(in) :: a, b
+    real(wp), parameter :: split = 134217729.0_wp     ! 2^27 + 1
+    real(wp) :: a_hi, a_lo, b_hi, b_lo, c
+    c = split * a
+    a_hi = c - (c - a)
+    a_lo = a - a_hi
+    c = split * b
+    b_hi = c - (c - b)
+    b_lo = b - b_hi
+    error = (((a_hi * b_hi - a * b) + a_hi * b_lo) + a_lo * b_hi) + a_lo * b_lo
+  end function product_error
 
   !> hi becomes hi + lo correctly rounded and lo what is left (Fast2Sum, exact while |lo| is
   !> below |hi|, as it is but for a sum passing through zero).
