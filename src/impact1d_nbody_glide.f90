@@ -15,11 +15,11 @@ module impact1d_nbody_glide
   use impact1d_kinds, only: wp
   use impact1d_error, only: error_type, raise, status_simulation, fmt
   use impact1d_scene, only: scene_type, step_length
-  use impact1d_state, only: state_type, add_compensated, finite_state
+  use impact1d_state, only: state_type, add_compensated, finite_state, take_state
   use impact1d_output, only: sink_type, run_stats, checkpoint
   use impact1d_yardsticks, only: gap_rounding, velocity_rounding
   use impact1d_body_mode, only: body_mode_type, mode_work_type, relative_velocity
-  use impact1d_nbody_step, only: row_gap, row_velocity, row_abs, nbody_step, mode_crossing
+  use impact1d_nbody_step, only: row_gap, row_velocity, row_abs, nbody_step, mode_crossing, kept_forces_type
   use impact1d_location, only: first_negative
   implicit none
   private
@@ -198,12 +198,13 @@ contains
   !> step under the mode's constant accelerations (closed_step), or under tables nbody_step
   !> itself (into trial) without its location; at_stop: they reached the stop (the clock is
   !> then set to it, as advance does). Counted in stats as steps, and as glided.
-  subroutine glide(scene, mode, g, t_stop, s, trial, at_stop, sink, stats, error)
+  subroutine glide(scene, mode, g, t_stop, s, trial, kept, at_stop, sink, stats, error)
     type(scene_type), intent(in) :: scene
     type(body_mode_type), intent(in) :: mode
     type(glide_type), intent(in) :: g
     real(wp), intent(in) :: t_stop
     type(state_type), intent(inout) :: s, trial
+    type(kept_forces_type), intent(inout) :: kept   !< advance's: kept across the steps here too
     logical, intent(out) :: at_stop
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
@@ -215,10 +216,12 @@ contains
       h = step_length(scene%dt, remaining)
       if (h <= 0.0_wp .or. .not. s%t + h < g%t_quiet) exit
       if (g%table) then
-        call nbody_step(scene, mode, s, h, trial)
-        s = trial
+        call nbody_step(scene, mode, s, h, trial, kept)
+        call take_state(s, trial)
+        call kept%accept()
       else
         call closed_step(scene, mode, g, h, s)
+        call kept%forget()
       end if
       at_stop = h == remaining
       if (at_stop) then

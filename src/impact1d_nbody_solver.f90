@@ -10,14 +10,14 @@ module impact1d_nbody_solver
   use impact1d_kinds, only: wp
   use impact1d_error, only: error_type, raise, status_simulation, fmt
   use impact1d_scene, only: scene_type, sample_time, step_length
-  use impact1d_state, only: state_type, new_state, finite_state
+  use impact1d_state, only: state_type, new_state, take_state, finite_state
   use impact1d_output, only: sink_type, run_stats, emit_bodies, checkpoint
   use impact1d_event_log, only: event_log_type
   use impact1d_yardsticks, only: velocity_rounding
   use impact1d_elements, only: element_potential, stop_potential
   use impact1d_body_mode, only: body_mode_type, new_mode
   use impact1d_nbody_step, only: nbody_step, nbody_force, locate_nbody, refine_nbody, gaps_hold, row_gap, &
-    row_velocity, row_gap_tolerance, found_none, found_row
+    row_velocity, row_gap_tolerance, found_none, found_row, kept_forces_type
   use impact1d_nbody_event, only: point_work_type, new_point_work, nbody_event_point
   use impact1d_nbody_glide, only: glide_type, new_glide, find_quiet_time, glide
   implicit none
@@ -31,6 +31,8 @@ module impact1d_nbody_solver
     type(body_mode_type) :: mode
     type(point_work_type) :: work
     type(event_log_type) :: event_log
+    !> The last step's end forces, for the next step's first stage (nbody_step).
+    type(kept_forces_type) :: kept
     !> Tables and constants only: the dense output is exact, so no root can be missed.
     logical :: polynomial = .false.
     real(wp) :: ke0 = 0.0_wp, pe0 = 0.0_wp
@@ -74,7 +76,7 @@ contains
       t_stop = min(sample_t, t_break, t_rest)
       ! The steps that can meet no event in closed form; then one located step (advance).
       at_stop = .false.
-      if (r%glide%able) call glide(scene, r%mode, r%glide, t_stop, s, trial, at_stop, sink, stats, error)
+      if (r%glide%able) call glide(scene, r%mode, r%glide, t_stop, s, trial, r%kept, at_stop, sink, stats, error)
       if (allocated(error)) return
       found = found_none
       index = 0
@@ -101,6 +103,7 @@ contains
         call r%event_log%flush_pending_rest(scene, s%t, s%v, sink, stats)
         call nbody_event_point(scene, .false., found, index, s, r%mode, r%event_log, r%work, sink, stats, error)
         if (allocated(error)) return
+        call r%kept%forget()
         call find_quiet_time(scene, r%mode, r%work%mode, s, r%glide)
       end if
       if (at_stop .and. s%t == sample_t) then
@@ -128,6 +131,7 @@ contains
       r%mode%engaged = .false.
     end if
     call new_point_work(scene%n_bodies, r%work)
+    call r%kept%reserve(scene%n_bodies)
     call new_glide(scene, r%glide)
     call r%event_log%allocate_log(scene%n_rows, scene%n_bodies)
     r%polynomial = scene%forcing%is_polynomial() .and. .not. scene%springs%present .and. scene%drives%polynomial &
@@ -161,7 +165,7 @@ contains
     type(state_type), intent(in) :: s
     pe = 0.0_wp
     if (.not. scene%springs%present) return
-    if (scene%drives%n > 0) then
+    if (scene%gap_terms) then
       pe = element_potential(scene, s%x, s%x_lo, s%t)
     else
       pe = element_potential(scene, s%x, s%x_lo)
@@ -191,17 +195,19 @@ contains
       index = 0
       if (h <= 0.0_wp) then
         trial = s
+        call r%kept%forget()
         exit
       end if
-      call nbody_step(scene, r%mode, s, h, trial)
-      call locate_nbody(scene, r%mode, r%work%mode, r%polynomial, s, trial, h, theta, found, index)
+      call nbody_step(scene, r%mode, s, h, trial, r%kept)
+      call locate_nbody(scene, r%mode, r%work%mode, r%polynomial, s, trial, h, r%kept, theta, found, index)
       if (found /= found_none .and. theta <= h) then
         h_taken = h
         h = theta
         if (h > 0.0_wp) then
-          call refine_nbody(scene, r%mode, r%polynomial, s, h, found, index, trial, h_taken)
+          call refine_nbody(scene, r%mode, r%polynomial, s, h, found, index, trial, r%kept, h_taken)
         else
           trial = s
+          call r%kept%forget()
           exit
         end if
       else
@@ -218,7 +224,8 @@ contains
       h = 0.5_wp * h
     end do
     at_stop = found == found_none .and. h == (t_stop - s%t) - s%t_lo
-    s = trial
+    call take_state(s, trial)
+    call r%kept%accept()
     if (at_stop) then
       s%t = t_stop
       s%t_lo = 0.0_wp
