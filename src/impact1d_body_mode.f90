@@ -14,7 +14,9 @@
 !> ends move as one: the bodies fall into groups (union-find over held rows and stuck bodies,
 !> 0 the ground). A group joined to the ground or to a stuck body has a = 0; any other moves
 !> with a = (sum of f_i + f_slide_i) / (sum of m_i), its contact forces internal. That is
-!> O(N) per stage, whatever the clusters.
+!> O(N) per stage, whatever the clusters. A geared row (-n, 1) makes its ends move at v_b =
+!> n v_a instead: in a geared scene each body has a scale s_i in its group (gear_groups) and
+!> a_i = s_i (sum s_j f_j) / (sum m_j s_j^2) (docs/method.md section 14).
 module impact1d_body_mode
   use impact1d_kinds, only: wp
   use impact1d_scene, only: scene_type
@@ -42,6 +44,11 @@ module impact1d_body_mode
     real(wp), allocatable :: f_slide(:)      !< (N) the sliding friction forces -c_i sgn_i
     integer, allocatable :: group(:)         !< (N) the body's group (a union-find root); 0: held still
     real(wp), allocatable :: group_mass(:)   !< (0:N) mass of the group rooted at each index
+    !> (N) geared scenes only (scene%geared; else unallocated): each body's velocity per unit
+    !> of its group's, s_i (a held row of normal (-n, 1) makes v_b = n v_a); the group then
+    !> moves as one coordinate q with x_i' = s_i q', its mass sum m_i s_i^2 (group_mass) and
+    !> its force sum s_i f_i (docs/method.md section 14)
+    real(wp), allocatable :: scale(:)
     !> (N) the drive of the moving ground whose held rows hold the body's group (group 0),
     !> else 0 (scenes with drives only: set_groups)
     integer, allocatable :: drive(:)
@@ -60,6 +67,7 @@ module impact1d_body_mode
   contains
     procedure :: acceleration
     procedure :: rate_response
+    procedure :: geared_response
   end type body_mode_type
 
   !> The mode solve's memory, sized by the run (new_mode) and grown at event points only when
@@ -139,6 +147,26 @@ contains
       if (self%group(i) > 0) da(i) = load(self%group(i)) / self%group_mass(self%group(i))
     end do
   end subroutine rate_response
+
+  !> The accelerations a of a geared scene's groups under forces f: each group's coordinate
+  !> accelerates at sum s_i f_i / sum m_i s_i^2, body i at s_i times that (a geared scene's
+  !> acceleration, with f + f_slide, and rate_response: its callers choose, since a test
+  !> here cost every scene's RK4 stage; nbody_step's mode_acceleration).
+  pure subroutine geared_response(self, f, a)
+    class(body_mode_type), intent(in) :: self
+    real(wp), intent(in) :: f(:)
+    real(wp), intent(out) :: a(:)
+    real(wp) :: load(0:size(f))
+    integer :: i
+    load = 0.0_wp
+    do i = 1, size(f)
+      load(self%group(i)) = load(self%group(i)) + self%scale(i) * f(i)
+    end do
+    do i = 1, size(f)
+      a(i) = 0.0_wp
+      if (self%group(i) > 0) a(i) = self%scale(i) * (load(self%group(i)) / self%group_mass(self%group(i)))
+    end do
+  end subroutine geared_response
 
   !> Whether two modes hold the same rows, stick the same bodies and slide the same ways.
   pure logical function same_mode(a, b)
@@ -531,6 +559,7 @@ contains
       mode%group(i) = uf_find(root, i)
       mode%group_mass(mode%group(i)) = mode%group_mass(mode%group(i)) + scene%body_mass(i)
     end do
+    if (scene%geared) call gear_groups(scene, mode)
     mode%f_slide = -scene%body_friction * mode%sgn
     ! A friction contact sliding: -F sgn on b, its opposite on a.
     do k = 1, scene%n_frictions
@@ -543,6 +572,56 @@ contains
     if (scene%n_frictions > 0) mode%held = mode%held .or. any(mode%friction_stuck)
     if (scene%drives%n > 0) call drive_components(scene, mode%active, mode%drive)
   end subroutine set_groups
+
+  !> A geared scene's groups (set_groups' union-find roots in mode%group): each body's scale
+  !> s_i from its group's root (s = 1) along the held rows (n_a s_a + n_b s_b = 0), and the
+  !> groups' masses sum m_i s_i^2. A group whose held rows close a loop of ratios that do
+  !> not multiply to 1 cannot move: it is held still (group 0). Sweeps over the held rows
+  !> until nothing grows: O(rows x the longest train) at an event point, geared scenes only.
+  pure subroutine gear_groups(scene, mode)
+    type(scene_type), intent(in) :: scene
+    type(body_mode_type), intent(inout) :: mode
+    logical :: known(scene%n_bodies), grew, locked(0:scene%n_bodies)
+    integer :: i, k
+    real(wp) :: mismatch
+    if (.not. allocated(mode%scale)) allocate(mode%scale(scene%n_bodies))
+    mode%scale = 1.0_wp
+    do i = 1, scene%n_bodies
+      known(i) = mode%group(i) == i .or. mode%group(i) == 0
+    end do
+    grew = .true.
+    do while (grew)
+      grew = .false.
+      do k = 1, scene%n_rows
+        if (.not. mode%active(k) .or. scene%row_body(1, k) == 0) cycle
+        associate (a => scene%row_body(1, k), b => scene%row_body(2, k), n => scene%row_normal(:, k))
+          if (known(a) .eqv. known(b)) cycle
+          if (known(a)) then
+            mode%scale(b) = -(n(1) / n(2)) * mode%scale(a)
+            known(b) = .true.
+          else
+            mode%scale(a) = -(n(2) / n(1)) * mode%scale(b)
+            known(a) = .true.
+          end if
+          grew = .true.
+        end associate
+      end do
+    end do
+    locked = .false.
+    do k = 1, scene%n_rows
+      if (.not. mode%active(k) .or. scene%row_body(1, k) == 0) cycle
+      associate (a => scene%row_body(1, k), b => scene%row_body(2, k), n => scene%row_normal(:, k))
+        mismatch = n(1) * mode%scale(a) + n(2) * mode%scale(b)
+        if (abs(mismatch) > 16.0_wp * epsilon(1.0_wp) * (abs(n(1) * mode%scale(a)) + abs(mode%scale(b)))) &
+          locked(mode%group(a)) = .true.
+      end associate
+    end do
+    mode%group_mass = 0.0_wp
+    do i = 1, scene%n_bodies
+      if (locked(mode%group(i))) mode%group(i) = 0
+      mode%group_mass(mode%group(i)) = mode%group_mass(mode%group(i)) + scene%body_mass(i) * mode%scale(i)**2
+    end do
+  end subroutine gear_groups
 
   !> drive(i): the drive of the moving ground that the rows marked (rows) join body i to,
   !> through rows between bodies too; 0 for none (or the still ground).

@@ -17,7 +17,7 @@ module impact1d_chain
     r_c, contact_fields, spring_fields, r_name, n_contact_fields, n_spring_fields, written_array, text_item, &
     a_f_table, mechanism_records, n_sine_fields, sine_fields, r_body, r_amp, r_period, r_phase, r_stop_k, r_stop_c, &
     r_ground_v, r_spring_ground_v, n_ground_fields, a_belt_v, a_v_s, a_c_v, n_friction_fields, friction_fields, &
-    r_mu, r_mus, r_normal, r_friction_name
+    r_mu, r_mus, r_normal, r_friction_name, r_ratio, r_spring_ratio
   implicit none
   private
   public :: settle_chain, validate_chain, input_records, mechanism_records, n_bodies_of, slot_of, alias_slot
@@ -464,6 +464,7 @@ contains
         end if
         if (.not. allocated(error)) call ground_motion(rec, merge(r_ground_v, r_spring_ground_v, contact), &
           where, error)
+        if (.not. allocated(error)) call gear_ratio(rec, contact, where, error)
         if (allocated(error)) return
       end associate
     end do
@@ -674,6 +675,37 @@ contains
     end if
   end subroutine motion_terms
 
+  !> A record's gear ratio n (it acts on x_b - n x_a; docs/method.md section 14): positive
+  !> (the sign of each shaft's angle is the user's to choose), and other than 1 only where
+  !> the engine has it: between two bodies (on a ground end n x_0 = 0 leaves nothing to
+  !> gear, and a ground as b only rescales the body: the limits are written in its own
+  !> coordinate instead), not on a compliant stop nor a rigid link (d_min = d_max).
+  subroutine gear_ratio(rec, contact, where, error)
+    type(record_input), intent(in) :: rec
+    logical, intent(in) :: contact
+    character(len=*), intent(in) :: where
+    type(error_type), allocatable, intent(inout) :: error
+    integer :: f
+    f = merge(r_ratio, r_spring_ratio, contact)
+    if (.not. rec%given(f)) return
+    call positive_value(where // 'ratio', rec%value(f), error)
+    if (allocated(error) .or. rec%value(f) == 1.0_wp) return
+    if (rec%value(r_a) == 0.0_wp .or. rec%value(r_b) == 0.0_wp) then
+      call raise(error, status_input, where // 'ratio = ' // trim(fmt(rec%value(f))) // ' on a record with a ' // &
+        'ground end (a or b = 0): a ratio gears two bodies (x_b - ratio x_a); against the ground write the ' // &
+        'limits in the body''s own coordinate')
+    else if (.not. contact) then
+      return
+    else if (rec%given(r_stop_k)) then
+      call raise(error, status_input, where // 'ratio = ' // trim(fmt(rec%value(f))) // ' on a compliant stop ' // &
+        '(k): geared compliant stops are not built yet')
+    else if (all(rec%given([r_d_min, r_d_max]))) then
+      if (rec%value(r_d_min) == rec%value(r_d_max)) call raise(error, status_input, where // 'ratio = ' // &
+        trim(fmt(rec%value(f))) // ' on a rigid link (d_min = d_max): geared rigid links are not built yet ' // &
+        '(give the mesh some backlash)')
+    end if
+  end subroutine gear_ratio
+
   !> The walls' prescribed motion (x_left_v ..., x_right_v ...): each needs its wall.
   subroutine wall_motion_terms(input, error)
     type(scene_input), intent(in) :: input
@@ -748,14 +780,19 @@ contains
     end do
   end subroutine check_names
 
-  !> 'x<b> - x<a>' (or 'x<b>' against the ground, 'x<b> - w(0)' against a moving one:
-  !> shifted), for messages (blank padded: callers trim).
-  pure function difference_name(a, b, shifted) result(text)
+  !> 'x<b> - x<a>' ('x<b> - n x<a>' with a gear ratio n; 'x<b>' against the ground,
+  !> 'x<b> - w(0)' against a moving one: shifted), for messages (blank padded: callers trim).
+  pure function difference_name(a, b, shifted, ratio) result(text)
     integer, intent(in) :: a, b
     logical, intent(in) :: shifted
-    character(len=2 * fmt_width + 16) :: text
+    real(wp), intent(in) :: ratio      !< a gear ratio: 'x2 - 3.0 x1'
+    character(len=3 * fmt_width + 16) :: text
     text = 'x' // trim(fmt(b))
-    if (a > 0) text = trim(text) // ' - x' // trim(fmt(a))
+    if (a > 0 .and. ratio /= 1.0_wp) then
+      text = trim(text) // ' - ' // trim(fmt(ratio)) // ' x' // trim(fmt(a))
+    else if (a > 0) then
+      text = trim(text) // ' - x' // trim(fmt(a))
+    end if
     if (shifted) text = trim(text) // ' - w(0)'
   end function difference_name
 
@@ -776,7 +813,7 @@ contains
     end do
     do k = 1, records%n_contacts
       associate (a => records%contact_body(1, k), b => records%contact_body(2, k))
-        d = x(b) - x(a)
+        d = x(b) - records%contact_ratio(k) * x(a)
         shifted = .false.
         ! A moving ground end starts at w(0) = ground_amp sin(ground_phase).
         if (a == 0 .and. records%contact_moves(k)) then
@@ -788,18 +825,20 @@ contains
         do side = 1, 2
           if (.not. records%contact_has(side, k)) cycle
           limit = records%contact_limit(side, k)
-          scale = max(abs(x(a)), abs(x(b)), abs(limit))
+          scale = max(abs(records%contact_ratio(k) * x(a)), abs(x(b)), abs(limit))
           gap = merge(d - limit, limit - d, side == 1)
           if (gap < -16.0_wp * eps_wp * scale) then
             call raise(error, status_input, 'the initial state violates the contact ''' // &
-              trim(records%contact_name(k)) // ''': ' // trim(difference_name(a, b, shifted)) // ' = ' // trim(fmt(d)) // &
+              trim(records%contact_name(k)) // ''': ' // trim(difference_name(a, b, shifted, &
+              records%contact_ratio(k))) // ' = ' // trim(fmt(d)) // &
               ' is ' // trim(merge('below', 'above', side == 1)) // ' its ' // &
               trim(merge('lower', 'upper', side == 1)) // ' limit ' // trim(fmt(limit)))
             return
           end if
           ! (within the rounding of its numbers a gap is contact, as in validate_bodies)
           if (gap > 16.0_wp * eps_wp * scale .and. unresolved(gap, scale)) call resolvable('the initial gap ' // &
-            'of the contact ''' // trim(records%contact_name(k)) // ''' (' // trim(difference_name(a, b, shifted)) // ')', &
+            'of the contact ''' // trim(records%contact_name(k)) // ''' (' // trim(difference_name(a, b, shifted, &
+            records%contact_ratio(k))) // ')', &
             gap, scale, error)
           if (a > 0 .and. unresolved(limit, scale)) call resolvable('the contact ''' // &
             trim(records%contact_name(k)) // '''s ' // trim(merge('d_min', 'd_max', side == 1)), limit, scale, error)
@@ -832,7 +871,9 @@ contains
       records%contact_restitution(2, nc), records%contact_name(nc), records%contact_k(nc), records%contact_c(nc))
     allocate(records%element_body(2, ne), records%element_k(ne), records%element_c(ne), records%element_rest(ne))
     allocate(records%contact_ground(n_ground_fields, nc), records%element_ground(n_ground_fields, ne), &
-      records%contact_moves(nc), records%element_moves(ne))
+      records%contact_moves(nc), records%element_moves(ne), records%contact_ratio(nc), records%element_ratio(ne))
+    records%contact_ratio = 1.0_wp
+    records%element_ratio = 1.0_wp
     records%contact_ground = 0.0_wp
     records%element_ground = 0.0_wp
     records%contact_moves = .false.
@@ -985,6 +1026,7 @@ contains
         if (rec%given(r_stop_c)) records%contact_c(k) = rec%value(r_stop_c)
         records%contact_ground(:, k) = ground_of(rec, r_ground_v)
         records%contact_moves(k) = any(rec%given(r_ground_v:r_ground_v + n_ground_fields - 1))
+        if (rec%given(r_ratio)) records%contact_ratio(k) = rec%value(r_ratio)
         if (ends(2) == 0) then
           records%contact_body(:, k) = [0, ends(1)]
           records%contact_has(:, k) = records%contact_has([2, 1], k)
@@ -1039,6 +1081,7 @@ contains
         records%element_ground(:, records%n_elements) = ground_of(rec, r_spring_ground_v)
         records%element_moves(records%n_elements) = any(rec%given(r_spring_ground_v:r_spring_ground_v + &
           n_ground_fields - 1))
+        if (rec%given(r_spring_ratio)) records%element_ratio(records%n_elements) = rec%value(r_spring_ratio)
       end associate
     end do
   end subroutine element_records
@@ -1072,6 +1115,8 @@ contains
       records%element_ground = records%element_ground(:, :ne)
       records%contact_moves = records%contact_moves(:nc)
       records%element_moves = records%element_moves(:ne)
+      records%contact_ratio = records%contact_ratio(:nc)
+      records%element_ratio = records%element_ratio(:ne)
       records%element_body = records%element_body(:, :ne)
       records%element_k = records%element_k(:ne)
       records%element_c = records%element_c(:ne)

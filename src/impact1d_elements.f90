@@ -66,19 +66,32 @@ contains
     end associate
   end function elongation
 
-  !> elongation at time t, a moving ground end where it is then.
+  !> elongation at time t, a moving ground end where it is then, and with the element's gear
+  !> ratio n: (x_b - n x_a) - rest (docs/method.md section 14; n = 1 leaves the same bits).
   pure real(wp) function moving_elongation(scene, j, x, dx, t) result(elongation)
     type(scene_type), intent(in) :: scene
     integer, intent(in) :: j
     real(wp), intent(in) :: x(:), dx(:), t
-    associate (a => scene%element_body(1, j), b => scene%element_body(2, j))
+    associate (a => scene%element_body(1, j), b => scene%element_body(2, j), n => scene%element_ratio(j))
       if (a == 0) then
         elongation = ((x(b) - anchor(scene, j, 0, t)) - scene%element_rest(j)) + dx(b)
       else
-        elongation = ((x(b) - x(a)) - scene%element_rest(j)) + (dx(b) - dx(a))
+        elongation = ((x(b) - n * x(a)) - scene%element_rest(j)) + (dx(b) - n * dx(a))
       end if
     end associate
   end function moving_elongation
+
+  !> Element j's elongation rate at velocities v, v_b - n v_a, relative to a moving ground
+  !> end at time t (optional: a still ground).
+  pure real(wp) function elongation_rate(scene, j, v, t) result(rate)
+    type(scene_type), intent(in) :: scene
+    integer, intent(in) :: j
+    real(wp), intent(in) :: v(:)
+    real(wp), intent(in), optional :: t
+    associate (a => scene%element_body(1, j), b => scene%element_body(2, j))
+      rate = (at_end(v, b) - scene%element_ratio(j) * at_end(v, a)) - anchor(scene, j, 1, t)
+    end associate
+  end function elongation_rate
 
   !> Element j's tension at positions x + dx, velocities v, time t (optional: a still ground).
   pure real(wp) function tension_of(scene, j, x, dx, v, t) result(tension)
@@ -86,33 +99,39 @@ contains
     integer, intent(in) :: j
     real(wp), intent(in) :: x(:), dx(:), v(:)
     real(wp), intent(in), optional :: t
-    associate (a => scene%element_body(1, j), b => scene%element_body(2, j))
-      tension = scene%element_k(j) * moving_elongation(scene, j, x, dx, t) + &
-        scene%element_c(j) * ((at_end(v, b) - at_end(v, a)) - anchor(scene, j, 1, t))
-    end associate
+    tension = scene%element_k(j) * moving_elongation(scene, j, x, dx, t) + scene%element_c(j) * &
+      elongation_rate(scene, j, v, t)
   end function tension_of
 
   !> f += the elements' forces at positions x + dx and velocities v (a still ground; moving
-  !> ones: add_moving_element_forces).
+  !> ones: add_moving_element_forces). Every stage of an N-body step calls it: its ends read
+  !> once, a ground end's zeros left out (x(b) - 0 is x(b): elongation's bits), the arrays
+  !> contiguous (no strides).
   pure subroutine add_element_forces(scene, x, dx, v, f)
     type(scene_type), intent(in) :: scene
-    real(wp), intent(in) :: x(:), dx(:), v(:)
-    real(wp), intent(inout) :: f(:)
+    real(wp), contiguous, intent(in) :: x(:), dx(:), v(:)
+    real(wp), contiguous, intent(inout) :: f(:)
     real(wp) :: tension
-    integer :: j
+    integer :: j, a, b
     do j = 1, scene%n_elements
-      associate (a => scene%element_body(1, j), b => scene%element_body(2, j))
-        tension = scene%element_k(j) * elongation(scene, j, x, dx) + &
-          scene%element_c(j) * (at_end(v, b) - at_end(v, a))
-        if (a > 0) f(a) = f(a) + tension
-        f(b) = f(b) - tension
-      end associate
+      a = scene%element_body(1, j)
+      b = scene%element_body(2, j)
+      if (a > 0) then
+        tension = scene%element_k(j) * (((x(b) - x(a)) - scene%element_rest(j)) + (dx(b) - dx(a))) + &
+          scene%element_c(j) * (v(b) - v(a))
+        f(a) = f(a) + tension
+      else
+        tension = scene%element_k(j) * ((x(b) - scene%element_rest(j)) + dx(b)) + scene%element_c(j) * v(b)
+      end if
+      f(b) = f(b) - tension
     end do
   end subroutine add_element_forces
 
-  !> add_element_forces at time t, moving ground ends where they are then (apart, so that
-  !> the loop of a scene without them stays as it was: with a branch inside it, a 50-body
-  !> spring chain's element forces took half as many instructions again).
+  !> add_element_forces at time t, moving ground ends where they are then, and geared
+  !> elements (scene%geared: the tension T on x_b - n x_a pulls b by -T and a by +n T, the
+  !> gradient of the elongation) (apart, so that the loop of a scene without them stays as
+  !> it was: with a branch inside it, a 50-body spring chain's element forces took half as
+  !> many instructions again).
   pure subroutine add_moving_element_forces(scene, x, dx, v, f, t)
     type(scene_type), intent(in) :: scene
     real(wp), intent(in) :: x(:), dx(:), v(:), t
@@ -122,7 +141,7 @@ contains
     do j = 1, scene%n_elements
       associate (a => scene%element_body(1, j), b => scene%element_body(2, j))
         tension = tension_of(scene, j, x, dx, v, t)
-        if (a > 0) f(a) = f(a) + tension
+        if (a > 0) f(a) = f(a) + scene%element_ratio(j) * tension
         f(b) = f(b) - tension
       end associate
     end do
@@ -140,15 +159,15 @@ contains
     integer :: j
     do j = 1, scene%n_elements
       associate (a => scene%element_body(1, j), b => scene%element_body(2, j))
-        rate = scene%element_k(j) * ((at_end(v, b) - at_end(v, a)) - anchor(scene, j, 1, t))
-        if (a > 0) df(a) = df(a) + rate
+        rate = scene%element_k(j) * elongation_rate(scene, j, v, t)
+        if (a > 0) df(a) = df(a) + scene%element_ratio(j) * rate
         df(b) = df(b) - rate
       end associate
     end do
   end subroutine add_element_rates
 
   !> Potential energy stored in the springs at positions x + dx (at time t: moving ground
-  !> ends where they are then).
+  !> ends where they are then, geared elements on x_b - n x_a).
   pure real(wp) function element_potential(scene, x, dx, t) result(pe)
     type(scene_type), intent(in) :: scene
     real(wp), intent(in) :: x(:), dx(:)
@@ -168,7 +187,7 @@ contains
   end function element_potential
 
   !> Power the dampers dissipate at velocities v (at time t: on the velocity relative to a
-  !> moving ground end).
+  !> moving ground end, geared elements' on v_b - n v_a).
   pure real(wp) function element_damping_power(scene, v, t) result(power)
     type(scene_type), intent(in) :: scene
     real(wp), intent(in) :: v(:)
@@ -177,9 +196,7 @@ contains
     power = 0.0_wp
     if (present(t)) then
       do j = 1, scene%n_elements
-        associate (a => scene%element_body(1, j), b => scene%element_body(2, j))
-          power = power + scene%element_c(j) * ((at_end(v, b) - at_end(v, a)) - anchor(scene, j, 1, t))**2
-        end associate
+        power = power + scene%element_c(j) * elongation_rate(scene, j, v, t)**2
       end do
       return
     end if

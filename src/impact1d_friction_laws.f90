@@ -12,7 +12,7 @@ module impact1d_friction_laws
   use impact1d_scene, only: scene_type
   implicit none
   private
-  public :: slip, sliding_bound, add_stribeck_forces, law_powers
+  public :: slip, sliding_bound, add_stribeck_forces, law_powers, contact_loss
 
 contains
 
@@ -77,4 +77,20 @@ contains
       if (scene%belts .and. group(i) == 0 .and. drive(i) == 0) belt = belt - (f(i) + f_slide(i)) * v(i)
     end do
   end subroutine law_powers
+
+  !> The power the friction contacts between bodies (&friction) dissipate at velocities v:
+  !> F |u| over those that slide (friction_sgn, the mode's), u = v_b - v_a. law_powers books
+  !> the bodies' own friction only; a contact's force, in f_slide, does no work on a belt
+  !> (its law stays Coulomb's, on the relative velocity: the belts are under the bodies).
+  pure real(wp) function contact_loss(scene, friction_sgn, v) result(loss)
+    type(scene_type), intent(in) :: scene
+    real(wp), intent(in) :: friction_sgn(:), v(:)
+    integer :: j
+    loss = 0.0_wp
+    do j = 1, scene%n_frictions
+      if (friction_sgn(j) == 0.0_wp) cycle
+      loss = loss + scene%friction_slide(j) * friction_sgn(j) * (v(scene%friction_body(2, j)) - &
+        v(scene%friction_body(1, j)))
+    end do
+  end function contact_loss
 end module impact1d_friction_laws

@@ -30,8 +30,8 @@ module impact1d_io
     'k1, x1_rest, c1, k2, x2_rest, c2, k12, d_rest, c12', &
     't_end, dt, dt_out, method, zero_vel, max_rows, max_impulses, max_step_events, substeps, events, max_events, ' // &
     'bodies_out', &
-    'a, b, d_min, r_min, d_max, r_max, name, k, c, ground_v, ground_amp, ground_period, ground_phase', &
-    'a, b, k, d_rest, c, ground_v, ground_amp, ground_period, ground_phase', 'body, amp, period, phase', &
+    'a, b, d_min, r_min, d_max, r_max, name, k, c, ground_v, ground_amp, ground_period, ground_phase, ratio', &
+    'a, b, k, d_rest, c, ground_v, ground_amp, ground_period, ground_phase, ratio', 'body, amp, period, phase', &
     'a, b, mu, mus, normal, name']
 
   !> The tutorial's parameter files list these, in its Table 1 order; g is 10 there.

@@ -8,7 +8,7 @@ module impact1d_nbody_event
   use impact1d_kinds, only: wp, eps_wp
   use impact1d_error, only: error_type, raise, status_simulation, fmt
   use impact1d_scene, only: scene_type
-  use impact1d_state, only: state_type, add_compensated
+  use impact1d_state, only: state_type, add_compensated, product_error
   use impact1d_output, only: sink_type, run_stats, class_impact, class_rest, class_stick, class_slip, class_release, &
     class_pair_stick, class_pair_slip
   use impact1d_yardsticks, only: gap_rounding, velocity_rounding, time_rounding, energy_rounding, same_instant, &
@@ -148,6 +148,7 @@ contains
         .and. index == i) .or. abs(slip(scene, i, s%v(i))) <= velocity_rounding * abs(acc(i)) * scene%dt)
       if (stopped(i)) call zero_velocity(scene, s, i)
     end do
+    if (scene%n_frictions > 0 .and. .not. initial .and. any(stopped)) call carry_stopped(scene, mode, stopped, s)
     if (found == found_friction) call relative_rest(scene, mode, index, s)
     call lock_rigid(scene, closed, stopped, s, work, sink, stats)
     call impacts(scene, closed, entry_scale, acc, s, work, hit, sink, stats, error)
@@ -170,7 +171,8 @@ contains
     ! (solved in place: the old mode is not read past here but for its friction contacts'
     ! stuck flags, kept for the log; a failed solve ends the run)
     if (scene%n_frictions > 0 .and. .not. initial) pair_was_stuck = mode%friction_stuck
-    if (initial .or. .not. work%frictionless .or. scene%drives%n > 0) then
+    ! (geared groups' scaled accelerations are set_groups' alone: no scoped shortcut)
+    if (initial .or. .not. work%frictionless .or. scene%drives%n > 0 .or. scene%geared) then
       call solve_mode_at(scene, work%mode, s%t, f, df, s%v, candidate, mode, status)
       work%mode_tracked = .false.
     else
@@ -347,6 +349,16 @@ contains
         associate (ea => scene%row_body(1, k), eb => scene%row_body(2, k))
           if (placed(ea) .eqv. placed(eb)) cycle
           limit = -scene%row_offset(k) / scene%row_normal(2, k)
+          if (scene%geared) then
+            ! (a geared row, x_b - n x_a = limit)
+            if (abs(scene%row_normal(1, k)) /= 1.0_wp) then
+              call place_geared(ea, eb, abs(scene%row_normal(1, k)), limit, placed(ea), s)
+              placed(ea) = .true.
+              placed(eb) = .true.
+              grew = .true.
+              cycle
+            end if
+          end if
           if (placed(ea)) then
             s%x(eb) = s%x(ea)
             s%x_lo(eb) = s%x_lo(ea)
@@ -375,6 +387,28 @@ contains
     end do
 
   contains
+
+    !> A geared row's ends on x_b - n x_a = limit, b placed from a (from_a) or a from b,
+    !> the products' rounding errors kept in the low parts (impact1d_state's product_error).
+    pure subroutine place_geared(a, b, n, limit, from_a, s)
+      integer, intent(in) :: a, b
+      real(wp), intent(in) :: n, limit
+      logical, intent(in) :: from_a
+      type(state_type), intent(inout) :: s
+      real(wp) :: y, y_lo
+      if (from_a) then
+        s%x(b) = n * s%x(a)
+        s%x_lo(b) = n * s%x_lo(a) + product_error(n, s%x(a))
+        call add_compensated(s%x(b), s%x_lo(b), limit)
+      else
+        y = s%x(b)
+        y_lo = s%x_lo(b)
+        call add_compensated(y, y_lo, -limit)
+        s%x(a) = y / n
+        ! (y - n x_a is exact: the two are within a rounding of each other)
+        s%x_lo(a) = (((y - n * s%x(a)) - product_error(n, s%x(a))) + y_lo) / n
+      end if
+    end subroutine place_geared
 
     !> Body b on row k's ground end: w(t + t_lo) as its two parts (impact1d_drives'
     !> position_parts).
@@ -477,7 +511,9 @@ contains
     tol = 0.0_wp
     do e = 1, 2
       i = scene%row_body(e, k)
-      if (i > 0) tol = tol + max(abs(v(i)) + abs(acc(i)) * scene%dt, entry_scale(i))
+      ! (|n_e| = 1 but on a geared row's a end)
+      if (i > 0) tol = tol + abs(scene%row_normal(e, k)) * max(abs(v(i)) + abs(acc(i)) * scene%dt, &
+        entry_scale(i))
     end do
     tol = velocity_rounding * tol
   end function u_tolerance
@@ -595,13 +631,17 @@ contains
 
   !> impact1d_accumulation's join_cycle (the bodies the rows marked join move as one, at rest
   !> when joined to the ground) at t: with moving grounds, moving with the ground they are
-  !> joined to.
+  !> joined to; geared rows (docs/method.md section 14) join nothing.
   subroutine join_moving(scene, rows, t, v)
     type(scene_type), intent(in) :: scene
     logical, intent(in) :: rows(:)
     real(wp), intent(in) :: t
     real(wp), intent(inout) :: v(:)
     real(wp) :: frame(scene%n_bodies)
+    if (scene%geared) then
+      call join_unit_rows(scene, rows, v)
+      return
+    end if
     if (scene%drives%n == 0) then
       call join_cycle(scene%row_body, rows, scene%body_mass, v)
       return
@@ -611,6 +651,17 @@ contains
     call join_cycle(scene%row_body, rows, scene%body_mass, v)
     v = v + frame
   end subroutine join_moving
+
+  !> join_moving in a geared scene: the rows marked that are walls or of unit ratio join
+  !> their ends; a geared row's do not move alike (its impulse left v_b - n v_a at 0 itself).
+  !> Apart from join_moving, so that the event point keeps it inlined.
+  subroutine join_unit_rows(scene, rows, v)
+    type(scene_type), intent(in) :: scene
+    logical, intent(in) :: rows(:)
+    real(wp), intent(inout) :: v(:)
+    call join_cycle(scene%row_body, rows .and. (scene%row_body(1, :scene%n_rows) == 0 .or. &
+      abs(scene%row_normal(1, :scene%n_rows)) == 1.0_wp), scene%body_mass, v)
+  end subroutine join_unit_rows
 
   !> Each body's moving ground's velocity at t through the rows marked (0: none).
   pure function frame_velocity(scene, rows, t) result(frame)
@@ -758,7 +809,12 @@ contains
       if (root(e) > 0) inverse(e) = 1.0_wp / work%rigid_mass(root(e))
     end do
     if (root(1) == root(2) .or. sum(inverse) == 0.0_wp) return
-    p = -(1.0_wp + r) * row_velocity(scene, k, v, t) / sum(inverse)
+    if (scene%geared) then
+      ! (a geared row's normal (-n, 1): its effective mass is 1 / (n^2 / m_a + 1 / m_b))
+      p = -(1.0_wp + r) * row_velocity(scene, k, v, t) / sum(inverse * scene%row_normal(:, k)**2)
+    else
+      p = -(1.0_wp + r) * row_velocity(scene, k, v, t) / sum(inverse)
+    end if
     if (.not. work%any_rigid) then
       ! (each body its own group: the row's ends alone)
       do e = 1, 2
@@ -883,7 +939,7 @@ contains
     type(error_type), allocatable :: ignored
     integer :: k, e, p
     real(wp) :: accel_bound, u
-    call zero_stopped(scene, s, acc, entry_scale)
+    call zero_stopped(scene, mode, s, acc, entry_scale)
     associate (rows => work%closed_rows(:work%n_closed))
       call joint_projection(scene, work, closed, rows, s%t, s%v, spread(0.0_wp, 1, scene%n_rows), v_after, pushed, &
         ignored)
@@ -903,7 +959,8 @@ contains
     ! grounds, whose rows follow w''; nor with rigid links, whose impulses' union-find steps
     ! must all be taken; nor under Stribeck's law, whose viscous part has no bound)
     accel_bound = huge(1.0_wp)
-    if (work%n_closed > 0 .and. scene%drives%n == 0 .and. .not. work%any_rigid .and. .not. scene%stribeck) &
+    if (work%n_closed > 0 .and. scene%drives%n == 0 .and. .not. work%any_rigid .and. .not. scene%stribeck .and. &
+        .not. scene%geared) &
       accel_bound = 4.0_wp * (sum(abs(f)) + sum(max(scene%body_friction, scene%body_static))) / &
       minval(scene%body_mass)
     do p = 1, work%n_closed
@@ -917,7 +974,7 @@ contains
       if (u > time_rounding * max(abs(s%t), scene%dt) * accel_bound) cycle
       call settle_bounce_series(scene, mode, k, u, f, df, closed, acc, entry_scale, s, event_log, work, sink, stats)
     end do
-    call zero_stopped(scene, s, acc, entry_scale)
+    call zero_stopped(scene, mode, s, acc, entry_scale)
     do p = 1, work%n_closed
       k = work%closed_rows(p)
       if (scene%row_body(1, k) == 0) cycle
@@ -1025,7 +1082,7 @@ contains
     a_gap = 0.0_wp
     a_end = 0.0_wp
     ! (friction contacts between bodies join clusters the rows' incidence lists do not see)
-    scoped = scene%drives%n == 0 .and. scene%n_frictions == 0
+    scoped = scene%drives%n == 0 .and. scene%n_frictions == 0 .and. .not. scene%geared
     if (.not. scoped) return
     do e = 1, 2
       if (scene%row_body(e, k) == 0) cycle
@@ -1292,16 +1349,21 @@ contains
   end subroutine sort_increasing
 
   !> Bodies whose velocity is below the rounding of what a step changes it by, or of the
-  !> velocities this event point started from, are at rest.
-  pure subroutine zero_stopped(scene, s, acc, entry_scale)
+  !> velocities this event point started from, are at rest (and with friction contacts,
+  !> what moved with them in the mode: carry_stopped).
+  pure subroutine zero_stopped(scene, mode, s, acc, entry_scale)
     type(scene_type), intent(in) :: scene
+    type(body_mode_type), intent(in) :: mode
     type(state_type), intent(inout) :: s
     real(wp), intent(in) :: acc(:), entry_scale(:)
+    logical :: zeroed(scene%n_bodies)
     integer :: i
     do i = 1, scene%n_bodies
-      if (s%v(i) /= rest_velocity(scene, i) .and. abs(s%v(i) - rest_velocity(scene, i)) <= velocity_rounding * &
-          max(abs(acc(i)) * scene%dt, entry_scale(i))) call zero_velocity(scene, s, i)
+      zeroed(i) = s%v(i) /= rest_velocity(scene, i) .and. abs(s%v(i) - rest_velocity(scene, i)) <= &
+        velocity_rounding * max(abs(acc(i)) * scene%dt, entry_scale(i))
+      if (zeroed(i)) call zero_velocity(scene, s, i)
     end do
+    if (scene%n_frictions > 0 .and. any(zeroed)) call carry_stopped(scene, mode, zeroed, s)
   end subroutine zero_stopped
 
   !> The velocity at which body i rests: its belt's when it has one and friction to hold it
@@ -1388,6 +1450,34 @@ contains
       moved = mode%group(i) /= 0 .and. (mode%group(i) == ga .or. mode%group(i) == gb)
     end function moved
   end subroutine relative_rest
+
+  !> The bodies that moved in one group with a body friction has just stopped (joined by
+  !> friction contacts stuck in the old mode: their velocities were equal) take its velocity,
+  !> the rounding-level energy booked to friction. On a belt the stopped body is put at the
+  !> belt's speed, which its partners (not at rest on their own) would otherwise miss by
+  !> the rounding: the contact would then seem to slide, and slip and stick at once.
+  pure subroutine carry_stopped(scene, mode, stopped, s)
+    type(scene_type), intent(in) :: scene
+    type(body_mode_type), intent(in) :: mode
+    logical, intent(in) :: stopped(:)
+    type(state_type), intent(inout) :: s
+    real(wp) :: carried(0:scene%n_bodies)
+    logical :: halted(0:scene%n_bodies)
+    integer :: i
+    halted = .false.
+    do i = 1, scene%n_bodies
+      if (.not. stopped(i) .or. mode%group(i) == 0) cycle
+      halted(mode%group(i)) = .true.
+      carried(mode%group(i)) = s%v(i)
+    end do
+    do i = 1, scene%n_bodies
+      if (stopped(i) .or. .not. halted(mode%group(i))) cycle
+      call add_compensated(s%friction_loss, s%friction_lo, 0.5_wp * scene%body_mass(i) * &
+        (s%v(i)**2 - carried(mode%group(i))**2))
+      s%v(i) = carried(mode%group(i))
+      s%v_lo(i) = 0.0_wp
+    end do
+  end subroutine carry_stopped
 
   !> Kinetic energy of the bodies at velocities v.
   pure real(wp) function kinetic(scene, v)
@@ -1500,7 +1590,11 @@ contains
       if (ready) return
       ready = .true.
       call mode_acceleration(scene, new, s%t, f, acc)
-      call new%rate_response(df, acc_rate)
+      if (scene%geared) then
+        call new%geared_response(df, acc_rate)
+      else
+        call new%rate_response(df, acc_rate)
+      end if
       if (scene%drives%n > 0) call drive_accelerations(scene, new, s%t, 3, acc_rate)
       tol_a = 1.0e3_wp * eps_wp * force_scale(scene, f, df) / scene%body_mass
       rate_tol = 1.0e3_wp * eps_wp * sum(abs(df))

@@ -1,23 +1,25 @@
 !> The N-body engine's driver (docs/method.md section 9): the two-body engine's method on
 !> N-long arrays. From the current state it picks the next stop (sample time, table corner
-!> or pending rest), takes one RK4 step toward it, locates the earliest event inside the step
-!> on the dense output (impact1d_nbody_step), re-takes the step to it, and calls the event
-!> point (impact1d_nbody_event); samples go to the sink at sample times. impact1d_solver's
+!> or pending rest), takes the steps before the mode's quiet time in closed form under
+!> constant forces or tables (impact1d_nbody_glide), then one RK4 step toward it, locates the earliest
+!> event inside the step on the dense output (impact1d_nbody_step), re-takes the step to it,
+!> and calls the event point (impact1d_nbody_event); samples go to the sink at sample times. impact1d_solver's
 !> run hands scenes of more than two bodies here.
 module impact1d_nbody_solver
   use, intrinsic :: iso_fortran_env, only: int64
   use impact1d_kinds, only: wp
   use impact1d_error, only: error_type, raise, status_simulation, fmt
   use impact1d_scene, only: scene_type, sample_time, step_length
-  use impact1d_state, only: state_type, new_state, finite_state
+  use impact1d_state, only: state_type, new_state, take_state, finite_state
   use impact1d_output, only: sink_type, run_stats, emit_bodies, checkpoint
   use impact1d_event_log, only: event_log_type
   use impact1d_yardsticks, only: velocity_rounding
   use impact1d_elements, only: element_potential, stop_potential
   use impact1d_body_mode, only: body_mode_type, new_mode
   use impact1d_nbody_step, only: nbody_step, nbody_force, locate_nbody, refine_nbody, gaps_hold, row_gap, &
-    row_velocity, row_gap_tolerance, found_none, found_row, clock_to_stop
+    row_velocity, row_gap_tolerance, found_none, found_row, kept_forces_type, clock_to_stop
   use impact1d_nbody_event, only: point_work_type, new_point_work, nbody_event_point
+  use impact1d_nbody_glide, only: glide_type, new_glide, find_quiet_time, glide
   implicit none
   private
   public :: run_nbody
@@ -29,19 +31,26 @@ module impact1d_nbody_solver
     type(body_mode_type) :: mode
     type(point_work_type) :: work
     type(event_log_type) :: event_log
+    !> The last step's end forces, for the next step's first stage (nbody_step).
+    type(kept_forces_type) :: kept
     !> Tables and constants only: the dense output is exact, so no root can be missed.
     logical :: polynomial = .false.
     real(wp) :: ke0 = 0.0_wp, pe0 = 0.0_wp
+    !> Constant forces or tables: the steps before the mode's quiet time without location.
+    type(glide_type) :: glide
   end type nbody_run_type
 
 contains
 
   !> Run an N-body scene from t = 0 to t_end, every dt_out sample and every event to sink.
-  subroutine run_nbody(scene, sink, stats, error)
+  subroutine run_nbody(scene, sink, stats, error, closed_form)
     type(scene_type), intent(in) :: scene
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats
     type(error_type), allocatable, intent(inout) :: error
+    !> .false.: every step taken with its location, none in closed form (tests compare the
+    !> two: the same bits); default .true.
+    logical, intent(in), optional :: closed_form
     type(state_type) :: s, trial
     type(nbody_run_type) :: r
     real(wp) :: sample_t, t_break, t_rest, t_stop, window_start
@@ -49,8 +58,10 @@ contains
     logical :: at_stop, event_due
 
     call start(scene, s, trial, r)
+    if (present(closed_form)) r%glide%able = r%glide%able .and. closed_form
     call nbody_event_point(scene, .true., found_none, 0, s, r%mode, r%event_log, r%work, sink, stats, error)
     if (allocated(error)) return
+    call find_quiet_time(scene, r%mode, r%work%mode, s, r%glide)
     j_sample = 0
     call emit(scene, s, r, j_sample, sink, stats, error)
     if (allocated(error)) return
@@ -63,7 +74,13 @@ contains
       t_rest = huge(1.0_wp)
       if (scene%n_rows > 0) t_rest = minval(r%event_log%pending_rest)
       t_stop = min(sample_t, t_break, t_rest)
-      call advance(scene, r, t_stop, s, trial, found, index, at_stop, sink, stats, error)
+      ! The steps that can meet no event in closed form; then one located step (advance).
+      at_stop = .false.
+      if (r%glide%able) call glide(scene, r%mode, r%glide, t_stop, s, trial, r%kept, at_stop, sink, stats, error)
+      if (allocated(error)) return
+      found = found_none
+      index = 0
+      if (.not. at_stop) call advance(scene, r, t_stop, s, trial, found, index, at_stop, sink, stats, error)
       if (allocated(error)) return
       event_due = found /= found_none
       if (.not. event_due .and. at_stop) event_due = t_stop == t_break .or. t_stop == t_rest .or. &
@@ -86,6 +103,8 @@ contains
         call r%event_log%flush_pending_rest(scene, s%t, s%v, sink, stats)
         call nbody_event_point(scene, .false., found, index, s, r%mode, r%event_log, r%work, sink, stats, error)
         if (allocated(error)) return
+        call r%kept%forget()
+        call find_quiet_time(scene, r%mode, r%work%mode, s, r%glide)
       end if
       if (at_stop .and. s%t == sample_t) then
         call emit(scene, s, r, j_sample, sink, stats, error)
@@ -112,6 +131,8 @@ contains
       r%mode%engaged = .false.
     end if
     call new_point_work(scene%n_bodies, r%work)
+    call r%kept%reserve(scene%n_bodies)
+    call new_glide(scene, r%glide)
     call r%event_log%allocate_log(scene%n_rows, scene%n_bodies)
     r%polynomial = scene%forcing%is_polynomial() .and. .not. scene%springs%present .and. scene%drives%polynomial &
       .and. .not. scene%stribeck
@@ -144,7 +165,7 @@ contains
     type(state_type), intent(in) :: s
     pe = 0.0_wp
     if (.not. scene%springs%present) return
-    if (scene%drives%n > 0) then
+    if (scene%gap_terms) then
       pe = element_potential(scene, s%x, s%x_lo, s%t)
     else
       pe = element_potential(scene, s%x, s%x_lo)
@@ -174,17 +195,19 @@ contains
       index = 0
       if (h <= 0.0_wp) then
         trial = s
+        call r%kept%forget()
         exit
       end if
-      call nbody_step(scene, r%mode, s, h, trial)
-      call locate_nbody(scene, r%mode, r%work%mode, r%polynomial, s, trial, h, theta, found, index)
+      call nbody_step(scene, r%mode, s, h, trial, r%kept)
+      call locate_nbody(scene, r%mode, r%work%mode, r%polynomial, s, trial, h, r%kept, theta, found, index)
       if (found /= found_none .and. theta <= h) then
         h_taken = h
         h = theta
         if (h > 0.0_wp) then
-          call refine_nbody(scene, r%mode, r%polynomial, s, h, found, index, trial, h_taken)
+          call refine_nbody(scene, r%mode, r%polynomial, s, h, found, index, trial, r%kept, h_taken)
         else
           trial = s
+          call r%kept%forget()
           exit
         end if
       else
@@ -201,7 +224,8 @@ contains
       h = 0.5_wp * h
     end do
     at_stop = found == found_none .and. h == (t_stop - s%t) - s%t_lo
-    s = trial
+    call take_state(s, trial)
+    call r%kept%accept()
     if (at_stop) call clock_to_stop(scene, r%mode, t_stop, s)
     stats%steps = stats%steps + 1
     if (iand(stats%steps, 4095_int64) == 0) then

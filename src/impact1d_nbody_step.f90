@@ -6,18 +6,18 @@
 module impact1d_nbody_step
   use impact1d_kinds, only: wp, eps_wp
   use impact1d_scene, only: scene_type
-  use impact1d_state, only: state_type, add_compensated
+  use impact1d_state, only: state_type, add_compensated, product_error
   use impact1d_events, only: hermite, earliest_crossing, stop_force_cubic
   use impact1d_yardsticks, only: gap_rounding, velocity_rounding, time_rounding
   use impact1d_elements, only: add_element_forces, add_moving_element_forces, add_element_rates, element_damping_power, &
     element_drive_power, add_stop_forces, add_stop_rates, stop_damping_power, stop_release_loss, stop_drive_power
   use impact1d_body_mode, only: body_mode_type, mode_work_type, solve_body_mode, same_mode, mode_solved, &
     drive_accelerations, shift_to_drives, relative_velocity
-  use impact1d_friction_laws, only: slip, add_stribeck_forces, law_powers
+  use impact1d_friction_laws, only: slip, add_stribeck_forces, law_powers, contact_loss
   implicit none
   private
   public :: nbody_force, nbody_rate, nbody_step, row_gap, row_velocity, row_gap_tolerance, locate_nbody, &
-    refine_nbody, gaps_hold, mode_acceleration, ground_motion, clock_to_stop
+    refine_nbody, gaps_hold, mode_acceleration, ground_motion, row_abs, mode_crossing, clock_to_stop
   public :: found_none, found_row, found_body, found_hold, found_stop, found_friction, stop_gap_band, stop_force_band
 
   !> What a location found: a row's gap closing (a compliant stop's too: its engagement), a
@@ -27,18 +27,90 @@ module impact1d_nbody_step
   integer, parameter :: found_none = 0, found_row = 1, found_body = 2, found_hold = 3, found_stop = 4, &
     found_friction = 5
 
+  !> A step's end forces kept for the next step's first stage (the two-body engine's
+  !> end_force, FSAL-like): the external forces at the end's time t and the mode's
+  !> accelerations under all the applied forces there. Two slots: the run's state's
+  !> (`now`) and the end of the step last taken from it (3 - now), which becomes the run's
+  !> when advance takes that step (`accept`). A step that computed its first stage itself
+  !> keeps it in the run's slot too, for its retries and refinements from the same state and
+  !> for the location's external forces there. A slot is used only at its own time t and
+  !> while valid: whatever changes the state or the mode without a step (an event point)
+  !> calls `forget`. Kept where the stages' forces are the external and the elements' only
+  !> (not scene%stage_powers): the same inputs and arithmetic as the stage it replaces.
+  type, public :: kept_forces_type
+    integer :: now = 1
+    logical :: valid(2) = .false.
+    real(wp) :: t(2) = 0.0_wp
+    real(wp), allocatable :: f(:, :), acc(:, :)      !< (N, 2)
+  contains
+    procedure :: reserve => reserve_kept
+    procedure :: accept => accept_kept
+    procedure :: forget => forget_kept
+    procedure :: holds => kept_holds
+    procedure :: keep => keep_forces
+  end type kept_forces_type
+
 contains
 
+  !> The slots of n bodies, both empty (the run's one allocation of them).
+  pure subroutine reserve_kept(self, n)
+    class(kept_forces_type), intent(inout) :: self
+    integer, intent(in) :: n
+    if (allocated(self%f)) deallocate(self%f, self%acc)
+    allocate(self%f(n, 2), self%acc(n, 2))
+    call self%forget()
+  end subroutine reserve_kept
+
+  !> The step last taken is the run's state now: its end's slot becomes the start's.
+  pure subroutine accept_kept(self)
+    class(kept_forces_type), intent(inout) :: self
+    self%now = 3 - self%now
+    self%valid(3 - self%now) = .false.
+  end subroutine accept_kept
+
+  !> The state or the mode changed without a step: nothing kept holds.
+  pure subroutine forget_kept(self)
+    class(kept_forces_type), intent(inout) :: self
+    self%valid = .false.
+  end subroutine forget_kept
+
+  !> Whether the run's slot holds the forces at time t (of the run's state).
+  pure logical function kept_holds(self, t)
+    class(kept_forces_type), intent(in) :: self
+    real(wp), intent(in) :: t
+    kept_holds = self%valid(self%now)
+    if (kept_holds) kept_holds = self%t(self%now) == t
+  end function kept_holds
+
+  !> Slot e holds the external forces f at time t and the accelerations acc.
+  pure subroutine keep_forces(self, e, t, f, acc)
+    class(kept_forces_type), intent(inout) :: self
+    integer, intent(in) :: e
+    real(wp), intent(in) :: t, f(:), acc(:)
+    self%f(:, e) = f
+    self%acc(:, e) = acc
+    self%t(e) = t
+    self%valid(e) = .true.
+  end subroutine keep_forces
+
   !> Applied forces f (external and elements') at time t, positions x + dx, velocities v;
-  !> engaged: the compliant stops engaged (a mode's; absent: none).
-  pure subroutine nbody_force(scene, t, x, dx, v, f, engaged)
+  !> engaged: the compliant stops engaged (a mode's; absent: none); external: the external
+  !> forces at t when they are known (a kept step's).
+  pure subroutine nbody_force(scene, t, x, dx, v, f, engaged, external)
     type(scene_type), intent(in) :: scene
-    real(wp), intent(in) :: t, x(:), dx(:), v(:)
-    real(wp), intent(out) :: f(:)
+    real(wp), intent(in) :: t
+    real(wp), contiguous, intent(in) :: x(:), dx(:), v(:)
+    real(wp), contiguous, intent(out) :: f(:)
     logical, intent(in), optional :: engaged(:)
-    call scene%forcing%force_all(t, f)
+    real(wp), intent(in), optional :: external(:)
+    if (present(external)) then
+      f = external
+    else
+      call scene%forcing%force_all(t, f)
+    end if
     if (.not. scene%springs%present) return
-    if (scene%drives%n > 0) then
+    ! (geared elements are the moving ones' loop too: add_moving_element_forces)
+    if (scene%gap_terms) then
       call add_moving_element_forces(scene, x, dx, v, f, t)
     else
       call add_element_forces(scene, x, dx, v, f)
@@ -54,8 +126,15 @@ contains
     type(body_mode_type), intent(in) :: mode
     real(wp), intent(in) :: t, f(:)
     real(wp), intent(out) :: a(:)
-    call mode%acceleration(f, a)
-    if (scene%drives%n > 0) call drive_accelerations(scene, mode, t, 2, a)
+    if (.not. scene%gap_terms) then
+      call mode%acceleration(f, a)
+    else if (scene%geared) then
+      ! (geared groups, docs/method.md section 14; no moving grounds with them)
+      call mode%geared_response(f + mode%f_slide, a)
+    else
+      call mode%acceleration(f, a)
+      call drive_accelerations(scene, mode, t, 2, a)
+    end if
   end subroutine mode_acceleration
 
   !> The part of row k's gap (order 0), its rate (1), acceleration (2) or jerk (3) at t
@@ -117,23 +196,33 @@ contains
   !> forces may depend on the state); the ledger by Simpson's rule on the step's Hermite
   !> velocity (external work, sliding friction's loss, dampers' dissipation), exact where
   !> RK4 is. With a friction law (belt_v, v_s, c_v) friction's loss and the belts' work are
-  !> RK4's own quadrature of their power at the stages (law_ledger).
-  subroutine nbody_step(scene, mode, a, step, b)
+  !> RK4's own quadrature of their power at the stages (law_ledger). The first stage's
+  !> forces are kept's when it holds them for a (the last step's end, or a step already
+  !> taken from a), and the end's go into kept for the next step.
+  subroutine nbody_step(scene, mode, a, step, b, kept)
     type(scene_type), intent(in) :: scene
     type(body_mode_type), intent(in) :: mode
     type(state_type), intent(in) :: a
     real(wp), intent(in) :: step
     type(state_type), intent(inout) :: b
+    type(kept_forces_type), intent(inout) :: kept
     real(wp), dimension(scene%n_bodies) :: v0, v1, vm, f, dx, kx1, kx2, kx3, kx4, kv1, kv2, kv3, kv4, &
       f0, fm, f1, acc_end
     real(wp) :: half, power(4), loss(4), belt(4)
     half = 0.5_wp * step
     v0 = a%v + a%v_lo
-    call scene%forcing%force_all(a%t, f0)
+    kx1 = v0
+    if (kept%holds(a%t)) then
+      f0 = kept%f(:, kept%now)
+      kv1 = kept%acc(:, kept%now)
+    else
+      call scene%forcing%force_all(a%t, f0)
+      call stage(f0, a%x_lo, kx1, kv1, 0.0_wp, 1)
+      ! (for the retries and refinements of this step, and the location)
+      if (.not. scene%stage_powers) call kept%keep(kept%now, a%t, f0, kv1)
+    end if
     call scene%forcing%force_all(a%t + half, fm)
     call scene%forcing%force_all(a%t + step, f1)
-    kx1 = v0
-    call stage(f0, a%x_lo, kx1, kv1, 0.0_wp, 1)
     kx2 = v0 + half * kv1
     call stage(fm, a%x_lo + half * kx1, kx2, kv2, half, 2)
     kx3 = v0 + half * kv2
@@ -147,11 +236,15 @@ contains
     if (scene%drives%n > 0) call hold_to_drives(scene, mode, a, step, b)
     v1 = b%v + b%v_lo
     f = f1
+    kept%valid(3 - kept%now) = .false.
+    ! (geared scenes take the stage_powers path, whose accelerations are mode_acceleration's)
     if (scene%stage_powers) then
       call drive_step_ledger()
     else
+      ! (stage 1's forces and arithmetic at b: the next step's first stage)
       if (scene%springs%present) call add_element_forces(scene, b%x, b%x_lo, v1, f)
       call mode%acceleration(f, acc_end)
+      call kept%keep(3 - kept%now, a%t + step, f1, acc_end)
     end if
     vm = 0.5_wp * (v0 + v1) + 0.125_wp * step * (kv1 - acc_end)
     call add_compensated(b%work, b%work_lo, step / 6.0_wp * (dot_product(f0, v0) + &
@@ -162,7 +255,7 @@ contains
       call add_compensated(b%friction_loss, b%friction_lo, step / 6.0_wp * &
         dot_product(-mode%f_slide, v0 + 4.0_wp * vm + v1))
     end if
-    if (scene%drives%n > 0) then
+    if (scene%gap_terms) then
       if (scene%springs%present) call add_compensated(b%damping_loss, b%damping_lo, step / 6.0_wp * &
         (element_damping_power(scene, v0, a%t) + 4.0_wp * element_damping_power(scene, vm, a%t + half) + &
         element_damping_power(scene, v1, a%t + step)))
@@ -217,6 +310,8 @@ contains
       drive_power = drive_power + held_drive_power(scene, mode, t, f, acc)
       if (scene%belts .or. scene%stribeck) call law_powers(scene, mode%f_slide, mode%sgn, mode%group, &
         mode%drive, f, v, loss(k), belt(k))
+      if ((scene%belts .or. scene%stribeck) .and. scene%n_frictions > 0) &
+        loss(k) = loss(k) + contact_loss(scene, mode%friction_sgn, v)
     end subroutine moving_stage
 
     !> Friction's loss and the belts' work over the step, by RK4's quadrature of the stages'
@@ -340,7 +435,10 @@ contains
       q = n(2) * s%x(b)
       low = low + n(2) * s%x_lo(b)
     end associate
-    if (scene%drives%n > 0) then
+    if (scene%gap_terms) then
+      ! (a gear ratio's n x_a is rounded: its exact error joins the low part)
+      if (scene%geared .and. scene%row_body(1, k) > 0) low = low + product_error(scene%row_normal(1, k), &
+        s%x(scene%row_body(1, k)))
       ! (the ground's place to the clock's low part, as snap_closed puts a body on it)
       if (scene%row_drive(k) > 0) then
         call scene%drives%position_parts(scene%row_drive(k), s%t, s%t_lo, w, w_lo)
@@ -368,7 +466,8 @@ contains
     end if
   end function row_velocity
 
-  !> n_k . y with |n| (row k's ends' sum of |y|).
+  !> n_k . y with |n| (row k's ends' sum of |y|; a geared row's a end counts once, not n
+  !> times: what it rounds is the low parts, far below the step's term).
   pure real(wp) function row_abs(scene, k, y)
     type(scene_type), intent(in) :: scene
     integer, intent(in) :: k
@@ -408,12 +507,13 @@ contains
   !> Earliest event in (0, step] of the step from a to b: a gap of a row not held closing, a
   !> body sliding with friction stopping, or (forces that vary) the mode failing; found and
   !> index say what and where (found_none: theta past the step).
-  subroutine locate_nbody(scene, mode, work, polynomial, a, b, step, theta, found, index)
+  subroutine locate_nbody(scene, mode, work, polynomial, a, b, step, kept, theta, found, index)
     type(scene_type), intent(in) :: scene
     type(body_mode_type), intent(in) :: mode
     type(mode_work_type), intent(inout) :: work
     logical, intent(in) :: polynomial     !< the motion is a cubic: the dense output is exact
     type(state_type), intent(in) :: a, b
+    type(kept_forces_type), intent(in) :: kept      !< the step's (its external forces at a)
     real(wp), intent(in) :: step
     real(wp), intent(out) :: theta
     integer, intent(out) :: found, index
@@ -424,7 +524,11 @@ contains
     found = found_none
     index = 0
     call dense_output(a, b, step, c)
-    call nbody_force(scene, a%t, a%x, a%x_lo, a%v, f, mode%engaged)
+    if (kept%holds(a%t)) then
+      call nbody_force(scene, a%t, a%x, a%x_lo, a%v, f, mode%engaged, kept%f(:, kept%now))
+    else
+      call nbody_force(scene, a%t, a%x, a%x_lo, a%v, f, mode%engaged)
+    end if
     if (scene%stribeck) call add_stribeck_forces(scene, mode%sgn, a%v, f)
     call mode_acceleration(scene, mode, a%t, f, acc0)
     acc_rounding = 1.0e3_wp * eps_wp * sum(abs(f)) / minval(scene%body_mass)
@@ -486,7 +590,7 @@ contains
       q(1:3) = gap_rounding * abs(c(:, eb))
       if (ea > 0) then
         p(1:3) = p(1:3) + n(1) * c(:, ea)
-        q(1:3) = q(1:3) + gap_rounding * abs(c(:, ea))
+        q(1:3) = q(1:3) + gap_rounding * abs(n(1) * c(:, ea))
       else if (scene%drives%n > 0) then
         ! A moving ground end on its own cubic over the step (exact for ground_v; the
         ! step's end is checked on the exact w: gaps_hold).
@@ -635,7 +739,7 @@ contains
     logical function holds_at(tau)
       real(wp), intent(in) :: tau
       type(body_mode_type) :: probe
-      real(wp), dimension(scene%n_bodies) :: f, df, dx, v
+      real(wp), dimension(scene%n_bodies) :: f, df, dx, v, sliding
       integer :: status
       dx = a%x_lo + tau * (c(1, :) + tau * (c(2, :) + tau * c(3, :)))
       v = c(1, :) + tau * (2.0_wp * c(2, :) + 3.0_wp * tau * c(3, :))
@@ -651,6 +755,13 @@ contains
       probe = mode
       call solve_body_mode(scene, work, f, df, v, mode%active, probe, status)
       holds_at = status == mode_solved
+      if (holds_at .and. scene%stribeck) then
+        ! begun weighs the probe's loads: on the bodies that slide in both modes they hold
+        ! Stribeck's part of sliding friction, beyond f_slide's -F sgn (without it a group
+        ! pushed by c(u) > F did not break a friction contact away at its bound)
+        sliding = merge(probe%sgn, 0.0_wp, .not. mode%stuck)
+        call add_stribeck_forces(scene, sliding, v, f)
+      end if
       if (holds_at) holds_at = same_mode(probe, mode) .or. .not. begun(probe, f)
     end function holds_at
 
@@ -667,7 +778,11 @@ contains
       real(wp) :: acc(scene%n_bodies), way(scene%n_bodies), lead(0:scene%n_bodies)
       logical :: against
       integer :: i, k
-      call probe%acceleration(f, acc)
+      if (scene%geared) then
+        call probe%geared_response(f + probe%f_slide, acc)
+      else
+        call probe%acceleration(f, acc)
+      end if
       begun = any(probe%active .and. .not. mode%active) .or. any(probe%stuck .and. .not. mode%stuck)
       lead = 0.0_wp
       do i = 1, scene%n_bodies
@@ -721,7 +836,7 @@ contains
   !> with a moving ground end was located on its cubic, whose root may come before the
   !> exact one, and so was a sliding body's stop under forcing that is not polynomial (the
   !> cubic's velocity): Newton may then go on up to the step taken (limit).
-  subroutine refine_nbody(scene, mode, polynomial, a, step, found, index, b, limit)
+  subroutine refine_nbody(scene, mode, polynomial, a, step, found, index, b, kept, limit)
     type(scene_type), intent(in) :: scene
     type(body_mode_type), intent(in) :: mode
     logical, intent(in) :: polynomial     !< the motion is a cubic: the dense output is exact
@@ -729,6 +844,7 @@ contains
     real(wp), intent(inout) :: step
     integer, intent(in) :: found, index
     type(state_type), intent(inout) :: b
+    type(kept_forces_type), intent(inout) :: kept     !< nbody_step's
     real(wp), intent(in), optional :: limit
     real(wp) :: value, slope, tol, located_step, f(scene%n_bodies), acc(scene%n_bodies)
     integer :: iteration
@@ -737,7 +853,7 @@ contains
       if (scene%row_drive(index) > 0) located_step = limit
     end if
     if (present(limit) .and. found == found_body .and. .not. polynomial) located_step = limit
-    call nbody_step(scene, mode, a, step, b)
+    call nbody_step(scene, mode, a, step, b, kept)
     if (found /= found_row .and. found /= found_body .and. found /= found_stop) return
     do iteration = 1, 8
       if (found == found_body) then
@@ -763,7 +879,7 @@ contains
       if (abs(value) <= tol .or. slope == 0.0_wp) exit
       if (step - value / slope <= 0.0_wp .or. step - value / slope > located_step) exit
       step = step - value / slope
-      call nbody_step(scene, mode, a, step, b)
+      call nbody_step(scene, mode, a, step, b, kept)
     end do
   end subroutine refine_nbody
 

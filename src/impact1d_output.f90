@@ -65,6 +65,8 @@ module impact1d_output
   !> What a run did, for the CLI's summary and Python's result.
   type :: run_stats
     integer(int64) :: steps = 0
+    !> Of them, the N-body engine's closed-form steps (impact1d_nbody_glide).
+    integer(int64) :: glided = 0
     !> Events counted: every one, per row (impacts, rests, releases: (3, nr)) and per body
     !> (sticks, slips: (2, N)) and per friction contact (its sticks, slips: (2, nf), the
     !> contact j's events at index nr + j); start_counts allocates them.

@@ -171,6 +171,7 @@ module impact1d_scene
     real(wp), allocatable :: element_k(:)            !< (ne) stiffness, N/m
     real(wp), allocatable :: element_c(:)            !< (ne) damping, N s/m
     real(wp), allocatable :: element_rest(:)         !< (ne) rest length of x_b - x_a, m
+    real(wp), allocatable :: element_ratio(:)        !< (ne) gear ratio n: acts on x_b - n x_a (1: none)
     !> The elements as the two-body kernels see them (set_springs), and whether the scene
     !> names a stiffness or a damping (present, has_spring, has_damper).
     type(springs_type) :: springs
@@ -184,6 +185,16 @@ module impact1d_scene
     character(len=name_len), allocatable :: contact_name(:)  !< (nc) 'left', 'right', 'slot', ...
     !> (nc) a compliant stop's stiffness (N/m) and damping (N s/m); k = 0: a rigid contact
     real(wp), allocatable :: contact_k(:), contact_c(:)
+    !> (nc) gear ratio n: the record acts on x_b - n x_a (1: none; docs/method.md section 14)
+    real(wp), allocatable :: contact_ratio(:)
+    !> Some contact or element has a gear ratio other than 1: only the N-body engine runs it
+    !> (runs_nbody), its RK4 stages through the elements' geared forces (stage_powers), its
+    !> modes and impacts on rows of normal (-n, 1) (body_mode_type's scale).
+    logical :: geared = .false.
+    !> Moving grounds or gear ratios (drives%n > 0 or geared): one test where a gap, a mode's
+    !> accelerations or the elements' forces have terms beyond a still ground's unit rows,
+    !> so that a scene with neither pays one test there, as before either was built.
+    logical :: gap_terms = .false.
     ! rows: one unilateral constraint per present limit, what the engine loops over, made
     ! from the records by set_rows in record order, lower limit first (docs/nbody-plan.md
     ! B4: left, right, slot_min, slot_max); gap_r = row_normal(:, r) . x(row_body(:, r))
@@ -509,7 +520,7 @@ contains
   pure logical function runs_nbody(scene)
     type(scene_type), intent(in) :: scene
     runs_nbody = scene%n_bodies > max_lanes .or. scene%drives%n > 0 .or. scene%belts .or. scene%stribeck .or. &
-      scene%n_frictions > 0
+      scene%n_frictions > 0 .or. scene%geared
   end function runs_nbody
 
   !> What the event log of a run of this input keeps (&run events; all by default).
@@ -727,17 +738,18 @@ contains
     if (allocated(error)) return
     call set_frictions(records, scene, error)
     if (allocated(error)) return
-    if (scene%belts .or. scene%stribeck) call refuse_stops(records, 'cannot be combined with belt_v, v_s ' // &
-      'or c_v yet (the two have not been tested together)', error)
-    if (allocated(error)) return
     call set_records(input, records, scene)
     if (scene%drives%n > 0) call refuse_drives(scene, error)
+    if (allocated(error)) return
+    call set_gears(records, scene, error)
     if (allocated(error)) return
     call set_rows(scene, error)
     if (allocated(error)) return
     call set_springs(scene, error)
     if (allocated(error)) return
-    scene%stage_powers = scene%drives%n > 0 .or. scene%belts .or. scene%stribeck .or. scene%n_stops > 0
+    scene%stage_powers = scene%drives%n > 0 .or. scene%belts .or. scene%stribeck .or. scene%n_stops > 0 .or. &
+      scene%geared
+    scene%gap_terms = scene%drives%n > 0 .or. scene%geared
 
     scene%t_end = input%value(i_t_end)
     scene%dt = input%value(i_dt)
@@ -787,7 +799,7 @@ contains
   end subroutine set_laws
 
   !> The &friction records (friction contacts between two bodies), which only the N-body
-  !> engine runs (impact1d_solver's run): neither the vissim method nor compliant stops.
+  !> engine runs (impact1d_solver's run): not the vissim method.
   subroutine set_frictions(records, scene, error)
     type(mechanism_records), intent(in) :: records
     type(scene_type), intent(inout) :: scene
@@ -799,19 +811,34 @@ contains
         'with friction between two bodies (&friction) runs with method = ''event''')
       return
     end if
-    call refuse_stops(records, 'cannot be combined with &friction records yet (the two have not ' // &
-      'been tested together)', error)
-    if (allocated(error)) return
-    ! (the friction laws' ledger, law_powers, books the bodies' own friction only)
-    if (scene%belts .or. scene%stribeck) then
-      call raise(error, status_input, '&friction records cannot be combined with belt_v, v_s or c_v yet')
-      return
-    end if
     scene%friction_body = records%friction_body
     scene%friction_slide = records%friction_slide
     scene%friction_static = records%friction_static
     scene%friction_name = records%friction_name
   end subroutine set_frictions
+
+  !> The records' gear ratios (impact1d_chain's gear_ratio checked each record): a scene
+  !> with one other than 1 is geared, which only the N-body engine runs, so far without the
+  !> vissim method, moving grounds, friction or the friction laws (refused by name: the
+  !> event point's friction tests and moving frames take groups as moving alike).
+  subroutine set_gears(records, scene, error)
+    type(mechanism_records), intent(in) :: records
+    type(scene_type), intent(inout) :: scene
+    type(error_type), allocatable, intent(inout) :: error
+    character(len=:), allocatable :: what
+    scene%contact_ratio = records%contact_ratio
+    scene%element_ratio = records%element_ratio
+    scene%geared = any(records%contact_ratio /= 1.0_wp) .or. any(records%element_ratio /= 1.0_wp)
+    if (.not. scene%geared) return
+    what = ''
+    if (scene%method == 'vissim') what = "method = 'vissim' (the tutorial's scheme)"
+    if (scene%drives%n > 0) what = 'a moving ground (ground_v, ground_amp, x_left_v ...)'
+    if (any(scene%body_static > 0.0_wp) .or. scene%n_frictions > 0) what = 'friction (mu, mus, &friction)'
+    if (scene%belts .or. scene%stribeck) what = 'belt_v, v_s or c_v'
+    if (len(what) > 0) call raise(error, status_input, 'a gear ratio (ratio other than 1) cannot be ' // &
+      'combined with ' // what // ' yet: geared scenes run on the N-body engine''s event method, ' // &
+      'frictionless, on still grounds')
+  end subroutine set_gears
 
   !> A scene with a moving ground runs on the N-body engine (whatever its N), which has no
   !> vissim method.
@@ -1090,7 +1117,9 @@ contains
     integer, intent(in) :: nc
     scene%n_contacts = nc
     allocate(scene%contact_body(2, nc), scene%contact_has(2, nc), scene%contact_limit(2, nc), &
-      scene%contact_restitution(2, nc), scene%contact_name(nc), scene%contact_k(nc), scene%contact_c(nc))
+      scene%contact_restitution(2, nc), scene%contact_name(nc), scene%contact_k(nc), scene%contact_c(nc), &
+      scene%contact_ratio(nc))
+    scene%contact_ratio = 1.0_wp
     scene%contact_body = 0
     scene%contact_has = .false.
     scene%contact_limit = 0.0_wp
@@ -1102,8 +1131,8 @@ contains
 
   !> The rows from the contact records: one per present limit, in record order, the lower
   !> limit first (the row order decides ties, docs/nbody-plan.md B4). A lower limit's gap
-  !> is (x_b - x_a) - d_min, an upper one's d_max - (x_b - x_a); a ground end has no
-  !> coefficient. The two limits of a rigid link (d_min = d_max) are each other's partner.
+  !> is (x_b - x_a) - d_min, an upper one's d_max - (x_b - x_a) (x_b - n x_a with a gear
+  !> ratio n); a ground end has no coefficient. The two limits of a rigid link (d_min = d_max) are each other's partner.
   subroutine set_rows(scene, error)
     type(scene_type), intent(inout) :: scene
     type(error_type), allocatable, intent(inout) :: error
@@ -1135,7 +1164,9 @@ contains
           sgn = merge(1.0_wp, -1.0_wp, e == 1)
           scene%row_contact(r) = j
           scene%row_body(:, r) = scene%contact_body(:, j)
-          scene%row_normal(:, r) = merge([-sgn, sgn], [0.0_wp, 0.0_wp], scene%contact_body(:, j) /= 0)
+          ! (a gear ratio n: the gap of x_b - n x_a, normal (-n, 1) or (n, -1))
+          scene%row_normal(:, r) = merge([-sgn * scene%contact_ratio(j), sgn], [0.0_wp, 0.0_wp], &
+            scene%contact_body(:, j) /= 0)
           scene%row_offset(r) = -sgn * scene%contact_limit(e, j)
           scene%row_restitution(r) = scene%contact_restitution(e, j)
           scene%row_k(r) = scene%contact_k(j)
@@ -1166,6 +1197,24 @@ contains
   end subroutine set_rows
 
 
+  !> A matrix assembled on x_b - x_a (assemble) turned into the geared elements' own: an
+  !> element of coefficient q on x_b - n x_a adds q g g' with g = (-n, 1) on (a, b), so its
+  !> (a, a) entry gains q (n^2 - 1) and its (a, b), (b, a) entries -q (n - 1).
+  pure subroutine gear_matrix(scene, coefficient, matrix)
+    type(scene_type), intent(in) :: scene
+    real(wp), intent(in) :: coefficient(:)
+    real(wp), intent(inout) :: matrix(:, :)
+    integer :: j
+    do j = 1, scene%n_elements
+      associate (a => scene%element_body(1, j), b => scene%element_body(2, j), n => scene%element_ratio(j))
+        if (a == 0 .or. n == 1.0_wp) cycle
+        matrix(a, a) = matrix(a, a) + coefficient(j) * (n**2 - 1.0_wp)
+        matrix(a, b) = matrix(a, b) - coefficient(j) * (n - 1.0_wp)
+        matrix(b, a) = matrix(a, b)
+      end associate
+    end do
+  end subroutine gear_matrix
+
   !> RK4's step against the modes of the springs and dampers (impact1d_stability): past the
   !> largest stable step the numbers would be garbage (positions to 1e76 with a normal exit),
   !> so the scene is refused; a stable step that is coarse for the fastest mode gets a warning
@@ -1194,6 +1243,10 @@ contains
     else
       call assemble(scene%element_body, scene%element_k, k)
       call assemble(scene%element_body, scene%element_c, c)
+    end if
+    if (scene%geared) then
+      call gear_matrix(scene, scene%element_k, k)
+      call gear_matrix(scene, scene%element_c, c)
     end if
     call linear_modes(scene%body_mass, c, k, lambda, ok)
     if (.not. ok) then

@@ -7,8 +7,8 @@ module impact1d_state
   use impact1d_lanes, only: max_lanes
   implicit none
   private
-  public :: state_type, lane_state_type, load_lanes, new_state, add_compensated, accumulate, &
-    renormalise, finite_state, constant_step, constant_steps
+  public :: state_type, lane_state_type, load_lanes, new_state, take_state, add_compensated, accumulate, &
+    renormalise, finite_state, constant_step, constant_steps, product_error
 
   !> Time, positions, velocities and the ledger integrals, compensated: a micrometre bounce
   !> near a wall at x = 10 m keeps its digits, and 10^6 steps of 1e-5 s do not drift the clock
@@ -74,6 +74,33 @@ contains
       to%v(:) = from%v
       to%v_lo(:) = from%v_lo
     end if
+    call copy_scalars(to, from)
+  end subroutine copy_state
+
+  !> to = from without copying the arrays: they are swapped (from is left with to's old
+  !> arrays, its values not to be read: a trial step's end taken as the run's state).
+  pure subroutine take_state(to, from)
+    type(state_type), intent(inout) :: to, from
+    call swap(to%x, from%x)
+    call swap(to%x_lo, from%x_lo)
+    call swap(to%v, from%v)
+    call swap(to%v_lo, from%v_lo)
+    call copy_scalars(to, from)
+  end subroutine take_state
+
+  !> a and b swapped by moving their allocations (no element copied).
+  pure subroutine swap(a, b)
+    real(wp), allocatable, intent(inout) :: a(:), b(:)
+    real(wp), allocatable :: held(:)
+    call move_alloc(a, held)
+    call move_alloc(b, a)
+    call move_alloc(held, b)
+  end subroutine swap
+
+  !> The clock and the ledger of from into to.
+  pure subroutine copy_scalars(to, from)
+    class(state_type), intent(inout) :: to
+    type(state_type), intent(in) :: from
     to%t = from%t
     to%t_lo = from%t_lo
     to%work = from%work
@@ -85,7 +112,7 @@ contains
     to%damping_lo = from%damping_lo
     to%drive_work = from%drive_work
     to%drive_lo = from%drive_lo
-  end subroutine copy_state
+  end subroutine copy_scalars
 
   !> hi + lo += increment: the exact rounding error of hi + increment (Knuth's two-sum, valid
   !> whichever is larger) goes into lo; then hi takes what of lo it can hold (Fast2Sum), so
@@ -108,6 +135,22 @@ contains
     lo = lo + ((hi - (total - rounded)) + (increment - rounded))
     hi = total
   end subroutine accumulate
+
+  !> The exact rounding error of the product a b: a b - fl(a b) (Dekker's two-product with
+  !> Veltkamp's split, no fused multiply-add: the build passes -ffp-contract=off; exact
+  !> while a b neither overflows nor underflows). A gear ratio's gap x_b - n x_a needs it.
+  elemental real(wp) function product_error(a, b) result(error)
+    real(wp), intent(in) :: a, b
+    real(wp), parameter :: split = 134217729.0_wp     ! 2^27 + 1
+    real(wp) :: a_hi, a_lo, b_hi, b_lo, c
+    c = split * a
+    a_hi = c - (c - a)
+    a_lo = a - a_hi
+    c = split * b
+    b_hi = c - (c - b)
+    b_lo = b - b_hi
+    error = (((a_hi * b_hi - a * b) + a_hi * b_lo) + a_lo * b_hi) + a_lo * b_lo
+  end function product_error
 
   !> hi becomes hi + lo correctly rounded and lo what is left (Fast2Sum, exact while |lo| is
   !> below |hi|, as it is but for a sum passing through zero).

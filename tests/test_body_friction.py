@@ -163,11 +163,10 @@ def test_friction_record_inputs_are_checked(record, words):
         impact1d.simulate(scene)
 
 
-def test_vissim_and_compliant_stops_refuse_the_record():
+def test_vissim_refuses_the_record():
+    """(compliant stops and the friction laws with the record: tests/test_combined_laws.py)"""
     with pytest.raises(impact1d.InputError, match="friction between two bodies"):
         impact1d.simulate(sliding_blocks(1e-3, 0.1, method="vissim"))
-    with pytest.raises(impact1d.InputError, match="cannot be combined with &friction records"):
-        impact1d.simulate(sliding_blocks(1e-3, 0.1, contacts=[{"a": 0, "b": 1, "d_min": -1.0, "k": 1e4}]))
 
 
 def test_a_stuck_pair_stays_stuck_while_another_contact_sticks():

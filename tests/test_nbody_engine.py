@@ -547,9 +547,10 @@ def test_engine_train_start_up(friction):
 # --- the N-body scenes of input/ ------------------------------------------------------------------
 
 NBODY_FILES = ("newtons_cradle.nml", "train.nml", "ball_stack.nml", "gear_train.nml")
-# Held to its closed form in tests/test_example_scenes.py (its springs and moving driver are
-# beyond exact_nbody).
-EXAMPLE_FILES = ("burridge_knopoff.nml",)
+# Held to their closed forms in tests/test_example_scenes.py (burridge_knopoff: its springs
+# and moving driver are beyond exact_nbody) and tests/test_gears.py (geared_train: its gear
+# ratios are).
+EXAMPLE_FILES = ("burridge_knopoff.nml", "geared_train.nml")
 
 
 def stack() -> dict:

@@ -1,12 +1,14 @@
 !> The compensated state: a clock advanced by 10^6 steps of 1e-5 s keeps its digits, and
 !> the bulk constant-force steps of the glide give the bits of the step-by-step path, and a
-!> state assigned to another is copied whole, into the arrays it has when their size fits.
+!> state assigned to another is copied whole, into the arrays it has when their size fits;
+!> product_error is the exact rounding error of a product (a gear ratio's gap).
 program test_state
   use, intrinsic :: iso_fortran_env, only: int64
   use, intrinsic :: iso_c_binding, only: c_ptr, c_loc, c_associated
   use impact1d_kinds, only: wp
   use impact1d_lanes, only: max_lanes
-  use impact1d_state, only: state_type, new_state, lane_state_type, add_compensated, renormalise, constant_step, constant_steps
+  use impact1d_state, only: state_type, new_state, lane_state_type, add_compensated, renormalise, constant_step, &
+    constant_steps, product_error
   use testing, only: check, finish
   implicit none
   integer, parameter :: n_steps = 1000000
@@ -32,9 +34,31 @@ program test_state
   call bulk_against_steps(1)
   call bulk_against_steps(2)
   call assignment_copies()
+  call product_errors()
   call finish('test_state')
 
 contains
+
+  !> a b - fl(a b) from product_error against the product in quadruple precision (113 bits
+  !> hold the 106 of the exact product): random factors over 60 binades of either sign, and
+  !> a gear's 3 x 0.1, whose error is not 0 (the check can fail).
+  subroutine product_errors()
+    integer, parameter :: qp = selected_real_kind(30)
+    real(wp) :: a, b, u(4)
+    logical :: exact
+    integer :: k
+    exact = .true.
+    do k = 1, 2000
+      call random_number(u)
+      a = sign((0.5_wp + u(1)) * 2.0_wp**int(60 * u(2) - 30), u(3) - 0.5_wp)
+      b = (0.5_wp + u(4)) * 2.0_wp**int(20 * u(1) - 10)
+      exact = exact .and. real(product_error(a, b), qp) == real(a, qp) * real(b, qp) - real(a * b, qp)
+    end do
+    call check(exact, 'product_error: the exact rounding error of 2000 random products')
+    call check(product_error(3.0_wp, 0.1_wp) /= 0.0_wp .and. real(product_error(3.0_wp, 0.1_wp), qp) == &
+      3.0_qp * real(0.1_wp, qp) - real(3.0_wp * 0.1_wp, qp), 'product_error: 3 x 0.1, not exact in doubles')
+    call check(product_error(-1.0_wp, 0.1_wp) == 0.0_wp, 'product_error: a unit ratio is exact')
+  end subroutine product_errors
 
   !> b = a (state_type's own assignment): every field copied; b's arrays kept when they have
   !> a's size (the same address), made anew when not, freed when a has none.

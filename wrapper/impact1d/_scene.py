@@ -63,8 +63,9 @@ ARRAY_FIELDS = ("m", "mu", "mus", "x", "v", "f", "f_amp", "f_period", "f_phase",
 LAW_FIELDS = ("belt_v", "v_s", "c_v")
 # A record with a ground end (a or b = 0) may move it: GROUND_FIELDS (DESIGN "Laws added").
 GROUND_FIELDS = ("ground_v", "ground_amp", "ground_period", "ground_phase")
-CONTACT_FIELDS = ("a", "b", "d_min", "r_min", "d_max", "r_max", "name", "k", "c") + GROUND_FIELDS
-SPRING_FIELDS = ("a", "b", "k", "d_rest", "c") + GROUND_FIELDS
+# A gear ratio n on a contact or spring (DESIGN "Laws added"): it acts on x_b - n x_a.
+CONTACT_FIELDS = ("a", "b", "d_min", "r_min", "d_max", "r_max", "name", "k", "c") + GROUND_FIELDS + ("ratio",)
+SPRING_FIELDS = ("a", "b", "k", "d_rest", "c") + GROUND_FIELDS + ("ratio",)
 SINE_FIELDS = ("body", "amp", "period", "phase")
 # A friction contact between bodies a and b under a constant normal load (DESIGN "Laws added").
 FRICTION_FIELDS = ("a", "b", "mu", "mus", "normal", "name")
@@ -91,7 +92,9 @@ class Scene:
     ..., and `d_min`, `r_min`, `d_max`, `r_max`, `d_rest` given as sequences), `r_meet`,
     and `contacts` / `springs` / `sines` / `frictions`: lists of dicts with the &contact /
     &spring / &sine / &friction fields (`{"a": 0, "b": 3, "d_min": -1.0, "name": "stop3"}`,
-    `{"body": 1, "amp": 2.0, "period": 0.5}`, `{"a": 1, "b": 2, "mu": 0.3, "normal": 9.81}`). One or two bodies given so run as the tutorial's names, with
+    `{"body": 1, "amp": 2.0, "period": 0.5}`, `{"a": 1, "b": 2, "mu": 0.3, "normal": 9.81}`; a gear
+    ratio on a contact or spring, `{"a": 1, "b": 2, "d_min": -0.01, "d_max": 0.01, "ratio": 3.0}`,
+    acts on x_b - ratio x_a). One or two bodies given so run as the tutorial's names, with
     their records; more wait for the N-body engine (InputError).
     """
 
