@@ -835,7 +835,8 @@ contains
   !> function on the integrator's own state (exact under polynomial forcing at once). A row
   !> with a moving ground end was located on its cubic, whose root may come before the
   !> exact one, and so was a sliding body's stop under forcing that is not polynomial (the
-  !> cubic's velocity): Newton may then go on up to the step taken (limit).
+  !> cubic's velocity), and a friction contact's relative stop (found_friction) likewise:
+  !> Newton may then go on up to the step taken (limit).
   subroutine refine_nbody(scene, mode, polynomial, a, step, found, index, b, kept, limit)
     type(scene_type), intent(in) :: scene
     type(body_mode_type), intent(in) :: mode
@@ -852,16 +853,26 @@ contains
     if (present(limit) .and. found == found_row .and. scene%drives%n > 0) then
       if (scene%row_drive(index) > 0) located_step = limit
     end if
-    if (present(limit) .and. found == found_body .and. .not. polynomial) located_step = limit
+    if (present(limit) .and. (found == found_body .or. found == found_friction) .and. .not. polynomial) &
+      located_step = limit
     call nbody_step(scene, mode, a, step, b, kept)
-    if (found /= found_row .and. found /= found_body .and. found /= found_stop) return
+    if (all(found /= [found_row, found_body, found_stop, found_friction])) return
     do iteration = 1, 8
-      if (found == found_body) then
-        value = slip(scene, index, b%v(index))
+      if (found == found_body .or. found == found_friction) then
         call nbody_force(scene, b%t, b%x, b%x_lo, b%v, f, mode%engaged)
         call law_acceleration(scene, mode, b%t, b%v, f, acc)
-        slope = acc(index)
-        tol = velocity_rounding * max(abs(a%v(index)), abs(value))
+        if (found == found_body) then
+          value = slip(scene, index, b%v(index))
+          slope = acc(index)
+          tol = velocity_rounding * max(abs(a%v(index)), abs(value))
+        else
+          ! a contact's stop: its ends' relative velocity v_b - v_a, rounded as relative_stops
+          associate (ea => scene%friction_body(1, index), eb => scene%friction_body(2, index))
+            value = relative_velocity(scene, index, b%v)
+            slope = relative_velocity(scene, index, acc)
+            tol = velocity_rounding * max(abs(a%v(ea)) + abs(a%v(eb)), abs(value))
+          end associate
+        end if
       else if (found == found_stop) then
         ! A stop's force F = -(k gap + c gap'), its rate -(k gap' + c gap'').
         call nbody_force(scene, b%t, b%x, b%x_lo, b%v, f, mode%engaged)
