@@ -1,10 +1,12 @@
 !> Prescribed motion of the ground end of a contact or element (docs/method.md section 11):
-!> w(t) = v t + amp sin(omega t + phase), each term present only when named. The gap of a row
+!> w(t) = v t + amp sin(omega t + phase) + table(t), each term present only when named (the
+!> table: piecewise linear between its corners, held at its ends, as a force table). The gap of a row
 !> with a moving ground end is x_b - w(t) - limit, a spring to a moving anchor stretches by
 !> x_b - w(t) - rest; w and its derivatives are evaluated exactly here (never interpolated),
 !> so that the engine's gaps, impacts and held rows see the motion the user wrote.
 module impact1d_drives
   use impact1d_kinds, only: wp
+  use impact1d_forcing, only: table_type, table_value, table_slope, segment
   implicit none
   private
   public :: drive_type
@@ -14,7 +16,12 @@ module impact1d_drives
     integer :: n = 0                             !< nd (0: every ground stays still)
     real(wp), allocatable :: v(:)                !< (nd) constant velocity, m/s
     real(wp), allocatable :: amp(:), omega(:), phase(:)   !< (nd) the sine: m, rad/s (0: none), rad
-    logical :: polynomial = .true.               !< no drive has a sine: w is linear in t
+    logical :: polynomial = .true.               !< no drive has a sine: w is piecewise linear in t
+    !> (nd) the drive's table (ground_table), when has_table: its velocity jumps at the
+    !> corners, which are stops (next_corner); w' there is the slope after the corner
+    logical, allocatable :: has_table(:)
+    type(table_type), allocatable :: table(:)
+    logical :: tables = .false.                  !< some drive has a table
   contains
     procedure :: add
     procedure :: position
@@ -24,19 +31,31 @@ module impact1d_drives
     procedure :: velocity
     procedure :: acceleration
     procedure :: jerk
+    procedure :: next_corner
+    procedure :: before_corner
   end type drive_type
 
 contains
 
-  !> One more drive (v, amp, omega, phase); its index is self%n after.
-  pure subroutine add(self, v, amp, omega, phase)
+  !> One more drive (v, amp, omega, phase, and its table when given); its index is self%n after.
+  pure subroutine add(self, v, amp, omega, phase, table)
     class(drive_type), intent(inout) :: self
     real(wp), intent(in) :: v, amp, omega, phase
-    if (.not. allocated(self%v)) allocate(self%v(0), self%amp(0), self%omega(0), self%phase(0))
+    type(table_type), intent(in), optional :: table
+    type(table_type) :: none
+    if (.not. allocated(self%v)) allocate(self%v(0), self%amp(0), self%omega(0), self%phase(0), &
+      self%has_table(0), self%table(0))
     self%v = [self%v, v]
     self%amp = [self%amp, amp]
     self%omega = [self%omega, omega]
     self%phase = [self%phase, phase]
+    self%has_table = [self%has_table, present(table)]
+    if (present(table)) then
+      self%table = [self%table, table]
+    else
+      self%table = [self%table, none]
+    end if
+    self%tables = any(self%has_table)
     self%n = self%n + 1
     self%polynomial = self%polynomial .and. omega == 0.0_wp
   end subroutine add
@@ -48,6 +67,9 @@ contains
     real(wp), intent(in) :: t
     w = self%v(d) * t
     if (self%omega(d) /= 0.0_wp) w = w + self%amp(d) * sin(self%omega(d) * t + self%phase(d))
+    if (self%tables) then
+      if (self%has_table(d)) w = w + table_value(self%table(d), t)
+    end if
   end function position
 
   !> w_d at the clock t + t_lo as hi + lo: v t without rounding (Dekker's product), the
@@ -74,6 +96,9 @@ contains
     lo = ((v_hi * t_hi - hi) + v_hi * t_lo_part + v_lo * t_hi) + v_lo * t_lo_part
     lo = lo + self%velocity(d, t) * t_lo
     if (self%omega(d) /= 0.0_wp) lo = lo + self%amp(d) * sin(self%omega(d) * t + self%phase(d))
+    if (self%tables) then
+      if (self%has_table(d)) lo = lo + table_value(self%table(d), t)
+    end if
   end subroutine position_parts
 
   !> The size of what position_parts rounds in w_d(t): the sine's |amp sin(omega t + phase)|
@@ -85,6 +110,9 @@ contains
     real(wp), intent(in) :: t
     w = 0.0_wp
     if (self%omega(d) /= 0.0_wp) w = abs(self%amp(d) * sin(self%omega(d) * t + self%phase(d)))
+    if (self%tables) then
+      if (self%has_table(d)) w = w + abs(table_value(self%table(d), t))
+    end if
   end function rounded_part
 
   !> w_d(t + h) - w_d(t), accurate however small h is against t (a difference of positions
@@ -97,7 +125,26 @@ contains
     dw = self%v(d) * h
     if (self%omega(d) /= 0.0_wp) dw = dw + 2.0_wp * self%amp(d) * cos(self%omega(d) * (t + 0.5_wp * h) + &
       self%phase(d)) * sin(0.5_wp * self%omega(d) * h)
+    if (self%tables) then
+      if (self%has_table(d)) dw = dw + table_displacement(self%table(d), t, h)
+    end if
   end function displacement
+
+  !> table(t + h) - table(t): the segment's slope times h within one segment (a step never
+  !> crosses a corner: corners are stops), so that a step below the clock's ulp counts.
+  pure real(wp) function table_displacement(table, t, h) result(dw)
+    type(table_type), intent(in) :: table
+    real(wp), intent(in) :: t, h
+    integer :: k
+    k = segment(table%t, t)
+    if (k == size(table%t)) then
+      dw = 0.0_wp
+    else if (t + h <= table%t(k + 1)) then
+      dw = table_slope(table, k) * h
+    else
+      dw = table_value(table, t + h) - table_value(table, t)
+    end if
+  end function table_displacement
 
   !> w_d'(t).
   pure real(wp) function velocity(self, d, t) result(w)
@@ -106,6 +153,9 @@ contains
     real(wp), intent(in) :: t
     w = self%v(d)
     if (self%omega(d) /= 0.0_wp) w = w + self%amp(d) * self%omega(d) * cos(self%omega(d) * t + self%phase(d))
+    if (self%tables) then
+      if (self%has_table(d)) w = w + table_slope(self%table(d), segment(self%table(d)%t, t))
+    end if
   end function velocity
 
   !> w_d''(t).
@@ -125,4 +175,32 @@ contains
     w = 0.0_wp
     if (self%omega(d) /= 0.0_wp) w = -self%amp(d) * self%omega(d)**3 * cos(self%omega(d) * t + self%phase(d))
   end function jerk
+
+  !> The first table corner strictly after t (huge if none): steps end there exactly, where
+  !> a table's velocity jumps (as force tables' corners: impact1d_forcing's next_breakpoint).
+  pure real(wp) function next_corner(self, t) result(t_next)
+    class(drive_type), intent(in) :: self
+    real(wp), intent(in) :: t
+    integer :: d, k
+    t_next = huge(1.0_wp)
+    if (.not. self%tables) return
+    do d = 1, self%n
+      if (.not. self%has_table(d)) cycle
+      k = segment(self%table(d)%t, t) + 1
+      if (k <= size(self%table(d)%t)) t_next = min(t_next, self%table(d)%t(k))
+    end do
+  end function next_corner
+
+  !> The time at which a step from t0 ending at t1 sees the drives at its end: t1, or the
+  !> float before a corner in (t0, t1] (the step ends there: velocity takes the slope after
+  !> a corner, the step's end the one before it; w moves by the slope times an ulp).
+  pure real(wp) function before_corner(self, t0, t1) result(t)
+    class(drive_type), intent(in) :: self
+    real(wp), intent(in) :: t0, t1
+    real(wp) :: corner
+    t = t1
+    if (.not. self%tables) return
+    corner = self%next_corner(t0)
+    if (corner <= t1) t = max(t0, nearest(corner, -1.0_wp))
+  end function before_corner
 end module impact1d_drives

@@ -922,7 +922,8 @@ contains
   end subroutine put_records
 
   !> Records, a line per given field ('# group.r.field = value'); field name_field (0: none)
-  !> is the record's name, written when not blank.
+  !> is the record's name, written when not blank; ground_table its table's path (as read:
+  !> relative to the folder the run started in, or absolute).
   subroutine put_numeric_records(self, group, fields, records, name_field)
     class(file_sink), intent(inout) :: self
     character(len=*), intent(in) :: group, fields(:)
@@ -933,8 +934,11 @@ contains
     do r = 1, size(records)
       do f = 1, size(fields)
         write(key, '(a, ".", i0, ".", a)') group, r, trim(fields(f))
-        if (f /= name_field .and. records(r)%given(f)) call self%put_line(self%unit, '# ' // trim(key) // ' = ' // &
-          trim(fmt(records(r)%value(f))))
+        if (fields(f) == 'ground_table') then
+          if (allocated(records(r)%table)) call self%put_line(self%unit, '# ' // trim(key) // ' = ' // records(r)%table)
+        else if (f /= name_field .and. records(r)%given(f)) then
+          call self%put_line(self%unit, '# ' // trim(key) // ' = ' // trim(fmt(records(r)%value(f))))
+        end if
       end do
       if (name_field == 0 .or. .not. allocated(records(r)%name)) cycle
       write(key, '(a, ".", i0, ".name")') group, r

@@ -11,7 +11,7 @@ module impact1d_scene
   use impact1d_lanes, only: max_lanes
   use impact1d_drives, only: drive_type
   use impact1d_fields, only: chain_input, mechanism_records, r_k, r_c, r_stop_k, r_stop_c, r_ground_v, &
-    r_spring_ground_v, n_ground_fields, array_value, a_m, &
+    r_spring_ground_v, r_ground_table, r_spring_ground_table, array_value, a_m, &
     a_mu, a_mus, a_x, a_v, a_belt_v, a_v_s, a_c_v, &
     a_f, a_f_amp, a_f_period, a_f_phase, a_f_table
   use impact1d_stability, only: linear_modes, stable_step, mode_error, coarse_rate
@@ -973,22 +973,33 @@ contains
     scene%element_drive = 0
     if (.not. allocated(records%contact_ground)) return
     do j = 1, records%n_contacts
-      if (records%contact_moves(j)) call add_drive(records%contact_ground(:, j), scene%contact_drive(j))
+      if (.not. records%contact_moves(j)) cycle
+      if (allocated(records%contact_table_path(j)%s)) then
+        call add_drive(records%contact_ground(:, j), scene%contact_drive(j), records%contact_table(j))
+      else
+        call add_drive(records%contact_ground(:, j), scene%contact_drive(j))
+      end if
     end do
     do j = 1, records%n_elements
-      if (records%element_moves(j)) call add_drive(records%element_ground(:, j), scene%element_drive(j))
+      if (.not. records%element_moves(j)) cycle
+      if (allocated(records%element_table_path(j)%s)) then
+        call add_drive(records%element_ground(:, j), scene%element_drive(j), records%element_table(j))
+      else
+        call add_drive(records%element_ground(:, j), scene%element_drive(j))
+      end if
     end do
 
   contains
 
-    !> ground = (v, amp, period, phase): drive d.
-    subroutine add_drive(ground, d)
+    !> ground = (v, amp, period, phase) and the table, if any: drive d.
+    subroutine add_drive(ground, d, table)
       real(wp), intent(in) :: ground(:)
       integer, intent(out) :: d
+      type(table_type), intent(in), optional :: table
       real(wp) :: omega
       omega = 0.0_wp
       if (ground(3) > 0.0_wp .and. ground(2) /= 0.0_wp) omega = angular_frequency(ground(3))
-      call scene%drives%add(ground(1), ground(2), omega, ground(4))
+      call scene%drives%add(ground(1), ground(2), omega, ground(4), table)
       d = scene%drives%n
     end subroutine add_drive
   end subroutine set_drives
@@ -1020,13 +1031,12 @@ contains
     ground_named = any(input%given(i_x_left_v:i_x_right_v + 3)) .or. input%chain%array(a_belt_v)%n > 0
     if (allocated(input%chain%contacts)) then
       do r = 1, size(input%chain%contacts)
-        ground_named = ground_named .or. any(input%chain%contacts(r)%given(r_ground_v:r_ground_v + n_ground_fields - 1))
+        ground_named = ground_named .or. any(input%chain%contacts(r)%given(r_ground_v:r_ground_table))
       end do
     end if
     if (.not. allocated(input%chain%springs)) return
     do r = 1, size(input%chain%springs)
-      ground_named = ground_named .or. any(input%chain%springs(r)%given(r_spring_ground_v:r_spring_ground_v + &
-        n_ground_fields - 1))
+      ground_named = ground_named .or. any(input%chain%springs(r)%given(r_spring_ground_v:r_spring_ground_table))
     end do
   end function ground_named
 

@@ -61,10 +61,13 @@ ARRAY_FIELDS = ("m", "mu", "mus", "x", "v", "f", "f_amp", "f_period", "f_phase",
 # The friction laws' arrays (DESIGN "Laws added on the records"): arrays for any N, with no
 # tutorial name; they go to the core with the records (record_fields).
 LAW_FIELDS = ("belt_v", "v_s", "c_v")
-# A record with a ground end (a or b = 0) may move it: GROUND_FIELDS (DESIGN "Laws added").
-GROUND_FIELDS = ("ground_v", "ground_amp", "ground_period", "ground_phase")
+# A record with a ground end (a or b = 0) may move it: GROUND_FIELDS (DESIGN "Laws added");
+# ground_table is the path of a (t, w) table, read as a force table is.
+GROUND_FIELDS = ("ground_v", "ground_amp", "ground_period", "ground_phase", "ground_table")
 CONTACT_FIELDS = ("a", "b", "d_min", "r_min", "d_max", "r_max", "name", "k", "c") + GROUND_FIELDS
 SPRING_FIELDS = ("a", "b", "k", "d_rest", "c") + GROUND_FIELDS
+# The records' fields that are texts.
+_RECORD_TEXT_FIELDS = ("name", "ground_table")
 SINE_FIELDS = ("body", "amp", "period", "phase")
 # A friction contact between bodies a and b under a constant normal load (DESIGN "Laws added").
 FRICTION_FIELDS = ("a", "b", "mu", "mus", "normal", "name")
@@ -380,7 +383,7 @@ def to_assignments(scene: Scene):
             for key, value in record.items():
                 if value is None:
                     continue
-                if key == "name":
+                if key in _RECORD_TEXT_FIELDS:
                     texts.append((_ID[prefix + key], j, _text(f"{group}[{j - 1}].name", value)))
                 else:
                     numbers.append((_ID[prefix + key], j, _number(f"{group}[{j - 1}].{key}", value)))
