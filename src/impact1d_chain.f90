@@ -10,7 +10,8 @@ module impact1d_chain
     positive_value, nonnegative_value, unit_interval, resolvable, unresolved, i_m1, i_m2, i_x_left, i_r_left, i_x_right, &
     i_r_right, i_r_min, i_d_min, i_g, default_gravity, i_mu1, i_mu2, i_mus1, i_mus2, i_x1, i_x2, i_v1, i_v2, i_f1, i_f2, &
     i_f1_amp, i_f2_amp, i_f1_period, i_f2_period, i_f1_phase, i_f2_phase, i_k1, i_k2, i_x1_rest, i_x2_rest, &
-    i_c1, i_c2, i_d_max, i_r_max, i_k12, i_d_rest, i_c12, i_f1_table, i_f2_table, i_x_left_v, i_x_right_v
+    i_c1, i_c2, i_d_max, i_r_max, i_k12, i_d_rest, i_c12, i_f1_table, i_f2_table, i_x_left_v, i_x_right_v, &
+    i_x_left_table, i_x_right_table
   use impact1d_forcing, only: table_value
   use impact1d_fields, only: array_value, n_arrays, array_names, array_is_link, array_is_text, alias_name, name_len, &
     record_input, a_m, a_mu, a_mus, a_x, a_f_amp, a_f_period, a_f_phase, a_k, a_x_rest, a_c, a_d_min, a_r_min, &
@@ -677,7 +678,7 @@ contains
     end if
   end subroutine motion_terms
 
-  !> The walls' prescribed motion (x_left_v ..., x_right_v ...): each needs its wall.
+  !> The walls' prescribed motion (x_left_v ..., x_left_table, x_right_v ...): each needs its wall.
   subroutine wall_motion_terms(input, error)
     type(scene_input), intent(in) :: input
     type(error_type), allocatable, intent(inout) :: error
@@ -687,10 +688,11 @@ contains
       first = merge(i_x_left_v, i_x_right_v, side == 1)
       wall = merge(i_x_left, i_x_right, side == 1)
       prefix = merge('x_left ', 'x_right', side == 1)
-      if (.not. any(input%given(first:first + n_ground_fields - 1))) cycle
+      if (.not. (any(input%given(first:first + n_ground_fields - 1)) .or. &
+        given_slot(input, n_real + merge(i_x_left_table, i_x_right_table, side == 1)))) cycle
       if (.not. input%given(wall)) then
-        call raise(error, status_input, trim(prefix) // '_v, _amp, _period, _phase move the wall ' // trim(prefix) // &
-          ', which is not given')
+        call raise(error, status_input, trim(prefix) // '_v, _amp, _period, _phase, _table move the wall ' // &
+          trim(prefix) // ', which is not given')
         return
       end if
       call motion_terms(input%given(first:first + n_ground_fields - 1), input%value(first:first + n_ground_fields - 1), &
@@ -911,21 +913,24 @@ contains
     type(mechanism_records), intent(inout) :: records
     if (input%given(i_x_left)) then
       call add_contact(records, 'left', 0, 1, 1, input%value(i_x_left), value_or(input, i_r_left, 1.0_wp))
-      call wall_motion(i_x_left_v)
+      call wall_motion(i_x_left_v, i_x_left_table)
     end if
     if (input%given(i_x_right)) then
       call add_contact(records, 'right', 0, n, 2, input%value(i_x_right), value_or(input, i_r_right, 1.0_wp))
-      call wall_motion(i_x_right_v)
+      call wall_motion(i_x_right_v, i_x_right_table)
     end if
 
   contains
 
-    !> The wall just added moves as its fields from first (x_left_v ...) say, when any is given.
-    subroutine wall_motion(first)
-      integer, intent(in) :: first
+    !> The wall just added moves as its fields from first (x_left_v ...) and its table (text
+    !> field table: x_left_table ...) say, when any is given.
+    subroutine wall_motion(first, table)
+      integer, intent(in) :: first, table
       associate (k => records%n_contacts, given => input%given(first:first + n_ground_fields - 1))
         records%contact_moves(k) = any(given)
         records%contact_ground(:, k) = merge(input%value(first:first + n_ground_fields - 1), 0.0_wp, given)
+        if (given_slot(input, n_real + table)) call set_table_path(records%contact_table_path(k), &
+          records%contact_moves(k), trim(input%text(table)%s))
       end associate
     end subroutine wall_motion
   end subroutine wall_records

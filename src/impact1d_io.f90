@@ -23,9 +23,10 @@ module impact1d_io
   !> The groups that may be given any number of times, each occurrence a record.
   integer, parameter :: g_contact = 9, g_spring = 10, g_sine = 11, g_friction = 12, g_run = 8
   !> Each group's variables: which group a name belongs to, and the message about a misspelt one.
-  character(len=*), parameter :: group_variables(size(known_groups)) = [character(len=160) :: &
+  character(len=*), parameter :: group_variables(size(known_groups)) = [character(len=176) :: &
     'title', 'm1, m2, mu1, mu2, mus1, mus2, g', 'x_left, r_left, x_right, r_right, x_left_v, x_left_amp, ' // &
-    'x_left_period, x_left_phase, x_right_v, x_right_amp, x_right_period, x_right_phase', 'd_min, r_min, d_max, r_max', &
+    'x_left_period, x_left_phase, x_right_v, x_right_amp, x_right_period, x_right_phase, x_left_table, ' // &
+    'x_right_table', 'd_min, r_min, d_max, r_max', &
     'x1, v1, x2, v2', 'f1, f2, f1_table, f2_table, f1_amp, f1_period, f1_phase, f2_amp, f2_period, f2_phase', &
     'k1, x1_rest, c1, k2, x2_rest, c2, k12, d_rest, c12', &
     't_end, dt, dt_out, method, zero_vel, max_rows, max_impulses, max_step_events, substeps, events, max_events, ' // &

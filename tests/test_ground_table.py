@@ -261,3 +261,58 @@ def test_lift_example_and_its_plot():
         assert back.scene.contacts[0]["ground_table"] == "input/lift_table.dat"
         again = impact1d.simulate(back.scene)
         np.testing.assert_array_equal(again.x1, back.x1)
+
+
+def test_wall_tables_are_the_records_tables(tmp_path):
+    """&walls x_left_table, x_right_table (DESIGN's names; Scene fields) move the walls as
+    a &contact record's ground_table does: the same run, bit for bit; the right wall closes
+    in at 0.2 m/s from t = 1 s and stops at 0.8 m."""
+    table = write_table(tmp_path / "closing.dat", [(1.0, 0.0), (2.0, -0.2)])
+    common = dict(m1=1.0, x1=0.5, v1=1.3, t_end=4.0, dt=1e-3, dt_out=0.01)
+    walls = impact1d.Scene(x_left=0.0, x_right=1.0, r_right=0.9, x_right_table=table, **common)
+    records = impact1d.Scene(contacts=[
+        dict(a=0, b=1, d_min=0.0, r_min=1.0, name="left"),
+        dict(a=0, b=1, d_max=1.0, r_max=0.9, ground_table=table, name="right")], **common)
+    a, b = impact1d.simulate(walls), impact1d.simulate(records)
+    assert len(a.events) > 3
+    np.testing.assert_array_equal(a.events, b.events)
+    np.testing.assert_array_equal(a.samples, b.samples)
+    assert a.columns == b.columns and "drive_work" in a.columns
+    assert np.all(a.x1 <= 1.0 + np.interp(a.t, [1.0, 2.0], [0.0, -0.2]) + 1e-12)
+
+
+def test_wall_table_in_a_namelist_runs_and_rebuilds(tmp_path):
+    """&walls x_left_table = 'floor.dat' (beside the scene file) through the CLI: the output
+    header names it (# x_left_table = ...), read_output rebuilds the scene, which runs the
+    same; the plot draws the wall where the table puts it."""
+    import subprocess
+    import tools
+    from impact1d import plot
+    write_table(tmp_path / "floor.dat", [(0.0, 0.0), (0.5, 0.0), (1.5, 1.0)])
+    (tmp_path / "lift.nml").write_text(
+        "&bodies m1 = 1.0 /\n&walls x_left = 0.0, r_left = 0.5, x_left_table = 'floor.dat' /\n"
+        "&initial x1 = 0.0, v1 = 0.0 /\n&forces f1 = -9.81 /\n&run t_end = 2.0, dt = 1e-3, dt_out = 0.01 /\n")
+    scene = impact1d.load_scene(tmp_path / "lift.nml")
+    assert scene.x_left_table == str(tmp_path / "floor.dat")
+    result = impact1d.simulate(scene)
+    left = result.events[result.events["kind"] == "left"]
+    assert left["t"][0] == 0.5 and left["v1_after"][0] == pytest.approx(1.5, abs=1e-14)
+    out = tmp_path / "out.dat"
+    subprocess.run([tools.find_tool("impact1d"), str(tmp_path / "lift.nml"), "-o", str(out)], check=True,
+                   capture_output=True)
+    back = impact1d.read_output(out)
+    assert back.scene.x_left_table == str(tmp_path / "floor.dat")
+    np.testing.assert_array_equal(back.x1, result.x1)
+    np.testing.assert_array_equal(impact1d.simulate(back.scene).x1, back.x1)
+    lines = [a for ax in plot.figure(back).axes for a in ax.get_children() if a.get_gid() == "wall:left"]
+    assert len(lines) == 1
+    np.testing.assert_allclose(lines[0].get_ydata(), np.interp(lines[0].get_xdata(), [0.0, 0.5, 1.5], [0.0, 0.0, 1.0]),
+                               rtol=0, atol=1e-15)
+
+
+def test_wall_table_needs_its_wall(tmp_path):
+    table = write_table(tmp_path / "w.dat", [(0.0, 0.0), (1.0, 1.0)])
+    scene = impact1d.Scene(m1=1.0, x1=0.0, t_end=1.0, dt=1e-3, x_left_table=table)
+    with pytest.raises(impact1d.InputError, match="x_left_v, _amp, _period, _phase, _table move the wall x_left, "
+                                                  "which is not given"):
+        impact1d.simulate(scene)

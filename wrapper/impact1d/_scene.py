@@ -51,7 +51,7 @@ REAL_FIELDS = (
     "x_left_v", "x_left_amp", "x_left_period", "x_left_phase",
     "x_right_v", "x_right_amp", "x_right_period", "x_right_phase",
 )
-TEXT_FIELDS = ("title", "f1_table", "f2_table", "method", "substeps", "events")
+TEXT_FIELDS = ("title", "f1_table", "f2_table", "method", "substeps", "events", "x_left_table", "x_right_table")
 # The N-body scene (DESIGN "Mechanisms as data"): arrays (body i's value at i; the &link
 # ones and k_link, d_rest, c_link one per neighbour pair), &link r_meet, and the fields of
 # the &contact, &spring, &sine and &friction records. Checked against _api.input_field_names() at import.
@@ -158,6 +158,9 @@ class Scene:
     method: Optional[str] = None
     substeps: Optional[str] = None     # 'auto': dt divided for springs coarse at dt
     events: Optional[str] = None       # 'all' (default), 'impacts' or 'none': what the log keeps
+    # The walls' tables (paths, read as force tables are), added to x_left / x_right.
+    x_left_table: Optional[str] = None
+    x_right_table: Optional[str] = None
     source: Optional[str] = None
     m: Optional[Sequence[float]] = None
     mu: Optional[Sequence[float]] = None

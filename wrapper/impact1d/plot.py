@@ -801,7 +801,8 @@ def _tutorial_records(result, n, joined=()):
         if value["x_" + wall] is not None:
             # (a moving wall, &walls x_left_v ...: its record's ground_* fields, as the engine's)
             records.append(dict(a=0, b=body, name=wall, **{"d_" + side: value["x_" + wall]}, **{
-                "ground_" + f: _float_or_none(_scene_value(result, f"x_{wall}_{f}")) for f in _MOTION_FIELDS}))
+                "ground_" + f: _float_or_none(_scene_value(result, f"x_{wall}_{f}")) for f in _MOTION_FIELDS},
+                ground_table=_scene_value(result, f"x_{wall}_table")))
     if n > 2:
         return records + _chain_links(result, n, joined)
     if n == 2:
