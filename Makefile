@@ -21,7 +21,7 @@ BUILDDIR := $(CURDIR)/build/py
 # contact records), then scenes of N bodies (their plots: the space-time picture).
 SCENES   := case1 case2 case3 case4 case5 case6 impact_oscillator stick_slip gear_rattle breakaway mounted_stop \
             inner_stop newtons_cradle train ball_stack gear_train geared_train burridge_knopoff vibrating_table \
-            drill_string
+            drill_string lift_table
 
 # What the installed package is made of: a change re-installs it (folders too,
 # so that a deleted file counts).
@@ -37,7 +37,8 @@ help:
 	@echo "make setup   gfortran (apt, if missing), .venv, pip install .[test]"
 	@echo "make demo    run the scenes in input/ (the six cases, springs, stick-slip, rattle, break-away,"
 	@echo "             contact records, Newton's cradle, a train, a ball stack, two gear trains (unit ratios; ratios 3 and 1/2), a"
-	@echo "             Burridge-Knopoff chain, a vibrating table, a drill string in stick-slip),"
+	@echo "             Burridge-Knopoff chain, a vibrating table, a drill string in stick-slip,"
+	@echo "             a ball in a lift),"
 	@echo "             plot them, animate case 3, the cradle and the train (docs/*.gif)"
 	@echo "make test    Fortran unit tests (meson test), then pytest"
 	@echo "make study   case 5's rest time over (r_left, r_right), the impact oscillator's bifurcation diagram"

@@ -11,7 +11,7 @@ module impact1d_api
   use impact1d_error, only: error_type, status_ok, status_input, status_interrupted, raise, fmt
   use impact1d_interrupt, only: catch_interrupts, interrupt_count
   use impact1d_scene, only: scene_input, scene_type, validate, n_real, n_text, real_names, text_names, &
-    i_title, i_f1_table, i_f2_table, i_method, i_substeps, i_events, set_text
+    i_title, i_f1_table, i_f2_table, i_method, i_substeps, i_events, set_text, i_x_left_table, i_x_right_table
   use impact1d_io, only: read_scene_file, prepare_scene
   use impact1d_chain, only: settle_chain, validate_chain, n_ids, id_arrays, id_r_meet, field_name, assign_number, &
     assign_text, scene_assignments
@@ -134,8 +134,8 @@ contains
     character(len=*), intent(in) :: text_blob
     real(c_double), intent(out) :: values(n)
     integer(c_int), intent(out) :: given(n)
-    integer(c_int), intent(out) :: text_codes(text_room, 6)    ! 6: n_text (f2py needs the number)
-    integer(c_int), intent(out) :: text_lengths(6)
+    integer(c_int), intent(out) :: text_codes(text_room, 8)    ! 8: n_text (f2py needs the number)
+    integer(c_int), intent(out) :: text_lengths(8)
     integer(c_int), intent(out) :: status
     character(len=16384), intent(out) :: message    ! 16384: message_length (f2py needs the number)
     type(scene_input) :: input
@@ -203,7 +203,7 @@ contains
     !f2py integer(c_int) optional, intent(in) :: interrupt_epoch = -1
     integer(c_int), intent(in) :: n, max_samples, n_cols, max_events, max_rows, text_room
     real(c_double), intent(in) :: values(n)
-    integer(c_int), intent(in) :: given(n), text_end(6)          ! 6: n_text (f2py needs the number)
+    integer(c_int), intent(in) :: given(n), text_end(8)          ! 8: n_text (f2py needs the number)
     character(len=*), intent(in) :: text_blob
     integer(c_int), intent(in) :: progress    !< non-zero: show progress on stderr after 1 s
     real(c_double), intent(inout), target :: samples(max_samples, n_cols)
@@ -241,7 +241,7 @@ contains
     !f2py threadsafe
     integer(c_int), intent(in) :: n
     real(c_double), intent(in) :: values(n)
-    integer(c_int), intent(in) :: given(n), text_end(6)          ! 6: n_text (f2py needs the number)
+    integer(c_int), intent(in) :: given(n), text_end(8)          ! 8: n_text (f2py needs the number)
     character(len=*), intent(in) :: text_blob
     integer(c_int), intent(in) :: n_numbers, n_texts, number_room, record_text_room
     integer(c_int), intent(in) :: field(number_room), index(number_room), record_text_field(record_text_room), &
@@ -315,13 +315,14 @@ contains
     type(scene_type), intent(out) :: scene
     type(error_type), allocatable, intent(out) :: error
     if (n /= n_real .or. n_cols < n_columns .or. any(text_end < 0 .or. text_end > len(text_blob)) .or. &
-        any(text_end(2:) < text_end(:5))) then
+        any(text_end(2:) < text_end(:7))) then
       call raise(error, status_input, 'internal: the scene''s fields, texts or sample columns do not match the core')
       return
     end if
     input = flat_input(values, given, text_blob(:text_end(1)), text_blob(text_end(1) + 1:text_end(2)), &
       text_blob(text_end(2) + 1:text_end(3)), text_blob(text_end(3) + 1:text_end(4)), &
-      text_blob(text_end(4) + 1:text_end(5)), text_blob(text_end(5) + 1:text_end(6)))
+      text_blob(text_end(4) + 1:text_end(5)), text_blob(text_end(5) + 1:text_end(6)), &
+      text_blob(text_end(6) + 1:text_end(7)), text_blob(text_end(7) + 1:text_end(8)))
     call apply_scene_assignments(input, n_numbers, n_texts, field, index, value, record_text_field, &
       record_text_index, record_text_end, record_blob, error)
     if (.not. allocated(error)) call prepare_scene(input, scene, error)
@@ -421,7 +422,8 @@ contains
   !> summary_sink: no samples): summary(:, j) in the order of summary_names, status(j) and
   !> message_codes(:, j) (the message's character codes, blank-padded) say how it ended. A
   !> failing run is a status, never the end of the batch.
-  subroutine simulate_summaries(n, values, given, title, f1_table, f2_table, method, substeps, events, n_numbers, &
+  subroutine simulate_summaries(n, values, given, title, f1_table, f2_table, method, substeps, events, x_left_table, &
+      x_right_table, n_numbers, &
       n_texts, number_room, field, index, value, text_room_in, text_field, text_index, text_end, text_blob, n_over, &
       over_index, n_runs, over_values, n_summary, summary, status, message_codes, interrupt_epoch)
     !f2py threadsafe
@@ -429,7 +431,7 @@ contains
     integer(c_int), intent(in) :: n, n_over, n_runs, n_summary
     real(c_double), intent(in) :: values(n), over_values(n_over, n_runs)
     integer(c_int), intent(in) :: given(n), over_index(n_over)
-    character(len=*), intent(in) :: title, f1_table, f2_table, method, substeps, events
+    character(len=*), intent(in) :: title, f1_table, f2_table, method, substeps, events, x_left_table, x_right_table
     integer(c_int), intent(in) :: n_numbers, n_texts, number_room, text_room_in
     integer(c_int), intent(in) :: field(number_room), index(number_room), text_field(text_room_in), &
       text_index(text_room_in), text_end(text_room_in)
@@ -460,7 +462,7 @@ contains
       call put_codes(message, message_codes(:, 1))
       return
     end if
-    base = flat_input(values, given, title, f1_table, f2_table, method, substeps, events)
+    base = flat_input(values, given, title, f1_table, f2_table, method, substeps, events, x_left_table, x_right_table)
     call apply_scene_assignments(base, n_numbers, n_texts, field, index, value, text_field, text_index, &
       text_end, text_blob, error)
     if (allocated(error)) then
@@ -573,10 +575,11 @@ contains
   end subroutine summary_column_names
 
   !> A scene's fields as the flat layer gets them (given: non-zero where set).
-  pure function flat_input(values, given, title, f1_table, f2_table, method, substeps, events) result(input)
+  pure function flat_input(values, given, title, f1_table, f2_table, method, substeps, events, x_left_table, &
+      x_right_table) result(input)
     real(c_double), intent(in) :: values(n_real)
     integer(c_int), intent(in) :: given(n_real)
-    character(len=*), intent(in) :: title, f1_table, f2_table, method, substeps, events
+    character(len=*), intent(in) :: title, f1_table, f2_table, method, substeps, events, x_left_table, x_right_table
     type(scene_input) :: input
     input%value = real(values, wp)
     input%given = given /= 0
@@ -586,6 +589,8 @@ contains
     call set_text(input, i_method, method)
     call set_text(input, i_substeps, substeps)
     call set_text(input, i_events, events)
+    call set_text(input, i_x_left_table, x_left_table)
+    call set_text(input, i_x_right_table, x_right_table)
   end function flat_input
 
   !> A text as character codes (byte values, 0 to 255), blank padded or cut to size(codes).
@@ -600,10 +605,11 @@ contains
   end subroutine put_codes
 
   !> Words separated by single spaces (how names cross to Python), as long as the flat
-  !> API's names (no function returns a deferred-length string: see impact1d_error's fmt).
+  !> API's longest names (input_field_names'; no function returns a deferred-length string:
+  !> see impact1d_error's fmt).
   pure function joined(words) result(out)
     character(len=*), intent(in) :: words(:)
-    character(len=1024) :: out
+    character(len=2048) :: out
     character(len=:), allocatable :: text
     integer :: k
     text = ''

@@ -10,17 +10,19 @@ module impact1d_chain
     positive_value, nonnegative_value, unit_interval, resolvable, unresolved, i_m1, i_m2, i_x_left, i_r_left, i_x_right, &
     i_r_right, i_r_min, i_d_min, i_g, default_gravity, i_mu1, i_mu2, i_mus1, i_mus2, i_x1, i_x2, i_v1, i_v2, i_f1, i_f2, &
     i_f1_amp, i_f2_amp, i_f1_period, i_f2_period, i_f1_phase, i_f2_phase, i_k1, i_k2, i_x1_rest, i_x2_rest, &
-    i_c1, i_c2, i_d_max, i_r_max, i_k12, i_d_rest, i_c12, i_f1_table, i_f2_table, i_x_left_v, i_x_right_v
+    i_c1, i_c2, i_d_max, i_r_max, i_k12, i_d_rest, i_c12, i_f1_table, i_f2_table, i_x_left_v, i_x_right_v, &
+    i_x_left_table, i_x_right_table
+  use impact1d_forcing, only: table_value
   use impact1d_fields, only: array_value, n_arrays, array_names, array_is_link, array_is_text, alias_name, name_len, &
     record_input, a_m, a_mu, a_mus, a_x, a_f_amp, a_f_period, a_f_phase, a_k, a_x_rest, a_c, a_d_min, a_r_min, &
     a_d_max, a_r_max, a_k_link, a_d_rest, a_c_link, r_a, r_b, r_d_min, r_r_min, r_d_max, r_r_max, r_k, r_d_rest, &
     r_c, contact_fields, spring_fields, r_name, n_contact_fields, n_spring_fields, written_array, text_item, &
     a_f_table, mechanism_records, n_sine_fields, sine_fields, r_body, r_amp, r_period, r_phase, r_stop_k, r_stop_c, &
     r_ground_v, r_spring_ground_v, n_ground_fields, a_belt_v, a_v_s, a_c_v, n_friction_fields, friction_fields, &
-    r_mu, r_mus, r_normal, r_friction_name, r_ratio, r_spring_ratio
+    r_mu, r_mus, r_normal, r_friction_name, r_ratio, r_spring_ratio, r_ground_table, r_spring_ground_table
   implicit none
   private
-  public :: settle_chain, validate_chain, input_records, mechanism_records, n_bodies_of, slot_of, alias_slot
+  public :: settle_chain, validate_chain, input_records, mechanism_records, n_bodies_of, slot_of, alias_slot, check_start
   public :: id_arrays, id_r_meet, id_contact, id_spring, id_sine, id_friction, id_bodies_out, n_ids, field_name, &
     field_is_text, assign_number, &
     assign_text, scene_assignments
@@ -449,6 +451,7 @@ contains
         call record_place(trim(merge('&contact', '&spring ', contact)), rec, r, where)
         do f = 1, merge(size(contact_fields), size(spring_fields), contact)
           if (contact .and. f == r_name) cycle
+          if (f == merge(r_ground_table, r_spring_ground_table, contact)) cycle
           if (rec%given(f) .and. .not. ieee_is_finite(rec%value(f))) call raise(error, status_input, where // &
             trim(field_of(contact, f)) // ' = ' // trim(fmt(rec%value(f))) // ' is not a finite number')
         end do
@@ -463,7 +466,7 @@ contains
           call spring_values(rec, where, error)
         end if
         if (.not. allocated(error)) call ground_motion(rec, merge(r_ground_v, r_spring_ground_v, contact), &
-          where, error)
+          merge(r_ground_table, r_spring_ground_table, contact), where, error)
         if (.not. allocated(error)) call gear_ratio(rec, contact, where, error)
         if (allocated(error)) return
       end associate
@@ -639,17 +642,18 @@ contains
   end subroutine contact_limits
 
   !> The prescribed motion of a record's ground end (fields first .. first + 3: ground_v,
-  !> ground_amp, ground_period, ground_phase): only on a record with a ground end (a or b =
-  !> 0); a sine has its amplitude and a positive period, a phase needs its sine.
-  subroutine ground_motion(rec, first, where, error)
+  !> ground_amp, ground_period, ground_phase; field table: ground_table): only on a record
+  !> with a ground end (a or b = 0); a sine has its amplitude and a positive period, a phase
+  !> needs its sine.
+  subroutine ground_motion(rec, first, table, where, error)
     type(record_input), intent(in) :: rec
-    integer, intent(in) :: first
+    integer, intent(in) :: first, table
     character(len=*), intent(in) :: where
     type(error_type), allocatable, intent(inout) :: error
-    if (.not. any(rec%given(first:first + n_ground_fields - 1))) return
+    if (.not. (any(rec%given(first:first + n_ground_fields - 1)) .or. rec%given(table))) return
     if (rec%value(r_a) /= 0.0_wp .and. rec%value(r_b) /= 0.0_wp) then
-      call raise(error, status_input, where // 'ground_v, ground_amp, ground_period and ground_phase move ' // &
-        'the ground end, but this record joins two bodies (a = 0 or b = 0 is the ground)')
+      call raise(error, status_input, where // 'ground_v, ground_amp, ground_period, ground_phase and ' // &
+        'ground_table move the ground end, but this record joins two bodies (a = 0 or b = 0 is the ground)')
       return
     end if
     call motion_terms(rec%given(first:first + n_ground_fields - 1), rec%value(first:first + n_ground_fields - 1), &
@@ -706,7 +710,7 @@ contains
     end if
   end subroutine gear_ratio
 
-  !> The walls' prescribed motion (x_left_v ..., x_right_v ...): each needs its wall.
+  !> The walls' prescribed motion (x_left_v ..., x_left_table, x_right_v ...): each needs its wall.
   subroutine wall_motion_terms(input, error)
     type(scene_input), intent(in) :: input
     type(error_type), allocatable, intent(inout) :: error
@@ -716,10 +720,11 @@ contains
       first = merge(i_x_left_v, i_x_right_v, side == 1)
       wall = merge(i_x_left, i_x_right, side == 1)
       prefix = merge('x_left ', 'x_right', side == 1)
-      if (.not. any(input%given(first:first + n_ground_fields - 1))) cycle
+      if (.not. (any(input%given(first:first + n_ground_fields - 1)) .or. &
+        given_slot(input, n_real + merge(i_x_left_table, i_x_right_table, side == 1)))) cycle
       if (.not. input%given(wall)) then
-        call raise(error, status_input, trim(prefix) // '_v, _amp, _period, _phase move the wall ' // trim(prefix) // &
-          ', which is not given')
+        call raise(error, status_input, trim(prefix) // '_v, _amp, _period, _phase, _table move the wall ' // &
+          trim(prefix) // ', which is not given')
         return
       end if
       call motion_terms(input%given(first:first + n_ground_fields - 1), input%value(first:first + n_ground_fields - 1), &
@@ -815,10 +820,16 @@ contains
       associate (a => records%contact_body(1, k), b => records%contact_body(2, k))
         d = x(b) - records%contact_ratio(k) * x(a)
         shifted = .false.
-        ! A moving ground end starts at w(0) = ground_amp sin(ground_phase).
+        ! A moving ground end starts at w(0) = ground_amp sin(ground_phase) (+ table(0):
+        ! checked once the tables are read, prepare_scene's second call).
         if (a == 0 .and. records%contact_moves(k)) then
           if (records%contact_ground(3, k) > 0.0_wp) then
             d = x(b) - records%contact_ground(2, k) * sin(records%contact_ground(4, k))
+            shifted = .true.
+          end if
+          if (allocated(records%contact_table_path(k)%s)) then
+            if (.not. records%tables_read) cycle
+            d = d - table_value(records%contact_table(k), 0.0_wp)
             shifted = .true.
           end if
         end if
@@ -878,6 +889,7 @@ contains
     records%element_ground = 0.0_wp
     records%contact_moves = .false.
     records%element_moves = .false.
+    allocate(records%contact_table_path(nc), records%element_table_path(ne))
     records%contact_has = .false.
     records%contact_limit = 0.0_wp
     records%contact_restitution = 1.0_wp
@@ -942,21 +954,24 @@ contains
     type(mechanism_records), intent(inout) :: records
     if (input%given(i_x_left)) then
       call add_contact(records, 'left', 0, 1, 1, input%value(i_x_left), value_or(input, i_r_left, 1.0_wp))
-      call wall_motion(i_x_left_v)
+      call wall_motion(i_x_left_v, i_x_left_table)
     end if
     if (input%given(i_x_right)) then
       call add_contact(records, 'right', 0, n, 2, input%value(i_x_right), value_or(input, i_r_right, 1.0_wp))
-      call wall_motion(i_x_right_v)
+      call wall_motion(i_x_right_v, i_x_right_table)
     end if
 
   contains
 
-    !> The wall just added moves as its fields from first (x_left_v ...) say, when any is given.
-    subroutine wall_motion(first)
-      integer, intent(in) :: first
+    !> The wall just added moves as its fields from first (x_left_v ...) and its table (text
+    !> field table: x_left_table ...) say, when any is given.
+    subroutine wall_motion(first, table)
+      integer, intent(in) :: first, table
       associate (k => records%n_contacts, given => input%given(first:first + n_ground_fields - 1))
         records%contact_moves(k) = any(given)
         records%contact_ground(:, k) = merge(input%value(first:first + n_ground_fields - 1), 0.0_wp, given)
+        if (given_slot(input, n_real + table)) call set_table_path(records%contact_table_path(k), &
+          records%contact_moves(k), trim(input%text(table)%s))
       end associate
     end subroutine wall_motion
   end subroutine wall_records
@@ -1027,6 +1042,8 @@ contains
         records%contact_ground(:, k) = ground_of(rec, r_ground_v)
         records%contact_moves(k) = any(rec%given(r_ground_v:r_ground_v + n_ground_fields - 1))
         if (rec%given(r_ratio)) records%contact_ratio(k) = rec%value(r_ratio)
+        if (rec%given(r_ground_table)) call set_table_path(records%contact_table_path(k), records%contact_moves(k), &
+          rec%table)
         if (ends(2) == 0) then
           records%contact_body(:, k) = [0, ends(1)]
           records%contact_has(:, k) = records%contact_has([2, 1], k)
@@ -1082,9 +1099,20 @@ contains
         records%element_moves(records%n_elements) = any(rec%given(r_spring_ground_v:r_spring_ground_v + &
           n_ground_fields - 1))
         if (rec%given(r_spring_ratio)) records%element_ratio(records%n_elements) = rec%value(r_spring_ratio)
+        if (rec%given(r_spring_ground_table)) call set_table_path(records%element_table_path(records%n_elements), &
+          records%element_moves(records%n_elements), rec%table)
       end associate
     end do
   end subroutine element_records
+
+  !> A record's ground end moved by the table at path (ground_table).
+  pure subroutine set_table_path(item, moves, path)
+    type(text_item), intent(inout) :: item
+    logical, intent(inout) :: moves
+    character(len=*), intent(in) :: path
+    item%s = path
+    moves = .true.
+  end subroutine set_table_path
 
   !> One more element between a and b.
   pure subroutine add_element(records, a, b, k, rest, c)
@@ -1117,6 +1145,8 @@ contains
       records%element_moves = records%element_moves(:ne)
       records%contact_ratio = records%contact_ratio(:nc)
       records%element_ratio = records%element_ratio(:ne)
+      records%contact_table_path = records%contact_table_path(:nc)
+      records%element_table_path = records%element_table_path(:ne)
       records%element_body = records%element_body(:, :ne)
       records%element_k = records%element_k(:ne)
       records%element_c = records%element_c(:ne)
@@ -1155,7 +1185,8 @@ contains
   pure logical function field_is_text(id)
     integer, intent(in) :: id
     field_is_text = (id > n_real .and. id <= id_arrays) .or. id == id_arrays + a_f_table .or. &
-      id == id_contact + r_name .or. id == id_friction + r_friction_name
+      id == id_contact + r_name .or. id == id_friction + r_friction_name .or. id == id_contact + r_ground_table .or. &
+      id == id_spring + r_spring_ground_table
   end function field_is_text
 
   !> Field id := value: a scalar (index ignored), element index of an array, or the field
@@ -1228,15 +1259,30 @@ contains
       call grow_array(input%chain%array(a_f_table), index)
       input%chain%array(a_f_table)%t(index)%s = text
     else if (id == id_contact + r_name) then
-      call grow_records(input%chain%contacts, index)
-      input%chain%contacts(index)%name = text
-      input%chain%contacts(index)%given(r_name) = .true.
+      call set_record_text(input%chain%contacts, index, r_name, text, .false.)
     else if (id == id_friction + r_friction_name) then
-      call grow_records(input%chain%frictions, index)
-      input%chain%frictions(index)%name = text
-      input%chain%frictions(index)%given(r_friction_name) = .true.
+      call set_record_text(input%chain%frictions, index, r_friction_name, text, .false.)
+    else if (id == id_contact + r_ground_table) then
+      call set_record_text(input%chain%contacts, index, r_ground_table, text, .true.)
+    else if (id == id_spring + r_spring_ground_table) then
+      call set_record_text(input%chain%springs, index, r_spring_ground_table, text, .true.)
     end if
   end subroutine assign_text
+
+  !> Record index's text field f := text: its name, or its ground_table's path (table).
+  pure subroutine set_record_text(records, index, f, text, table)
+    type(record_input), allocatable, intent(inout) :: records(:)
+    integer, intent(in) :: index, f
+    character(len=*), intent(in) :: text
+    logical, intent(in) :: table
+    call grow_records(records, index)
+    if (table) then
+      records(index)%table = text
+    else
+      records(index)%name = text
+    end if
+    records(index)%given(f) = .true.
+  end subroutine set_record_text
 
   !> An array holds at least n elements (new numbers NaN, new texts '').
   pure subroutine grow_array(array, n)
@@ -1359,9 +1405,9 @@ contains
       given = input%chain%has_r_meet
       number = input%chain%r_meet
     else if (id <= id_spring) then
-      call record_value(input%chain%contacts(i), id - id_contact, r_name, given, number, text)
+      call record_value(input%chain%contacts(i), id - id_contact, r_name, given, number, text, r_ground_table)
     else if (id <= id_sine) then
-      call record_value(input%chain%springs(i), id - id_spring, 0, given, number, text)
+      call record_value(input%chain%springs(i), id - id_spring, 0, given, number, text, r_spring_ground_table)
     else if (id <= id_friction) then
       call record_value(input%chain%sines(i), id - id_sine, 0, given, number, text)
     else if (id < id_bodies_out) then
@@ -1373,15 +1419,20 @@ contains
     if (field_is_text(id) .and. id /= id_arrays + a_f_table) given = len(text) > 0
   end subroutine field_value
 
-  !> Field f of a record whose name is field name_field (0: it has none).
-  subroutine record_value(rec, f, name_field, given, number, text)
+  !> Field f of a record whose name is field name_field (0: it has none), whose ground_table
+  !> is field table_field (absent: it has none).
+  subroutine record_value(rec, f, name_field, given, number, text, table_field)
     type(record_input), intent(in) :: rec
     integer, intent(in) :: f, name_field
     logical, intent(out) :: given
     real(wp), intent(out) :: number
     character(len=:), allocatable, intent(inout) :: text
+    integer, intent(in), optional :: table_field
     given = rec%given(f)
     number = rec%value(f)
     if (allocated(rec%name) .and. f == name_field) text = rec%name
+    if (present(table_field)) then
+      if (allocated(rec%table) .and. f == table_field) text = rec%table
+    end if
   end subroutine record_value
 end module impact1d_chain

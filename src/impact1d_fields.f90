@@ -5,6 +5,7 @@
 !> k_link(1)). The tutorial's n_real scalars stay in scene_input's slots; this is the rest.
 module impact1d_fields
   use impact1d_kinds, only: wp
+  use impact1d_forcing, only: table_type
   implicit none
   private
   public :: n_arrays, array_names, array_groups, array_aliases, array_is_link, array_is_text
@@ -14,6 +15,7 @@ module impact1d_fields
   public :: r_a, r_b, r_d_min, r_r_min, r_d_max, r_r_max, r_name, r_k, r_d_rest, r_c, r_stop_k, r_stop_c
   public :: r_body, r_amp, r_period, r_phase, r_ground_v, r_spring_ground_v, n_ground_fields
   public :: r_ratio, r_spring_ratio
+  public :: r_ground_table, r_spring_ground_table
   public :: n_friction_fields, friction_fields, r_mu, r_mus, r_normal, r_friction_name
   public :: name_len, text_item, written_array, record_input, chain_input, alias_name, mechanism_records, array_value
 
@@ -49,19 +51,22 @@ module impact1d_fields
   !> a &spring record (tension k ((x_b - x_a) - d_rest) + c (v_b - v_a)). Either may move
   !> its ground end (a or b = 0): n_ground_fields from r_ground_v (contact) or
   !> r_spring_ground_v (spring): ground_v, ground_amp, ground_period, ground_phase, the
-  !> prescribed motion w(t) = ground_v t + ground_amp sin(2 pi t / ground_period + ground_phase).
+  !> prescribed motion w(t) = ground_v t + ground_amp sin(2 pi t / ground_period + ground_phase),
+  !> and after them ground_table (r_ground_table, r_spring_ground_table: a text, the path of
+  !> a (t, w) table added to w, read as a force table is).
   !> Either may carry a gear ratio n (r_ratio, r_spring_ratio; 1 when not given): it then
   !> acts on x_b - n x_a instead (docs/method.md section 14).
   integer, parameter :: n_ground_fields = 4
-  integer, parameter :: n_contact_fields = 10 + n_ground_fields, n_spring_fields = 6 + n_ground_fields
+  integer, parameter :: n_contact_fields = 11 + n_ground_fields, n_spring_fields = 7 + n_ground_fields
   integer, parameter :: r_a = 1, r_b = 2, r_d_min = 3, r_r_min = 4, r_d_max = 5, r_r_max = 6, r_name = 7, &
-    r_stop_k = 8, r_stop_c = 9, r_ground_v = 10, r_ratio = 14
-  integer, parameter :: r_k = 3, r_d_rest = 4, r_c = 5, r_spring_ground_v = 6, r_spring_ratio = 10
+    r_stop_k = 8, r_stop_c = 9, r_ground_v = 10, r_ground_table = 14, r_ratio = 15
+  integer, parameter :: r_k = 3, r_d_rest = 4, r_c = 5, r_spring_ground_v = 6, r_spring_ground_table = 10, &
+    r_spring_ratio = 11
   character(len=*), parameter :: contact_fields(n_contact_fields) = [character(len=13) :: &
     'a', 'b', 'd_min', 'r_min', 'd_max', 'r_max', 'name', 'k', 'c', 'ground_v', 'ground_amp', 'ground_period', &
-    'ground_phase', 'ratio']
+    'ground_phase', 'ground_table', 'ratio']
   character(len=*), parameter :: spring_fields(n_spring_fields) = [character(len=13) :: &
-    'a', 'b', 'k', 'd_rest', 'c', 'ground_v', 'ground_amp', 'ground_period', 'ground_phase', 'ratio']
+    'a', 'b', 'k', 'd_rest', 'c', 'ground_v', 'ground_amp', 'ground_period', 'ground_phase', 'ground_table', 'ratio']
   !> The fields of a &sine record: amp sin(2 pi t / period + phase) on body `body`'s force
   !> (phase optional, 0 by default).
   integer, parameter :: n_sine_fields = 4
@@ -94,6 +99,7 @@ module impact1d_fields
     real(wp) :: value(n_contact_fields) = 0.0_wp
     logical :: given(n_contact_fields) = .false.
     character(len=:), allocatable :: name
+    character(len=:), allocatable :: table     !< ground_table's path (a &contact or &spring record)
     integer :: line = 0
   end type record_input
 
@@ -133,6 +139,11 @@ module impact1d_fields
     logical, allocatable :: contact_moves(:), element_moves(:)
     !> (nc), (ne) the gear ratio n of each record: it acts on x_b - n x_a (1: none)
     real(wp), allocatable :: contact_ratio(:), element_ratio(:)
+    !> (nc), (ne) the ground end's table (ground_table): its path (unallocated: none), and the
+    !> table itself once read (impact1d_io's prepare_scene: tables_read)
+    type(text_item), allocatable :: contact_table_path(:), element_table_path(:)
+    type(table_type), allocatable :: contact_table(:), element_table(:)
+    logical :: tables_read = .false.
     integer :: n_sines = 0                               !< the &sine records, in file order
     integer, allocatable :: sine_body(:)                 !< (ns) the body whose force it adds to
     real(wp), allocatable :: sine_amp(:), sine_period(:), sine_phase(:)   !< (ns) N, s, rad

@@ -6,7 +6,7 @@ module impact1d_forcing
   use impact1d_lanes, only: max_lanes, to_lanes
   implicit none
   private
-  public :: table_type, forcing_type, angular_frequency
+  public :: table_type, forcing_type, angular_frequency, table_value, table_slope, segment
 
   !> A piecewise-linear force table: strictly increasing times, held constant outside.
   type :: table_type
@@ -189,11 +189,7 @@ contains
     integer :: i, k
     df = 0.0_wp      ! (and an idle lane)
     do i = 1, size(self%constant)
-      if (self%has_table(i)) then
-        k = segment(self%table(i)%t, t)
-        if (k >= 1 .and. k < size(self%table(i)%t)) df(i) = &
-          (self%table(i)%f(k + 1) - self%table(i)%f(k)) / (self%table(i)%t(k + 1) - self%table(i)%t(k))
-      end if
+      if (self%has_table(i)) df(i) = table_slope(self%table(i), segment(self%table(i)%t, t))
       if (self%has_sine(i)) df(i) = df(i) + self%amp(i) * self%omega(i) * cos(self%omega(i) * t + self%phase(i))
       if (self%n_sines == 0) cycle
       !GCC$ novector      ! (glibc's vector cos: see add_sines)
@@ -240,6 +236,15 @@ contains
       f = table%f(k) + s * (table%f(k + 1) - table%f(k))
     end if
   end function table_value
+
+  !> The slope of a table's segment k (segment's numbering): 0 before the first time and at
+  !> or after the last (held there).
+  pure real(wp) function table_slope(table, k) result(slope)
+    type(table_type), intent(in) :: table
+    integer, intent(in) :: k
+    slope = 0.0_wp
+    if (k >= 1 .and. k < size(table%t)) slope = (table%f(k + 1) - table%f(k)) / (table%t(k + 1) - table%t(k))
+  end function table_slope
 
   !> Index k with times(k) <= t < times(k+1); 0 before the first time, n at or after the last.
   pure integer function segment(times, t) result(k)

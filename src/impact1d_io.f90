@@ -12,7 +12,7 @@ module impact1d_io
   use impact1d_fields, only: n_arrays, array_names, array_groups, array_is_text, n_contact_fields, contact_fields, &
     n_spring_fields, spring_fields, n_sine_fields, sine_fields, friction_fields, r_name, record_input, text_item, a_f_table
   use impact1d_chain, only: settle_chain, validate_chain, slot_of, mechanism_records, id_arrays, id_r_meet, &
-    id_contact, id_spring, id_sine, id_friction, n_ids, n_bodies_of
+    id_contact, id_spring, id_sine, id_friction, n_ids, n_bodies_of, check_start
   use impact1d_files, only: check_input_file
   implicit none
   private
@@ -23,15 +23,17 @@ module impact1d_io
   !> The groups that may be given any number of times, each occurrence a record.
   integer, parameter :: g_contact = 9, g_spring = 10, g_sine = 11, g_friction = 12, g_run = 8
   !> Each group's variables: which group a name belongs to, and the message about a misspelt one.
-  character(len=*), parameter :: group_variables(size(known_groups)) = [character(len=160) :: &
+  character(len=*), parameter :: group_variables(size(known_groups)) = [character(len=176) :: &
     'title', 'm1, m2, mu1, mu2, mus1, mus2, g', 'x_left, r_left, x_right, r_right, x_left_v, x_left_amp, ' // &
-    'x_left_period, x_left_phase, x_right_v, x_right_amp, x_right_period, x_right_phase', 'd_min, r_min, d_max, r_max', &
+    'x_left_period, x_left_phase, x_right_v, x_right_amp, x_right_period, x_right_phase, x_left_table, ' // &
+    'x_right_table', 'd_min, r_min, d_max, r_max', &
     'x1, v1, x2, v2', 'f1, f2, f1_table, f2_table, f1_amp, f1_period, f1_phase, f2_amp, f2_period, f2_phase', &
     'k1, x1_rest, c1, k2, x2_rest, c2, k12, d_rest, c12', &
     't_end, dt, dt_out, method, zero_vel, max_rows, max_impulses, max_step_events, substeps, events, max_events, ' // &
     'bodies_out', &
-    'a, b, d_min, r_min, d_max, r_max, name, k, c, ground_v, ground_amp, ground_period, ground_phase, ratio', &
-    'a, b, k, d_rest, c, ground_v, ground_amp, ground_period, ground_phase, ratio', 'body, amp, period, phase', &
+    'a, b, d_min, r_min, d_max, r_max, name, k, c, ground_v, ground_amp, ground_period, ground_phase, ground_table, ' // &
+      'ratio', &
+    'a, b, k, d_rest, c, ground_v, ground_amp, ground_period, ground_phase, ground_table, ratio', 'body, amp, period, phase', &
     'a, b, mu, mus, normal, name']
 
   !> The tutorial's parameter files list these, in its Table 1 order; g is 10 there.
@@ -125,8 +127,41 @@ contains
     call validate(input, .true., error)
     if (.not. allocated(error)) call validate_chain(input, error, records)
     if (allocated(error)) return
+    call read_ground_tables(input, records, error)
+    if (allocated(error)) return
     call build_scene(input, tables, records, scene, error, validated=.true.)
   end subroutine prepare_scene
+
+  !> The tables that move ground ends (the records' ground_table), read as
+  !> force tables are; the start checked again with them (w(0) counts table(0)). A scene
+  !> that names none reads nothing.
+  subroutine read_ground_tables(input, records, error)
+    type(scene_input), intent(in) :: input
+    type(mechanism_records), intent(inout) :: records
+    type(error_type), allocatable, intent(inout) :: error
+    integer :: k
+    if (all([(.not. allocated(records%contact_table_path(k)%s), k = 1, records%n_contacts)]) .and. &
+      all([(.not. allocated(records%element_table_path(k)%s), k = 1, records%n_elements)])) return
+    allocate(records%contact_table(records%n_contacts), records%element_table(records%n_elements))
+    do k = 1, records%n_contacts
+      if (.not. allocated(records%contact_table_path(k)%s)) cycle
+      call read_table(records%contact_table_path(k)%s, records%contact_table(k), error)
+      if (allocated(error)) then
+        error%message = 'the contact ''' // trim(records%contact_name(k)) // '''s ground_table: ' // error%message
+        return
+      end if
+    end do
+    do k = 1, records%n_elements
+      if (.not. allocated(records%element_table_path(k)%s)) cycle
+      call read_table(records%element_table_path(k)%s, records%element_table(k), error)
+      if (allocated(error)) then
+        error%message = '&spring ground_table: ' // error%message
+        return
+      end if
+    end do
+    records%tables_read = .true.
+    call check_start(input, records, error)
+  end subroutine read_ground_tables
 
   !> A namelist scene, read by its own parser: gfortran's namelist reader took an '&initial'
   !> inside a quoted title for the group, and passed over a variable with no value
@@ -456,13 +491,13 @@ contains
       input%chain%has_r_meet = .true.
     else
       if (field > id_friction) then
-        call take_record_field(name, value, field - id_friction, input%chain%frictions, error)
+        call take_record_field(path, name, value, field - id_friction, input%chain%frictions, error)
       else if (field > id_sine) then
-        call take_record_field(name, value, field - id_sine, input%chain%sines, error)
+        call take_record_field(path, name, value, field - id_sine, input%chain%sines, error)
       else if (field > id_spring) then
-        call take_record_field(name, value, field - id_spring, input%chain%springs, error)
+        call take_record_field(path, name, value, field - id_spring, input%chain%springs, error)
       else
-        call take_record_field(name, value, field - id_contact, input%chain%contacts, error)
+        call take_record_field(path, name, value, field - id_contact, input%chain%contacts, error)
       end if
     end if
   end subroutine take_value
@@ -554,9 +589,10 @@ contains
     end associate
   end subroutine take_array
 
-  !> Field f of the record open (the last of records): a number, or the contact's name.
-  subroutine take_record_field(name, value, f, records, error)
-    character(len=*), intent(in) :: name, value
+  !> Field f of the record open (the last of records): a number, or the contact's name, or
+  !> the ground_table's path (relative to the scene file's folder, as force tables).
+  subroutine take_record_field(path, name, value, f, records, error)
+    character(len=*), intent(in) :: path, name, value
     integer, intent(in) :: f
     type(record_input), intent(inout) :: records(:)
     type(error_type), allocatable, intent(inout) :: error
@@ -566,6 +602,11 @@ contains
         call read_text(name, value, text, error)
         if (allocated(error)) return
         rec%name = text
+        rec%given(f) = .true.
+      else if (name == 'ground_table') then
+        call read_text(name, value, text, error)
+        if (allocated(error)) return
+        rec%table = trim(resolved_text(path, i_f1_table, text))
         rec%given(f) = .true.
       else
         call read_scalar(name, value, rec%value(f), error)

@@ -67,10 +67,10 @@ contains
     if (allocated(error)) return
     window_events = 0
     window_start = 0.0_wp
-    t_break = scene%forcing%next_breakpoint(s%t)
+    t_break = min(scene%forcing%next_breakpoint(s%t), scene%drives%next_corner(s%t))
     do while (j_sample < scene%n_samples)
       sample_t = sample_time(scene, j_sample)
-      if (t_break <= s%t) t_break = scene%forcing%next_breakpoint(s%t)
+      if (t_break <= s%t) t_break = min(scene%forcing%next_breakpoint(s%t), scene%drives%next_corner(s%t))
       t_rest = huge(1.0_wp)
       if (scene%n_rows > 0) t_rest = minval(r%event_log%pending_rest)
       t_stop = min(sample_t, t_break, t_rest)

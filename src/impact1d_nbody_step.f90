@@ -258,7 +258,7 @@ contains
     if (scene%gap_terms) then
       if (scene%springs%present) call add_compensated(b%damping_loss, b%damping_lo, step / 6.0_wp * &
         (element_damping_power(scene, v0, a%t) + 4.0_wp * element_damping_power(scene, vm, a%t + half) + &
-        element_damping_power(scene, v1, a%t + step)))
+        element_damping_power(scene, v1, drive_time(a%t, step))))
     else if (scene%springs%present) then
       call add_compensated(b%damping_loss, b%damping_lo, step / 6.0_wp * &
         (element_damping_power(scene, v0) + 4.0_wp * element_damping_power(scene, vm) + &
@@ -277,7 +277,7 @@ contains
       real(wp), intent(out) :: acc(:)
       integer, intent(in) :: k
       if (scene%stage_powers) then
-        call moving_stage(fx, dx_stage, v, acc, a%t + tau, power(k), k)
+        call moving_stage(fx, dx_stage, v, acc, drive_time(a%t, tau), power(k), k)
         return
       end if
       f = fx
@@ -314,6 +314,14 @@ contains
         loss(k) = loss(k) + contact_loss(scene, mode%friction_sgn, v)
     end subroutine moving_stage
 
+    !> The time a + tau at which the stage sees the drives (a table's corner at the step's
+    !> end: just before it, impact1d_drives' before_corner).
+    pure real(wp) function drive_time(t, tau)
+      real(wp), intent(in) :: t, tau
+      drive_time = t + tau
+      if (scene%drives%tables) drive_time = scene%drives%before_corner(t, drive_time)
+    end function drive_time
+
     !> Friction's loss and the belts' work over the step, by RK4's quadrature of the stages'
     !> powers (impact1d_friction_laws' law_powers).
     subroutine law_ledger()
@@ -327,9 +335,12 @@ contains
     !> the accelerations there, and the work the prescribed motion did, by RK4's own
     !> quadrature of the stages' power (0 without moving grounds).
     subroutine drive_step_ledger()
-      if (scene%springs%present) call add_moving_element_forces(scene, b%x, b%x_lo, v1, f, b%t)
-      if (scene%n_stops > 0) call add_stop_forces(scene, mode%engaged, b%x, b%x_lo, v1, f, b%t)
-      call law_acceleration(scene, mode, b%t, v1, f, acc_end)
+      real(wp) :: t_end
+      t_end = b%t
+      if (scene%drives%tables) t_end = drive_time(a%t, step)
+      if (scene%springs%present) call add_moving_element_forces(scene, b%x, b%x_lo, v1, f, t_end)
+      if (scene%n_stops > 0) call add_stop_forces(scene, mode%engaged, b%x, b%x_lo, v1, f, t_end)
+      call law_acceleration(scene, mode, t_end, v1, f, acc_end)
       call add_compensated(b%drive_work, b%drive_lo, step / 6.0_wp * (power(1) + 2.0_wp * (power(2) + &
         power(3)) + power(4)))
     end subroutine drive_step_ledger
@@ -339,14 +350,15 @@ contains
     subroutine stop_ledger()
       call add_compensated(b%damping_loss, b%damping_lo, step / 6.0_wp * &
         (stop_damping_power(scene, mode%engaged, v0, a%t) + 4.0_wp * stop_damping_power(scene, mode%engaged, &
-        vm, a%t + half) + stop_damping_power(scene, mode%engaged, v1, a%t + step)) + &
+        vm, a%t + half) + stop_damping_power(scene, mode%engaged, v1, drive_time(a%t, step))) + &
         stop_release_loss(scene, mode%engaged, a%x, a%x_lo, b%x, b%x_lo, a%t, b%t))
     end subroutine stop_ledger
   end subroutine nbody_step
 
   !> Bodies held to a moving ground move with it exactly over the step from a to b (by w(t +
-  !> step) - w(t), at w'(t + step)): RK4's quadrature of w'' would leave their held rows'
-  !> normal velocity off zero by its error, which the event points would take for impacts.
+  !> step) - w(t), at w'(t + step), a table's slope before a corner there): RK4's quadrature
+  !> of w'' would leave their held rows' normal velocity off zero by its error, which the
+  !> event points would take for impacts.
   pure subroutine hold_to_drives(scene, mode, a, step, b)
     type(scene_type), intent(in) :: scene
     type(body_mode_type), intent(in) :: mode
@@ -360,7 +372,7 @@ contains
         b%x(i) = a%x(i)
         b%x_lo(i) = a%x_lo(i)
         call move_with_drive(scene, d, a%t, step, b%x(i), b%x_lo(i))
-        b%v(i) = scene%drives%velocity(d, a%t + step)
+        b%v(i) = scene%drives%velocity(d, scene%drives%before_corner(a%t, a%t + step))
         b%v_lo(i) = 0.0_wp
       end associate
     end do
@@ -595,7 +607,8 @@ contains
         ! A moving ground end on its own cubic over the step (exact for ground_v; the
         ! step's end is checked on the exact w: gaps_hold).
         if (scene%row_drive(k) > 0) p(1:3) = p(1:3) + hermite(-n(2) * scene%drives%displacement( &
-          scene%row_drive(k), a%t, step), ground_motion(scene, k, a%t, 1), ground_motion(scene, k, a%t + step, 1), step)
+          scene%row_drive(k), a%t, step), ground_motion(scene, k, a%t, 1), ground_motion(scene, k, &
+          scene%drives%before_corner(a%t, a%t + step), 1), step)
       end if
     end associate
   end subroutine gap_cubic

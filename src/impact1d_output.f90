@@ -7,7 +7,8 @@ module impact1d_output
   use impact1d_kinds, only: wp
   use impact1d_error, only: error_type, raise, status_input, status_simulation, status_interrupted, fmt, fmt_width
   use impact1d_interrupt, only: interrupt_count
-  use impact1d_scene, only: scene_input, real_names, n_real, i_title, i_method, i_g, i_dt_out, &
+  use impact1d_scene, only: scene_input, real_names, n_real, i_title, i_method, i_g, i_dt_out, i_x_left_table, &
+    i_x_right_table, &
     events_all, events_impacts, events_none, events_kept, name_len, &
     i_dt, default_gravity, i_m2, springs_named, is_nbody, ground_named
   use impact1d_fields, only: n_contact_fields, contact_fields, spring_fields, sine_fields, friction_fields, &
@@ -795,6 +796,11 @@ contains
     else
       call self%put_line(self%unit, '# method = event')
     end if
+    ! (the walls' tables, as the records' ground_table: the path as the run read it)
+    if (len_trim(input%text(i_x_left_table)%s) > 0) &
+      call self%put_line(self%unit, '# x_left_table = ' // trim(input%text(i_x_left_table)%s))
+    if (len_trim(input%text(i_x_right_table)%s) > 0) &
+      call self%put_line(self%unit, '# x_right_table = ' // trim(input%text(i_x_right_table)%s))
     do k = 1, n_real
       if (input%given(k)) then
         call self%put_line(self%unit, '# ' // trim(real_names(k)) // ' = ' // trim(fmt(input%value(k))))
@@ -924,7 +930,8 @@ contains
   end subroutine put_records
 
   !> Records, a line per given field ('# group.r.field = value'); field name_field (0: none)
-  !> is the record's name, written when not blank.
+  !> is the record's name, written when not blank; ground_table its table's path (as read:
+  !> relative to the folder the run started in, or absolute).
   subroutine put_numeric_records(self, group, fields, records, name_field)
     class(file_sink), intent(inout) :: self
     character(len=*), intent(in) :: group, fields(:)
@@ -935,8 +942,11 @@ contains
     do r = 1, size(records)
       do f = 1, size(fields)
         write(key, '(a, ".", i0, ".", a)') group, r, trim(fields(f))
-        if (f /= name_field .and. records(r)%given(f)) call self%put_line(self%unit, '# ' // trim(key) // ' = ' // &
-          trim(fmt(records(r)%value(f))))
+        if (fields(f) == 'ground_table') then
+          if (allocated(records(r)%table)) call self%put_line(self%unit, '# ' // trim(key) // ' = ' // records(r)%table)
+        else if (f /= name_field .and. records(r)%given(f)) then
+          call self%put_line(self%unit, '# ' // trim(key) // ' = ' // trim(fmt(records(r)%value(f))))
+        end if
       end do
       if (name_field == 0 .or. .not. allocated(records(r)%name)) cycle
       write(key, '(a, ".", i0, ".name")') group, r

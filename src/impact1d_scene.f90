@@ -11,7 +11,7 @@ module impact1d_scene
   use impact1d_lanes, only: max_lanes
   use impact1d_drives, only: drive_type
   use impact1d_fields, only: chain_input, mechanism_records, r_k, r_c, r_stop_k, r_stop_c, r_ground_v, &
-    r_spring_ground_v, n_ground_fields, array_value, a_m, &
+    r_spring_ground_v, r_ground_table, r_spring_ground_table, array_value, a_m, &
     a_mu, a_mus, a_x, a_v, a_belt_v, a_v_s, a_c_v, &
     a_f, a_f_amp, a_f_period, a_f_phase, a_f_table
   use impact1d_stability, only: linear_modes, stable_step, mode_error, coarse_rate
@@ -26,12 +26,12 @@ module impact1d_scene
   public :: sample_time, step_length, set_text, events_kept, name_of, is_nbody, value_or, ground_named
   public :: runs_nbody
   public :: positive_value, nonnegative_value, unit_interval, resolvable, unresolved
-  public :: i_x_left_v, i_x_right_v
+  public :: i_x_left_v, i_x_right_v, i_x_left_table, i_x_right_table
   public :: i_title, i_f1_table, i_f2_table, i_method, i_substeps, i_events, default_gravity
   public :: events_all, events_impacts, events_none
   public :: name_len, set_rows, allocate_contacts, set_springs, springs_named
 
-  integer, parameter :: n_real = 52, n_text = 6
+  integer, parameter :: n_real = 52, n_text = 8
   !> Names of the real inputs, as in the namelist and in Python's Scene, in this order.
   character(len=*), parameter :: real_names(n_real) = [character(len=15) :: &
     'm1', 'm2', 'mu1', 'mu2', 'g', 'x_left', 'r_left', 'x_right', 'r_right', &
@@ -41,8 +41,8 @@ module impact1d_scene
     'k1', 'x1_rest', 'c1', 'k2', 'x2_rest', 'c2', 'k12', 'd_rest', 'c12', 'max_events', &
     'x_left_v', 'x_left_amp', 'x_left_period', 'x_left_phase', 'x_right_v', 'x_right_amp', 'x_right_period', &
     'x_right_phase']
-  character(len=*), parameter :: text_names(n_text) = [character(len=8) :: &
-    'title', 'f1_table', 'f2_table', 'method', 'substeps', 'events']
+  character(len=*), parameter :: text_names(n_text) = [character(len=13) :: &
+    'title', 'f1_table', 'f2_table', 'method', 'substeps', 'events', 'x_left_table', 'x_right_table']
   integer, parameter :: i_m1 = 1, i_m2 = 2, i_mu1 = 3, i_mu2 = 4, i_g = 5, i_x_left = 6, &
     i_r_left = 7, i_x_right = 8, i_r_right = 9, i_d_min = 10, i_r_min = 11, i_d_max = 12, &
     i_r_max = 13, i_x1 = 14, i_v1 = 15, i_x2 = 16, i_v2 = 17, i_f1 = 18, i_f2 = 19, &
@@ -63,6 +63,8 @@ module impact1d_scene
   integer, parameter :: spring_index(n_tutorial_elements) = [i_k1, i_k2, i_k12]
   integer, parameter :: i_title = 1, i_f1_table = 2, i_f2_table = 3, i_method = 4, i_substeps = 5, &
     i_events = 6
+  !> The walls' tables (x_left_table, x_right_table: a wall's ground_table, wall_records).
+  integer, parameter :: i_x_left_table = 7, i_x_right_table = 8
   !> What the event log keeps (&run events): every event, the impacts only, nothing. The
   !> run's counts (the summary, a sweep's row) are exact whatever it keeps.
   integer, parameter :: events_all = 0, events_impacts = 1, events_none = 2
@@ -1000,22 +1002,33 @@ contains
     scene%element_drive = 0
     if (.not. allocated(records%contact_ground)) return
     do j = 1, records%n_contacts
-      if (records%contact_moves(j)) call add_drive(records%contact_ground(:, j), scene%contact_drive(j))
+      if (.not. records%contact_moves(j)) cycle
+      if (allocated(records%contact_table_path(j)%s)) then
+        call add_drive(records%contact_ground(:, j), scene%contact_drive(j), records%contact_table(j))
+      else
+        call add_drive(records%contact_ground(:, j), scene%contact_drive(j))
+      end if
     end do
     do j = 1, records%n_elements
-      if (records%element_moves(j)) call add_drive(records%element_ground(:, j), scene%element_drive(j))
+      if (.not. records%element_moves(j)) cycle
+      if (allocated(records%element_table_path(j)%s)) then
+        call add_drive(records%element_ground(:, j), scene%element_drive(j), records%element_table(j))
+      else
+        call add_drive(records%element_ground(:, j), scene%element_drive(j))
+      end if
     end do
 
   contains
 
-    !> ground = (v, amp, period, phase): drive d.
-    subroutine add_drive(ground, d)
+    !> ground = (v, amp, period, phase) and the table, if any: drive d.
+    subroutine add_drive(ground, d, table)
       real(wp), intent(in) :: ground(:)
       integer, intent(out) :: d
+      type(table_type), intent(in), optional :: table
       real(wp) :: omega
       omega = 0.0_wp
       if (ground(3) > 0.0_wp .and. ground(2) /= 0.0_wp) omega = angular_frequency(ground(3))
-      call scene%drives%add(ground(1), ground(2), omega, ground(4))
+      call scene%drives%add(ground(1), ground(2), omega, ground(4), table)
       d = scene%drives%n
     end subroutine add_drive
   end subroutine set_drives
@@ -1044,16 +1057,16 @@ contains
   pure logical function ground_named(input)
     type(scene_input), intent(in) :: input
     integer :: r
-    ground_named = any(input%given(i_x_left_v:i_x_right_v + 3)) .or. input%chain%array(a_belt_v)%n > 0
+    ground_named = any(input%given(i_x_left_v:i_x_right_v + 3)) .or. input%chain%array(a_belt_v)%n > 0 .or. &
+      len_trim(input%text(i_x_left_table)%s) > 0 .or. len_trim(input%text(i_x_right_table)%s) > 0
     if (allocated(input%chain%contacts)) then
       do r = 1, size(input%chain%contacts)
-        ground_named = ground_named .or. any(input%chain%contacts(r)%given(r_ground_v:r_ground_v + n_ground_fields - 1))
+        ground_named = ground_named .or. any(input%chain%contacts(r)%given(r_ground_v:r_ground_table))
       end do
     end if
     if (.not. allocated(input%chain%springs)) return
     do r = 1, size(input%chain%springs)
-      ground_named = ground_named .or. any(input%chain%springs(r)%given(r_spring_ground_v:r_spring_ground_v + &
-        n_ground_fields - 1))
+      ground_named = ground_named .or. any(input%chain%springs(r)%given(r_spring_ground_v:r_spring_ground_table))
     end do
   end function ground_named
 

@@ -326,7 +326,7 @@ def test_moving_walls_are_the_records_moving():
 
 
 @pytest.mark.parametrize("fields, message", [
-    (dict(x_left_v=0.1), "x_left_v, _amp, _period, _phase move the wall x_left, which is not given"),
+    (dict(x_left_v=0.1), "x_left_v, _amp, _period, _phase, _table move the wall x_left, which is not given"),
     (dict(x_right=2.0, x_right_amp=0.1), "x_right_amp and x_right_period go together"),
     (dict(x_right=2.0, x_right_phase=0.1), "x_right_phase is given but x_right_amp is not"),
     (dict(x_left=-1.0, x_left_amp=1.5, x_left_period=1.0, x_left_phase=1.0), "violates the left"),

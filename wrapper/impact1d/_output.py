@@ -7,7 +7,7 @@ import os
 
 import numpy as np
 
-from ._scene import (REAL_FIELDS, TEXT_FIELDS, ARRAY_FIELDS, LAW_FIELDS, Scene, InputError, load_scene, is_nbody_form, from_core, to_core,
+from ._scene import (REAL_FIELDS, TEXT_FIELDS, ARRAY_FIELDS, LAW_FIELDS, _RECORD_TEXT_FIELDS, Scene, InputError, load_scene, is_nbody_form, from_core, to_core,
                      _put)
 from ._files import check_input
 from ._simulate import LEDGER, Result, event_dtype, result_from_columns
@@ -115,7 +115,7 @@ def read_output(path, scene=None) -> Result:
         group, _, rest = key.partition(".")
         number, _, field = rest.partition(".")
         if group in ("contact", "spring", "sine", "friction") and number.isdigit() and field:
-            _put(kwargs, f"{group}.{field}", int(number), value if field == "name" else float(value))
+            _put(kwargs, f"{group}.{field}", int(number), value if field in _RECORD_TEXT_FIELDS else float(value))
     header_scene = Scene(**kwargs, source=header.get("scene"))
 
     events_file = events_path(path)

@@ -51,7 +51,7 @@ REAL_FIELDS = (
     "x_left_v", "x_left_amp", "x_left_period", "x_left_phase",
     "x_right_v", "x_right_amp", "x_right_period", "x_right_phase",
 )
-TEXT_FIELDS = ("title", "f1_table", "f2_table", "method", "substeps", "events")
+TEXT_FIELDS = ("title", "f1_table", "f2_table", "method", "substeps", "events", "x_left_table", "x_right_table")
 # The N-body scene (DESIGN "Mechanisms as data"): arrays (body i's value at i; the &link
 # ones and k_link, d_rest, c_link one per neighbour pair), &link r_meet, and the fields of
 # the &contact, &spring, &sine and &friction records. Checked against _api.input_field_names() at import.
@@ -61,11 +61,14 @@ ARRAY_FIELDS = ("m", "mu", "mus", "x", "v", "f", "f_amp", "f_period", "f_phase",
 # The friction laws' arrays (DESIGN "Laws added on the records"): arrays for any N, with no
 # tutorial name; they go to the core with the records (record_fields).
 LAW_FIELDS = ("belt_v", "v_s", "c_v")
-# A record with a ground end (a or b = 0) may move it: GROUND_FIELDS (DESIGN "Laws added").
-GROUND_FIELDS = ("ground_v", "ground_amp", "ground_period", "ground_phase")
+# A record with a ground end (a or b = 0) may move it: GROUND_FIELDS (DESIGN "Laws added");
+# ground_table is the path of a (t, w) table, read as a force table is.
+GROUND_FIELDS = ("ground_v", "ground_amp", "ground_period", "ground_phase", "ground_table")
 # A gear ratio n on a contact or spring (DESIGN "Laws added"): it acts on x_b - n x_a.
 CONTACT_FIELDS = ("a", "b", "d_min", "r_min", "d_max", "r_max", "name", "k", "c") + GROUND_FIELDS + ("ratio",)
 SPRING_FIELDS = ("a", "b", "k", "d_rest", "c") + GROUND_FIELDS + ("ratio",)
+# The records' fields that are texts.
+_RECORD_TEXT_FIELDS = ("name", "ground_table")
 SINE_FIELDS = ("body", "amp", "period", "phase")
 # A friction contact between bodies a and b under a constant normal load (DESIGN "Laws added").
 FRICTION_FIELDS = ("a", "b", "mu", "mus", "normal", "name")
@@ -158,6 +161,9 @@ class Scene:
     method: Optional[str] = None
     substeps: Optional[str] = None     # 'auto': dt divided for springs coarse at dt
     events: Optional[str] = None       # 'all' (default), 'impacts' or 'none': what the log keeps
+    # The walls' tables (paths, read as force tables are), added to x_left / x_right.
+    x_left_table: Optional[str] = None
+    x_right_table: Optional[str] = None
     source: Optional[str] = None
     m: Optional[Sequence[float]] = None
     mu: Optional[Sequence[float]] = None
@@ -383,7 +389,7 @@ def to_assignments(scene: Scene):
             for key, value in record.items():
                 if value is None:
                     continue
-                if key == "name":
+                if key in _RECORD_TEXT_FIELDS:
                     texts.append((_ID[prefix + key], j, _text(f"{group}[{j - 1}].name", value)))
                 else:
                     numbers.append((_ID[prefix + key], j, _number(f"{group}[{j - 1}].{key}", value)))

@@ -754,30 +754,37 @@ class _Row(NamedTuple):
     side: str
     limit: float
     record: int         # the record it comes from (a slot's two rows share one)
-    motion: tuple = ()  # its ground end's (v, amp, period, phase) when it moves (ground_*)
+    motion: tuple = ()  # its ground end's (v, amp, period, phase, table) when it moves (ground_*)
 
 
 _MOTION_FIELDS = ("v", "amp", "period", "phase")
 
 
-def _motion(values):
-    """(v, amp, period, phase) from a record's ground_* values (None: not named), or ()
-    when none is named: the ground end stays at 0."""
-    if all(value is None for value in values):
+def _motion(values, table=None):
+    """(v, amp, period, phase, table) from a record's ground_* values (None: not named) and
+    its ground_table's path (None: none; the table read as (t, w) arrays), or () when none
+    is named: the ground end stays at 0."""
+    if all(value is None for value in values) and table is None:
         return ()
-    return tuple(float(value) if value is not None else 0.0 for value in values)
+    if table is not None:
+        rows = np.loadtxt(table, comments="#", ndmin=2)
+        table = (rows[:, 0], rows[:, 1])
+    return tuple(float(value) if value is not None else 0.0 for value in values) + (table,)
 
 
 def _ground_line(row, t):
     """Where a limit of body b with the ground holds b over the times t: its limit plus the
-    ground end's prescribed position w(t) = v t + amp sin(2 pi t / period + phase)
-    (docs/method.md section 11), as the engine moves it."""
+    ground end's prescribed position w(t) = v t + amp sin(2 pi t / period + phase) + table(t)
+    (linear between the table's corners, held at its ends: np.interp's rule; docs/method.md
+    section 11), as the engine moves it."""
     line = np.full(np.shape(t), row.limit, dtype=float)
     if row.motion:
-        v, amp, period, phase = row.motion
+        v, amp, period, phase, table = row.motion
         line = line + v * np.asarray(t, dtype=float)
         if amp:
             line = line + amp * np.sin(2.0 * np.pi * np.asarray(t, dtype=float) / period + phase)
+        if table is not None:
+            line = line + np.interp(np.asarray(t, dtype=float), *table)
     return line
 
 
@@ -794,7 +801,8 @@ def _tutorial_records(result, n, joined=()):
         if value["x_" + wall] is not None:
             # (a moving wall, &walls x_left_v ...: its record's ground_* fields, as the engine's)
             records.append(dict(a=0, b=body, name=wall, **{"d_" + side: value["x_" + wall]}, **{
-                "ground_" + f: _float_or_none(_scene_value(result, f"x_{wall}_{f}")) for f in _MOTION_FIELDS}))
+                "ground_" + f: _float_or_none(_scene_value(result, f"x_{wall}_{f}")) for f in _MOTION_FIELDS},
+                ground_table=_scene_value(result, f"x_{wall}_table")))
     if n > 2:
         return records + _chain_links(result, n, joined)
     if n == 2:
@@ -835,7 +843,8 @@ def _record_rows(j, record):
     limits = {side: _float_or_none(_field(record, "d_" + side)) for side in ("min", "max")}
     name = str(_field(record, "name", f"contact{j + 1}"))
     both = None not in limits.values()
-    motion = _motion([_float_or_none(_field(record, "ground_" + f)) for f in _MOTION_FIELDS])
+    motion = _motion([_float_or_none(_field(record, "ground_" + f)) for f in _MOTION_FIELDS],
+                     _field(record, "ground_table"))
     rows = []
     for side, limit in limits.items():
         if limit is None:
