@@ -72,20 +72,25 @@ contains
     integer, intent(in) :: d
     real(wp), intent(in) :: t
     w = self%v(d) * t
-    if (self%varies(d)) call self%varying(self, d, t, 0, w)
+    if (self%varies(d)) w = self%varying(self, d, t, 0, w)
   end function position
 
-  !> w += drive d's sine and table terms at t, of w (order 0) or of w' (1), in that order.
+  !> w plus drive d's sine and table terms at t, of w (order 0) or of w' (1), in that order.
   !> (Apart from position and velocity, and called through a pointer (varying), so that
   !> those stay small enough to be inlined: with the table's terms inside them they no
   !> longer were, and input/burridge_knopoff.nml's ten blocks dragged by anchors at
   !> constant speed took 15% more instructions (154.0 M -> 177.5 M, callgrind, 2 s of the
-  !> CLI's run); as now, 159.5 M: +3.6%, the rest not found yet.)
-  pure subroutine add_varying(self, d, t, order, w)
+  !> CLI's run); a direct call, subroutine or pure function, was inlined back (175.7 M).
+  !> The pointer's cost, 159.0 M (+3.2%): the compiler must assume the call writes memory,
+  !> so the callers' element loops reload the scene's array descriptors at each element
+  !> where they kept them in registers around sin. A function with w by value: with w
+  !> intent(inout) every call also stored w first, 159.5 M.)
+  pure real(wp) function add_varying(self, d, t, order, w_in) result(w)
     type(drive_type), intent(in) :: self
     integer, intent(in) :: d, order
     real(wp), intent(in) :: t
-    real(wp), intent(inout) :: w
+    real(wp), value :: w_in
+    w = w_in
     if (self%omega(d) /= 0.0_wp) then
       if (order == 0) then
         w = w + self%amp(d) * sin(self%omega(d) * t + self%phase(d))
@@ -94,7 +99,7 @@ contains
       end if
     end if
     if (self%tables) w = w + table_part(self, d, t, order)
-  end subroutine add_varying
+  end function add_varying
 
   !> w_d at the clock t + t_lo as hi + lo: v t without rounding (Dekker's product), the
   !> clock's low part w' t_lo and the sine in lo. A body put on the ground (snapped) is then
@@ -215,7 +220,7 @@ contains
     integer, intent(in) :: d
     real(wp), intent(in) :: t
     w = self%v(d)
-    if (self%varies(d)) call self%varying(self, d, t, 1, w)
+    if (self%varies(d)) w = self%varying(self, d, t, 1, w)
   end function velocity
 
   !> w_d''(t).
