@@ -7,6 +7,7 @@
 module impact1d_drives
   use impact1d_kinds, only: wp
   use impact1d_forcing, only: table_type, table_value, table_slope, segment
+  use impact1d_state, only: product_error
   implicit none
   private
   public :: drive_type
@@ -119,20 +120,12 @@ contains
     if (self%tables) lo = lo + table_part(self, d, t, 0)
   end subroutine position_parts
 
-  !> a b = p + e exactly (Dekker's product: p rounded, e its error).
+  !> a b = p + e exactly (p rounded, e its error: impact1d_state's product_error).
   pure subroutine exact_product(a, b, p, e)
     real(wp), intent(in) :: a, b
     real(wp), intent(out) :: p, e
-    real(wp), parameter :: split = 134217729.0_wp   ! 2**27 + 1
-    real(wp) :: c, a_hi, a_lo, b_hi, b_lo
     p = a * b
-    c = split * a
-    a_hi = c - (c - a)
-    a_lo = a - a_hi
-    c = split * b
-    b_hi = c - (c - b)
-    b_lo = b - b_hi
-    e = ((a_hi * b_hi - p) + a_hi * b_lo + a_lo * b_hi) + a_lo * b_lo
+    e = product_error(a, b)
   end subroutine exact_product
 
   !> The size of what position_parts rounds in w_d(t): the sine's |amp sin(omega t + phase)|
