@@ -834,7 +834,7 @@ contains
     if (.not. scene%geared) return
     what = ''
     if (scene%method == 'vissim') what = "method = 'vissim' (the tutorial's scheme)"
-    if (scene%drives%n > 0) what = 'a moving ground (ground_v, ground_amp, x_left_v ...)'
+    if (scene%drives%n > 0) what = 'a moving ground (ground_v, ground_amp, ground_table, x_left_v ...)'
     if (any(scene%body_static > 0.0_wp) .or. scene%n_frictions > 0) what = 'friction (mu, mus, &friction)'
     if (scene%belts .or. scene%stribeck) what = 'belt_v, v_s or c_v'
     if (len(what) > 0) call raise(error, status_input, 'a gear ratio (ratio other than 1) cannot be ' // &

@@ -275,6 +275,17 @@ def test_a_moving_ground_in_a_geared_scene_is_refused():
         impact1d.simulate(scene)
 
 
+def test_a_ground_table_in_a_geared_scene_is_refused_by_name(tmp_path):
+    """A ground moved by a table is a moving ground too: refused, and the message names
+    ground_table among the moving grounds' fields."""
+    table = tmp_path / "lift.dat"
+    table.write_text("0.0 0.0\n1.0 0.5\n")
+    scene = rattle(1e-3, 1.0)
+    scene.springs = [{"a": 0, "b": 1, "k": 10.0, "d_rest": 0.0, "ground_table": str(table)}]
+    with pytest.raises(impact1d.InputError, match="gear ratio.*moving ground.*ground_table"):
+        impact1d.simulate(scene)
+
+
 def test_scene_file_cli_header_and_read_output_carry_the_ratio(tmp_path):
     """The namelist's `ratio` reaches the run; the output header writes it and read_output
     rebuilds the scene from it (the same run again)."""
