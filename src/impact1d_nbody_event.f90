@@ -146,6 +146,7 @@ contains
     do i = 1, scene%n_bodies
       stopped(i) = scene%body_static(i) > 0.0_wp .and. slip(scene, i, s%v(i)) /= 0.0_wp .and. ((found == found_body &
         .and. index == i) .or. abs(slip(scene, i, s%v(i))) <= velocity_rounding * abs(acc(i)) * scene%dt)
+      if (.not. initial) stopped(i) = stopped(i) .and. .not. rides_drive(scene, mode, i, s%t)
       if (stopped(i)) call zero_velocity(scene, s, i)
     end do
     if (scene%n_frictions > 0 .and. .not. initial .and. any(stopped)) call carry_stopped(scene, mode, stopped, s)
@@ -1360,11 +1361,25 @@ contains
     integer :: i
     do i = 1, scene%n_bodies
       zeroed(i) = s%v(i) /= rest_velocity(scene, i) .and. abs(s%v(i) - rest_velocity(scene, i)) <= &
-        velocity_rounding * max(abs(acc(i)) * scene%dt, entry_scale(i))
+        velocity_rounding * max(abs(acc(i)) * scene%dt, entry_scale(i)) .and. .not. rides_drive(scene, mode, i, s%t)
       if (zeroed(i)) call zero_velocity(scene, s, i)
     end do
     if (scene%n_frictions > 0 .and. any(zeroed)) call carry_stopped(scene, mode, zeroed, s)
   end subroutine zero_stopped
+
+  !> Whether body i is held to a ground that accelerates at t: its velocity is w'(t), which
+  !> does not stay at zero, not a stop within rounding of it (zeroed at a turn of w', it was
+  !> stuck: its friction lost while it rode the ground on, not sliding back). On a ground at
+  !> constant speed (w'' = 0) a held body is zeroed as on the still ground.
+  pure logical function rides_drive(scene, mode, i, t)
+    type(scene_type), intent(in) :: scene
+    type(body_mode_type), intent(in) :: mode
+    integer, intent(in) :: i
+    real(wp), intent(in) :: t
+    rides_drive = .false.
+    if (scene%drives%n == 0) return
+    if (mode%drive(i) > 0) rides_drive = scene%drives%acceleration(mode%drive(i), t) /= 0.0_wp
+  end function rides_drive
 
   !> The velocity at which body i rests: its belt's when it has one and friction to hold it
   !> there (impact1d_friction_laws), else 0.

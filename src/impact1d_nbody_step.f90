@@ -568,7 +568,22 @@ contains
       end if
     end do
     do i = 1, scene%n_bodies
-      if (scene%body_static(i) == 0.0_wp .or. mode%sgn(i) == 0.0_wp .or. mode%group(i) == 0) cycle
+      if (scene%body_static(i) == 0.0_wp .or. mode%sgn(i) == 0.0_wp) cycle
+      if (mode%group(i) == 0) then
+        ! A body held to a moving ground that slides: its velocity is w'(t), whose zero may
+        ! fall between two doubles of the clock; past it within the clock's rounding
+        ! (gaps_hold) it stops at once, for the event point to take the new direction.
+        if (scene%drives%n == 0) cycle
+        if (mode%drive(i) == 0) cycle
+        if (mode%sgn(i) * slip(scene, i, a%v(i)) < 0.0_wp .and. &
+          abs(slip(scene, i, a%v(i))) <= clock_band(scene, mode%drive(i), a%t)) then
+          theta = 0.0_wp
+          found = found_body
+          index = i
+          return
+        end if
+        cycle
+      end if
       ! (the slip: velocity relative to the body's friction surface)
       p = mode%sgn(i) * [slip(scene, i, c(1, i)), 2.0_wp * c(2, i), 3.0_wp * c(3, i), 0.0_wp]
       q = [velocity_rounding * max(abs(a%v(i)), abs(b%v(i)), abs(b%v(i) - a%v(i))), 0.0_wp, 0.0_wp, 0.0_wp]
@@ -586,6 +601,14 @@ contains
         .or. scene%stribeck)) &
       call mode_crossing(scene, mode, work, a, c, min(theta, step), theta, found)
   end subroutine locate_nbody
+
+  !> What the rounding of the clock at t moves drive d's velocity w' by.
+  pure real(wp) function clock_band(scene, d, t) result(band)
+    type(scene_type), intent(in) :: scene
+    integer, intent(in) :: d
+    real(wp), intent(in) :: t
+    band = time_rounding * max(abs(t), scene%dt) * abs(scene%drives%acceleration(d, t))
+  end function clock_band
 
   !> Row k's gap over the step from a with dense output c, as a cubic p in theta, and the
   !> rounding of its terms of order 1 to 3 (q(1:3); q(0) is left to the caller).
@@ -924,7 +947,7 @@ contains
     do i = 1, scene%n_bodies
       if (scene%body_static(i) == 0.0_wp .or. mode%sgn(i) == 0.0_wp) cycle
       if (mode%sgn(i) * slip(scene, i, b%v(i)) < -velocity_rounding * max(abs(s%v(i)), abs(b%v(i)), &
-          abs(b%v(i) - s%v(i)))) gaps_hold = .false.
+          abs(b%v(i) - s%v(i))) - held_band(i)) gaps_hold = .false.
     end do
     do k = 1, scene%n_frictions
       if (mode%friction_sgn(k) == 0.0_wp) cycle
@@ -935,6 +958,16 @@ contains
     end do
 
   contains
+
+    !> A body held to a moving ground has w'(t) formed at the clock's leading double: where
+    !> w' turns between two doubles (a sine ground at its top) it passes zero with no time
+    !> to locate; what the clock's rounding moves w' by is a stop (locate_nbody, theta 0).
+    pure real(wp) function held_band(i)
+      integer, intent(in) :: i
+      held_band = 0.0_wp
+      if (scene%drives%n == 0) return
+      if (mode%drive(i) > 0) held_band = clock_band(scene, mode%drive(i), b%t)
+    end function held_band
 
     !> What the step moved row k's gap by (row_abs of the bodies' displacements, formed for
     !> its two ends only: over all N bodies for each row, it was O(N) a row and most of a

@@ -522,3 +522,42 @@ def test_a_release_on_the_nbody_engine_logs_the_bodies_velocities():
         assert len(at) > 5
         assert np.all(np.abs(events["v1_before"][at] - u) < 0.5)
         np.testing.assert_array_equal(events["v1_after"][at], events["v1_before"][at])
+
+
+def sine_ground_travel(t, amp, omega, phase):
+    """The distance a point on w(t) = amp sin(omega t + phase) has travelled by t (w' turns
+    where omega t + phase = pi/2 + k pi)."""
+    w = lambda s: amp * np.sin(omega * s + phase)
+    turns = (np.pi / 2 - phase + np.pi * np.arange(0, 8)) / omega
+    travel = np.zeros_like(t)
+    start = np.zeros_like(t)
+    for turn in turns[turns > 0]:
+        passed = t > turn
+        travel[passed] += np.abs(w(turn) - w(start[passed]))
+        start[passed] = turn
+    return travel + np.abs(w(t) - w(start))
+
+
+@pytest.mark.parametrize("dt", [1e-3, 1e-2])
+@pytest.mark.parametrize("phase", [0.0, 0.3])
+def test_a_body_held_to_a_sine_wall_slides_back_with_it_where_it_turns(dt, phase):
+    """A body with floor friction (mu m g = 3 N) held on a wall w = A sin(omega t + phase) by
+    f1 = -5 N rides it exactly and slides on the floor the way w' goes: friction takes
+    3 N times the distance travelled, its force turning with w' at each turn (t = 0.25 and
+    0.75 for phase 0). With phase 0, w' at the double 0.25 is +7.7e-18 and its zero falls
+    before the next double: the run stopped there ("no step keeps the constraints"), no
+    time left to locate the zero (now: a stop within the clock's rounding of w', taken at
+    the next step's start). With phase 0.3 (or dt = 1e-2) the event point zeroed the body's
+    velocity at the turn and the mode kept it stuck on the floor: friction lost while the
+    body rode on. No stick or slip is logged: the body never sticks, it turns with the wall."""
+    amp, omega = 0.02, 2 * math.pi
+    result = impact1d.simulate(impact1d.Scene(
+        m1=1.0, mu1=0.3, g=10.0, f1=-5.0, x1=amp * math.sin(phase), v1=amp * omega * math.cos(phase),
+        t_end=1.0, dt=dt, contacts=[dict(a=0, b=1, d_min=0.0, r_min=0.0, ground_amp=amp,
+                                         ground_period=1.0, ground_phase=phase, name="wall")]))
+    assert list(result.events["kind"]) == ["rest_wall"]
+    np.testing.assert_allclose(result.x1, amp * np.sin(omega * result.t + phase), rtol=0, atol=1e-15)
+    np.testing.assert_allclose(result.v1, amp * omega * np.cos(omega * result.t + phase), rtol=0, atol=1e-15)
+    np.testing.assert_allclose(result.friction_loss, 3.0 * sine_ground_travel(result.t, amp, omega, phase),
+                               rtol=0, atol=1e-7)
+    assert result.energy_residual < RESIDUAL_TOL_QUADRATURE
