@@ -10,7 +10,7 @@ module impact1d_nbody_step
   use impact1d_events, only: hermite, earliest_crossing, stop_force_cubic
   use impact1d_yardsticks, only: gap_rounding, velocity_rounding, time_rounding
   use impact1d_elements, only: add_element_forces, add_moving_element_forces, add_element_rates, element_damping_power, &
-    element_drive_power, add_stop_forces, add_stop_rates, stop_damping_power, stop_release_loss, stop_drive_power
+    add_stop_forces, add_stop_rates, stop_damping_power, stop_release_loss, stop_drive_power
   use impact1d_body_mode, only: body_mode_type, mode_work_type, solve_body_mode, same_mode, mode_solved, &
     drive_accelerations, shift_to_drives, relative_velocity
   use impact1d_friction_laws, only: slip, add_stribeck_forces, law_powers, contact_loss
@@ -309,8 +309,7 @@ contains
       drive_power = 0.0_wp
       if (scene%springs%present) then
         dx = dx_stage
-        call add_moving_element_forces(scene, a%x, dx, v, f, t)
-        drive_power = element_drive_power(scene, a%x, dx, v, t)
+        call add_moving_element_forces(scene, a%x, dx, v, f, t, drive_power)
         if (scene%n_stops > 0) then
           call add_stop_forces(scene, mode%engaged, a%x, dx, v, f, t)
           drive_power = drive_power + stop_drive_power(scene, mode%engaged, a%x, dx, v, t)

@@ -561,3 +561,24 @@ def test_a_body_held_to_a_sine_wall_slides_back_with_it_where_it_turns(dt, phase
     np.testing.assert_allclose(result.friction_loss, 3.0 * sine_ground_travel(result.t, amp, omega, phase),
                                rtol=0, atol=1e-7)
     assert result.energy_residual < RESIDUAL_TOL_QUADRATURE
+
+
+def test_anchors_at_one_speed_put_in_that_speed_times_the_momentum_they_gave():
+    """Three free blocks joined by springs, the outer two also tied (a spring, one with a
+    damper) to anchors moving at one speed V: the links' tensions cancel in the momentum P,
+    so the anchors' power V sum T_j integrates to V (P(t) - P(0)). RK4 steps P with the
+    same stage forces whose power the ledger takes, so drive_work = V dP to rounding. Guards
+    impact1d_elements' moving-ground loop, which forms the forces and the anchors' power in
+    one pass (only its ground ends count; a sign or a link counted would move it by far more)."""
+    big_v = 0.25
+    m = np.array([1.0, 2.0, 1.5])
+    scene = impact1d.Scene(m=list(m), x=[0.0, 1.0, 2.0], v=[0.0, 0.0, 0.0], k_link=[40.0, 30.0], d_rest=[1.0, 1.0],
+                           c_link=[0.2, 0.0],
+                           springs=[dict(a=0, b=1, k=4.0, c=0.5, d_rest=0.0, ground_v=big_v),
+                                    dict(a=0, b=3, k=6.0, d_rest=2.0, ground_v=big_v)],
+                           t_end=3.0, dt=1e-3, dt_out=0.5)
+    result = impact1d.simulate(scene)
+    momentum = result.v @ m
+    assert momentum[-1] > 0.1
+    np.testing.assert_allclose(result.drive_work, big_v * (momentum - momentum[0]), rtol=0, atol=1e-13)
+    assert result.damping_loss[-1] > 0.0 and abs(result.energy_residual) < 1e-9
