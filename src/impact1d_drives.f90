@@ -83,9 +83,10 @@ contains
   !> constant speed took 15% more instructions (154.0 M -> 177.5 M, callgrind, 2 s of the
   !> CLI's run); a direct call, subroutine or pure function, was inlined back (175.7 M).
   !> The pointer's cost, 159.0 M (+3.2%): the compiler must assume the call writes memory,
-  !> so the callers' element loops reload the scene's array descriptors at each element
-  !> where they kept them in registers around sin. A function with w by value: with w
-  !> intent(inout) every call also stored w first, 159.5 M.)
+  !> so the callers' element loops reloaded the scene's array descriptors at each element
+  !> where they kept them in registers around sin (they now take the element records as
+  !> explicit-shape arrays: impact1d_elements' moving_forces, 142.6 M). A function with w
+  !> by value: with w intent(inout) every call also stored w first, 159.5 M.)
   pure real(wp) function add_varying(self, d, t, order, w_in) result(w)
     type(drive_type), intent(in) :: self
     integer, intent(in) :: d, order
