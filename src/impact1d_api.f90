@@ -472,10 +472,16 @@ contains
     end if
     call catch_interrupts()
     do j = 1, n_runs
-      input = base
-      input%value(over_index) = real(over_values(:, j), wp)
-      input%given(over_index) = .true.
-      call prepare_scene(input, scene, error)
+      if (interrupt_epoch >= 0 .and. interrupt_count() /= interrupt_epoch) then
+        ! An interrupt since the caller's epoch ends the batch before its next run: a run
+        ! shorter than a checkpoint (4096 steps) never looks, and the batch ran to its end.
+        call raise(error, status_interrupted, 'interrupted before run ' // trim(fmt(j)) // ' of the batch')
+      else
+        input = base
+        input%value(over_index) = real(over_values(:, j), wp)
+        input%given(over_index) = .true.
+        call prepare_scene(input, scene, error)
+      end if
       ! Past two bodies, x3_end v3_end .. xN_end vN_end follow the named columns.
       if (.not. allocated(error) .and. n_summary /= size(summary_names) + 2 * max(0, scene%n_bodies - 2)) &
         call raise(error, status_input, 'internal: the summary has room for ' // trim(fmt(n_summary)) // &

@@ -147,7 +147,14 @@ contains
       if (.not. allocated(records%contact_table_path(k)%s)) cycle
       call read_table(records%contact_table_path(k)%s, records%contact_table(k), error)
       if (allocated(error)) then
-        error%message = 'the contact ''' // trim(records%contact_name(k)) // '''s ground_table: ' // error%message
+        if (k <= count([input%given(i_x_left), input%given(i_x_right)])) then
+          ! A wall's table: named as the user wrote it (the walls are the first records,
+          ! the left one first: input_records), not by the record made of it.
+          error%message = trim(merge('x_left_table ', 'x_right_table', k == 1 .and. input%given(i_x_left))) // &
+            ': ' // error%message
+        else
+          error%message = 'the contact ''' // trim(records%contact_name(k)) // '''s ground_table: ' // error%message
+        end if
         return
       end if
     end do

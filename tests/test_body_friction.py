@@ -219,3 +219,26 @@ def test_friction_damper_sticks_and_slips_at_the_closed_form_instants(dt, tol, r
     assert abs(r.events[0]["t"] - float(t1)) < tol
     assert abs(r.events[1]["t"] - float(t1 + s)) < tol
     assert np.max(np.abs(r.residual)) < residual
+
+
+@pytest.mark.parametrize("dt", [1e-3, 0.05, 0.1])
+@pytest.mark.parametrize("v_common", [0.0, 10.0, -3.0])
+def test_relative_stop_under_constant_forces_is_a_lone_bodys(dt, v_common):
+    """Two blocks (m1 = m2 = 1) moving at v_common, the upper one faster by u0 = 1 and pushed
+    by P = 0.25, the lower one free on a frictionless ground; the contact (F = mu N = 0.5,
+    S = mus N = 0.6). Sliding, u = v2 - v1 obeys u' = (P - F) / m2 - F / m1 = -0.75: the stick
+    at t* = u0 / 0.75, after which the pair needs m1 P / (m1 + m2) = 0.125 <= S and moves as
+    one. One body of the reduced mass m1 m2 / (m1 + m2) = 0.5 on the ground (mu = 1, g = 1:
+    F) pushed by P m1 / (m1 + m2) has that equation: both stick at t* to rounding at every dt
+    (constant forces: RK4 exact), whatever the pair's common velocity (the pair's rounding
+    band, |v_a| + |v_b|, is a rounding's; measured 4e-15 s)."""
+    t_star = 1.0 / 0.75
+    pair = impact1d.Scene(m=[1.0, 1.0], x=[0.0, 10.0], v=[v_common, v_common + 1.0], f=[0.0, 0.25], t_end=2.0,
+                          dt=dt, frictions=[{"a": 1, "b": 2, "mu": 0.5, "mus": 0.6, "normal": 1.0, "name": "pad"}])
+    one = impact1d.Scene(m1=0.5, mu1=1.0, mus1=1.2, g=1.0, x1=0.0, v1=1.0, f1=0.125, t_end=2.0, dt=dt,
+                         x_left=-100.0, x_left_v=0.0)     # (a still wall far away: the N-body engine)
+    a, b = impact1d.simulate(one), impact1d.simulate(pair)
+    assert list(a.events["kind"]) == ["stick1"] and list(b.events["kind"]) == ["stick_pad"]
+    assert a.events["t"][0] == pytest.approx(t_star, abs=1e-15)
+    assert b.events["t"][0] == pytest.approx(t_star, abs=1e-14)
+    np.testing.assert_allclose(b.v2[b.t > t_star] - b.v1[b.t > t_star], 0.0, rtol=0, atol=1e-14)

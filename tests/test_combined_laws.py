@@ -291,14 +291,18 @@ def test_top_block_breaks_away_from_a_block_on_a_belt(dt, tol):
     assert abs(result.energy_residual) < residual_bound(dt)
 
 
-@pytest.mark.parametrize("dt", [1e-3, 0.02])
+@pytest.mark.parametrize("dt", [1e-3, 0.02, 0.05, 0.1])
 def test_relative_stop_is_polished_as_a_bodys_stop(dt):
     """(f) again: block 2 on block 1 (stuck on the belt at V) meets the same equation, steps
     and events as one block of mass m2 on the belt (tests/test_friction_laws.py (a), mu, mus
     the contact's): its relative stops (stick_pad, v_2 - v_1 reaching 0 under the spring) are
     Newton's roots on the integrator's state as the one block's stops are, not the step's
     cubic's, so the two runs agree to rounding at a fine and a coarse dt (measured 4.4e-15 s;
-    before, the cubic's error: 7.4e-10 s at dt = 1e-3, 4.8e-6 s at 0.02)."""
+    before, the cubic's error: 7.4e-10 s at dt = 1e-3, 4.8e-6 s at 0.02). Block 1 stuck makes
+    the mode a held one, whose check (mode_crossing) probes the dense output up to the stop,
+    where the cubic turns u's sign: that failure is the stop's own, so the stop stays found
+    and polished (it was taken as the mode failing, left on the cubic: 7.9e-7 s off at the
+    fourth stick at dt = 0.05, 2.0e-4 s at the first at dt = 0.1)."""
     v, k = 0.1, 100.0
     pair = impact1d.Scene(m=[M1, M2], x=[-10.0, 0.0], v=[v, v], g=G, mu=[0.5, 0.0], mus=[1.0, 0.0], belt_v=[v, 0.0],
                           t_end=3.0, dt=dt, frictions=pad(), springs=[{"a": 0, "b": 2, "k": k, "d_rest": 0.0}])
@@ -309,6 +313,26 @@ def test_relative_stop_is_polished_as_a_bodys_stop(dt):
     assert [kind.replace("_pad", "1") for kind in kinds] == list(a.events["kind"]) and "stick_pad" in kinds
     np.testing.assert_allclose(times, a.events["t"], rtol=0, atol=1e-13)
     np.testing.assert_allclose(b.x[:, 1], a.x[:, 0], rtol=0, atol=1e-13)
+
+
+@pytest.mark.parametrize("dt", [1e-3, 0.05, 0.1])
+def test_a_stop_in_a_held_mode_is_polished_as_a_lone_bodys(dt):
+    """(f) with a body's own friction: block 2 on the belt with the spring (the one block of
+    the test above, mu, mus its own) beside block 1 stuck on a still floor, apart: the mode
+    is a held one (block 1 stuck), checked up to each of block 2's stops, where the dense
+    output turns its slip's sign. Block 2 stops, sticks and slips as the lone block does, to
+    rounding (before: 5.6e-6 s at dt = 0.05, 3.9e-4 s at 0.1, the stops left on the cubic)."""
+    v, k = 0.1, 100.0
+    one = impact1d.Scene(m1=M2, mu1=MU_P, mus1=MUS_P, g=G, x1=0.0, v1=v, k1=k, x1_rest=0.0, t_end=3.0, dt=dt,
+                         belt_v=[v])
+    two = impact1d.Scene(m=[M1, M2], x=[-10.0, 0.0], v=[0.0, v], mu=[0.5, MU_P], mus=[1.0, MUS_P], g=G,
+                         belt_v=[0.0, v], t_end=3.0, dt=dt, springs=[{"a": 0, "b": 2, "k": k, "d_rest": 0.0}])
+    a, b = impact1d.simulate(one), impact1d.simulate(two)
+    kinds, times = kinds_and_times(b)
+    assert [kind.replace("2", "1") for kind in kinds] == list(a.events["kind"]) and "stick2" in kinds
+    np.testing.assert_allclose(times, a.events["t"], rtol=0, atol=1e-13)
+    np.testing.assert_allclose(b.x[:, 1], a.x[:, 0], rtol=0, atol=1e-13)
+    np.testing.assert_array_equal(b.v[:, 0], 0.0)
 
 
 # (the pair's run cuts its steps where its held mode is checked, the one body's does not: at

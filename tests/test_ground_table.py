@@ -190,6 +190,29 @@ def test_missing_ground_table_is_refused(tmp_path):
         impact1d.simulate(scene)
 
 
+@pytest.mark.parametrize("walls, side", [
+    (dict(x_left=-1.0), "left"), (dict(x_right=1.0), "right"),
+    (dict(x_left=-1.0, x_right=1.0), "left"), (dict(x_left=-1.0, x_right=1.0), "right")])
+@pytest.mark.parametrize("rows", [None, "0 0\n1 x\n"])
+def test_bad_wall_table_is_refused_by_the_name_written(tmp_path, walls, side, rows):
+    """&walls x_left_table = 'missing.dat' (or a bad table) is refused naming x_left_table and
+    the file, not the record made of the wall ('left's ground_table); the other wall's table
+    is good. A &contact record named 'right' keeps its record's name."""
+    good = write_table(tmp_path / "good.dat", [(0.0, 0.0), (1.0, 0.0)])
+    path = tmp_path / "bad.dat"
+    if rows is not None:
+        path.write_text(rows)
+    tables = {f"x_{wall}_table": str(path) if wall == side else good
+              for wall in ("left", "right") if f"x_{wall}" in walls}
+    scene = impact1d.Scene(m1=1.0, x1=0.0, t_end=1.0, dt=1e-3, **walls, **tables)
+    with pytest.raises(impact1d.InputError, match=f"^x_{side}_table: .*bad.dat"):
+        impact1d.simulate(scene)
+    scene = impact1d.Scene(m1=1.0, x1=0.0, t_end=1.0, dt=1e-3, x_left=-1.0, x_left_table=good,
+                           contacts=[dict(a=0, b=1, d_max=1.0, ground_table=str(path), name="right")])
+    with pytest.raises(impact1d.InputError, match="^the contact 'right's ground_table: .*bad.dat"):
+        impact1d.simulate(scene)
+
+
 def test_ground_table_between_two_bodies_is_refused(tmp_path):
     table = write_table(tmp_path / "w.dat", [(0.0, 0.0), (1.0, 1.0)])
     scene = impact1d.Scene(m1=1.0, m2=1.0, x1=0.0, x2=1.0, t_end=1.0, dt=1e-3,

@@ -110,6 +110,23 @@ def test_a_sweep_run_that_starts_after_an_interrupt_ends(name, first):
     assert lines[1] == "next run 41", lines
 
 
+# A program whose own SIGINT handler does not raise (as if Python's flag were lost: the
+# handler prints only) leaves the core's count as the one thing that ends the sweep.
+QUIET_HANDLER = "signal.signal(signal.SIGINT, lambda *a: print('handler', flush=True))\n"
+
+
+def test_a_batch_of_short_runs_ends_at_the_next_run():
+    """The interrupt comes as the chunk starts (LATE_INTERRUPT), the program's handler does
+    not raise, and the runs are short (case 3 to 1 s: 1000 steps, no checkpoint in any): the
+    batch ends at its next run (simulate_summaries checks the count before each), the sweep
+    raises. Before, every run of the batch ran to its end, and the sweep finished."""
+    call = "impact1d.sweep(scene, {'r_left': [0.5] * 64, 't_end': [1.0]}, workers=1)"
+    lines = run_child(call, setup=QUIET_HANDLER + LATE_INTERRUPT, interrupt="", timeout=120)
+    assert lines[0] == "handler", lines
+    assert lines[1].split()[0] == "interrupted", lines
+    assert lines[2] == "next run 41", lines
+
+
 # The long call's form marked as run once before: the call prepares it (api prepare) and
 # runs the prepared scene (run_prepared), which an interrupt ends as it ends a whole set-up's
 # (the child says at exit whether the form was prepared).

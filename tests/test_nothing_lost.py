@@ -247,33 +247,69 @@ def test_plot_on_full_disk_keeps_previous_image(small_disk):
 
 # --- the Python commands: interrupted, or with nowhere to report --------------------
 
-# impact1d-sweep's main() in a Python that says "ready" on stdout once it is imported, so
-# that SIGINT lands in the sweep (2000 runs of case 3 for 200 s each: minutes of work).
-SWEEP_UNTIL_READY = ("import sys, impact1d.sweep_cli as cli; print('ready', flush=True); "
-                     "sys.exit(cli.main(sys.argv[1:]))")
+# impact1d-sweep's main() in a Python that says on stdout where it is: "ready" once it is
+# imported, then `at` when main() reaches `at` (a function of the sweep's modules,
+# wrapped), so that SIGINT lands where the test means (2000 runs of case 3 for 200 s each:
+# minutes of work). QUIET: the program's own SIGINT handler does not raise (as if Python's
+# flag were lost), so only the core's count of the interrupt ends the sweep.
+SWEEP_SAYING = """
+import signal, sys, impact1d.sweep_cli as cli
+if {quiet}:
+    signal.signal(signal.SIGINT, lambda *a: None)
+module = sys.modules["impact1d.sweep" if "{at}" == "run_chunk" else "impact1d.sweep_cli"]
+wrapped = getattr(module, "{at}")
+def saying(*args, **kwargs):
+    print("{at}", flush=True)
+    if {quiet}:
+        import time
+        time.sleep(1.0)        # the signal comes in here (the quiet handler, then on)
+    return wrapped(*args, **kwargs)
+setattr(module, "{at}", saying)
+print("ready", flush=True)
+sys.exit(cli.main(sys.argv[1:]))
+"""
 
 
-def test_interrupted_sweep_is_one_line_and_130(tmp_path):
+def interrupted_sweep(tmp_path, at, quiet=False):
+    """The sweep's return code and stderr, SIGINT sent once main() said `at`; the previous
+    table and the folder checked as they must be after an interrupt."""
     table = tmp_path / "t.csv"
     table.write_text("the previous table\n")
-    proc = subprocess.Popen([sys.executable, "-c", SWEEP_UNTIL_READY, str(CASE3), "--vary",
-                             "r_left=0:0.95:2000", "--vary", "t_end=200", "--workers", "1",
-                             "-o", str(table)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            text=True)
+    code = SWEEP_SAYING.format(at=at, quiet=quiet)
+    proc = subprocess.Popen([sys.executable, "-c", code, str(CASE3), "--vary", "r_left=0:0.95:2000",
+                             "--vary", "t_end=200", "--workers", "1", "-o", str(table)],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         assert proc.stdout.readline() == "ready\n", proc.stderr.read()
-        time.sleep(0.2)       # into the runs; a signal earlier in main() is handled the same
+        assert proc.stdout.readline() == at + "\n", proc.stderr.read()
         proc.send_signal(signal.SIGINT)
         returncode = proc.wait(timeout=RUN_TIMEOUT)
     finally:
         if proc.poll() is None:
             proc.kill()
             proc.wait()
-    stderr = proc.stderr.read()
-    assert returncode == 130, stderr
-    assert stderr.count("\n") == 1 and stderr.startswith("impact1d-sweep: interrupted"), stderr
     assert table.read_text() == "the previous table\n"
     assert temporaries(tmp_path) == []
+    return returncode, proc.stderr.read()
+
+
+def test_interrupted_sweep_is_one_line_and_130(tmp_path):
+    """SIGINT once the sweep's first runs are under way (it was sent 0.2 s after "ready",
+    which a loaded machine once let through: the sweep ran its 90 s and returned 0)."""
+    returncode, stderr = interrupted_sweep(tmp_path, "run_chunk")
+    assert returncode == 130, stderr
+    assert stderr.count("\n") == 1 and stderr.startswith("impact1d-sweep: interrupted"), stderr
+
+
+@pytest.mark.parametrize("at", ["load_scene", "run_chunk"])
+def test_sweep_interrupted_before_its_runs_ends_without_pythons_flag(tmp_path, at):
+    """impact1d-sweep counts SIGINT from main()'s start (interrupt_epoch_now), not from the
+    sweep's, so an interrupt while it reads the scene, before any run, ends the runs even if
+    Python's KeyboardInterrupt never comes (here a handler of the program's own that does not
+    raise; before, the sweep ran all its runs and returned 0)."""
+    returncode, stderr = interrupted_sweep(tmp_path, at, quiet=True)
+    assert returncode == 130, stderr
+    assert stderr.count("\n") == 1 and stderr.startswith("impact1d-sweep: interrupted"), stderr
 
 
 def run_with_stdout(command, stdout, cwd=ROOT):

@@ -340,7 +340,8 @@ class _Progress:
 
 
 def sweep(scene: Scene, params, *, workers: Optional[int] = None, client=None,
-          progress: Optional[bool] = None, keep: Optional[str] = None, settle: Optional[float] = None):
+          progress: Optional[bool] = None, keep: Optional[str] = None, settle: Optional[float] = None,
+          _interrupt_epoch: Optional[int] = None):
     """Run `scene` over `params` and return a pandas DataFrame, one row per run in order.
 
     params: a dict field -> sequence (the Cartesian grid, the first field varying slowest)
@@ -351,7 +352,8 @@ def sweep(scene: Scene, params, *, workers: Optional[int] = None, client=None,
     settle=T: the table gains STEADY_COLUMNS, the steady state over [T, t_end] (peak-to-peak
     and RMS of each position and velocity, impacts per forcing period: steady_state). Each
     run's Result is measured and dropped (the batch path keeps no samples, so these runs
-    go one by one)."""
+    go one by one). (_interrupt_epoch: the caller's interrupt_epoch_now, taken earlier than
+    the sweep's start: impact1d-sweep's, from its main().)"""
     import pandas as pd
 
     if not isinstance(scene, Scene):
@@ -375,6 +377,8 @@ def sweep(scene: Scene, params, *, workers: Optional[int] = None, client=None,
     # checkpoint; with its own count it ran to its end, and the interpreter waited for it at
     # exit. (A Dask worker's process counts its own: its runs take theirs.)
     epoch = interrupt_epoch_now()
+    if _interrupt_epoch is not None:
+        epoch = _interrupt_epoch
     try:
         if client is not None:
             if keep_results:

@@ -23,6 +23,7 @@ import numpy as np
 from . import __version__
 from ._scene import InputError, load_scene
 from ._files import STANDARD_OUTPUT, Ended, die_of, ending_signals_raise, output_target, print_line, write_whole
+from ._simulate import interrupt_epoch_now
 from .sweep import sweep
 
 
@@ -73,7 +74,11 @@ def write_table(table, path: str) -> None:
 
 
 def main(argv=None) -> int:
-    state = {}
+    # SIGINT counted from here on (the core's count, src/impact1d_interrupt.c), and the runs
+    # ended by any interrupt since: one that comes while the scene is read, before the sweep
+    # begins, ends them even if Python's KeyboardInterrupt for it is lost on the way (a
+    # loaded machine once let one through: the sweep ran its 90 s and returned 0).
+    state = {"interrupt_epoch": interrupt_epoch_now()}
     try:
         with ending_signals_raise():
             return _main(argv, state)
@@ -122,7 +127,8 @@ def _main(argv, state) -> int:
         out = args.output or os.path.join("output", f"{stem}_sweep.csv")
         output_target(out)         # a FIFO or a folder there: refused before the runs
         scene = load_scene(args.scene)
-        table = sweep(scene, parse_vary(args.vary), workers=args.workers, settle=args.settle)
+        table = sweep(scene, parse_vary(args.vary), workers=args.workers, settle=args.settle,
+                      _interrupt_epoch=state["interrupt_epoch"])
     except InputError as error:
         print(f"impact1d-sweep: {error}", file=sys.stderr)
         return 1
