@@ -24,7 +24,7 @@ module impact1d_body_mode
   use impact1d_cluster_mode, only: cluster_work_type, cluster_reserve, cluster_mode, cluster_solved
   use impact1d_lcp, only: lcp_too_large
   use impact1d_path_mode, only: path_work_type, path_reserve, path_order, path_mode
-  use impact1d_friction_laws, only: slip, sliding_bound, belt_accelerations
+  use impact1d_friction_laws, only: slip, sliding_bound
   implicit none
   private
   public :: body_mode_type, mode_work_type, new_mode, solve_body_mode, same_mode, mode_solved
@@ -657,8 +657,7 @@ contains
 
   !> a(i) := w_d^(order)(t) of a body held to moving ground d (order 2: the accelerations
   !> after acceleration, whose group 0 is the still ground; order 3: their rate, after
-  !> rate_response), and of a stuck body on an accelerating belt its V^(order - 1)(t)
-  !> (impact1d_friction_laws' belt_accelerations). Called where scene%held_motion.
+  !> rate_response).
   pure subroutine drive_accelerations(scene, mode, t, order, a)
     type(scene_type), intent(in) :: scene
     type(body_mode_type), intent(in) :: mode
@@ -674,7 +673,6 @@ contains
         a(i) = scene%drives%jerk(mode%drive(i), t)
       end if
     end do
-    if (scene%belt_moves) call belt_accelerations(scene, mode%stuck, t, order, a)
   end subroutine drive_accelerations
 
   !> The forces f and their rate df as seen from the moving ground that the candidate rows

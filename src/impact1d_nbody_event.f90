@@ -15,7 +15,7 @@ module impact1d_nbody_event
     force_scale
   use impact1d_event_log, only: event_log_type, log_event
   use impact1d_event_point, only: bounce_series_time
-  use impact1d_friction_laws, only: slip, belt_speed, belt_moving, belt_rate, shift_to_belts
+  use impact1d_friction_laws, only: slip, belt_speed, belt_moving, belt_rate, shift_to_belts, belt_accelerations
   use impact1d_clusters, only: uf_join, uf_find, cluster_set_type, clusters_build
   use impact1d_accumulation, only: join_cycle
   use impact1d_cluster_impact, only: impact_work_type, impact_reserve, cluster_projection
@@ -1641,7 +1641,7 @@ contains
       else
         call new%rate_response(df, acc_rate)
       end if
-      if (scene%held_motion) call drive_accelerations(scene, new, s%t, 3, acc_rate)
+      if (scene%drives%n > 0) call drive_accelerations(scene, new, s%t, 3, acc_rate)
       ! (on an accelerating belt a body leaves or rests by its acceleration relative to it)
       if (scene%belt_moves) call relative_to_belts()
       tol_a = 1.0e3_wp * eps_wp * force_scale(scene, f, df) / scene%body_mass
@@ -1651,6 +1651,7 @@ contains
     !> acc and acc_rate relative to the accelerating belts (a stuck body's: 0).
     subroutine relative_to_belts()
       integer :: j
+      call belt_accelerations(scene, new%stuck, s%t, 3, acc_rate)
       do j = 1, scene%n_bodies
         if (.not. belt_moving(scene, j)) cycle
         acc(j) = acc(j) - belt_rate(scene, j, s%t, 2)

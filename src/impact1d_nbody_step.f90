@@ -14,7 +14,7 @@ module impact1d_nbody_step
   use impact1d_body_mode, only: body_mode_type, mode_work_type, solve_body_mode, same_mode, mode_solved, &
     drive_accelerations, shift_to_drives, relative_velocity
   use impact1d_friction_laws, only: slip, add_stribeck_forces, law_powers, contact_loss, belt_speed, belt_rate, &
-    belt_moving, belt_displacement, shift_to_belts
+    belt_moving, belt_displacement, shift_to_belts, belt_accelerations
   implicit none
   private
   public :: nbody_force, nbody_rate, nbody_step, row_gap, row_velocity, row_gap_tolerance, locate_nbody, &
@@ -51,6 +51,40 @@ module impact1d_nbody_step
     procedure :: holds => kept_holds
     procedure :: keep => keep_forces
   end type kept_forces_type
+
+  !> The belts of sine speed's work in the hot procedures, called through pointers (set
+  !> here, never assigned): inlined, or called directly, they changed what the compiler
+  !> inlined around them, and scenes without such a belt paid (callgrind, the CLI's run:
+  !> input/stick_slip.nml on the N-body engine +1.1%, drill_string.nml +1.3%; through the
+  !> pointers -0.4% and +0.6%).
+  abstract interface
+    pure subroutine belt_hold_if(scene, mode, a, step, b)
+      import :: scene_type, body_mode_type, state_type, wp
+      type(scene_type), intent(in) :: scene
+      type(body_mode_type), intent(in) :: mode
+      type(state_type), intent(in) :: a
+      real(wp), intent(in) :: step
+      type(state_type), intent(inout) :: b
+    end subroutine belt_hold_if
+    pure subroutine less_belt_if(scene, i, sgn, t, step, p, q)
+      import :: scene_type, wp
+      type(scene_type), intent(in) :: scene
+      integer, intent(in) :: i
+      real(wp), intent(in) :: sgn, t, step
+      real(wp), intent(inout) :: p(0:3), q(0:3)
+    end subroutine less_belt_if
+    pure subroutine belt_acc_if(scene, stuck, t, order, a)
+      import :: scene_type, wp
+      type(scene_type), intent(in) :: scene
+      logical, intent(in) :: stuck(:)
+      real(wp), intent(in) :: t
+      integer, intent(in) :: order
+      real(wp), intent(inout) :: a(:)
+    end subroutine belt_acc_if
+  end interface
+  procedure(belt_hold_if), pointer :: belt_hold => hold_to_belts
+  procedure(less_belt_if), pointer :: belt_less => less_belt
+  procedure(belt_acc_if), pointer :: belt_acc => belt_accelerations
 
 contains
 
@@ -122,8 +156,8 @@ contains
   end subroutine nbody_force
 
   !> Accelerations a in the mode under applied forces f at time t: a body held to a moving
-  !> ground moves with it, a stuck body with its accelerating belt (impact1d_body_mode's
-  !> drive_accelerations).
+  !> ground moves with it (impact1d_body_mode's drive_accelerations), a stuck body with its
+  !> accelerating belt (impact1d_friction_laws' belt_accelerations).
   pure subroutine mode_acceleration(scene, mode, t, f, a)
     type(scene_type), intent(in) :: scene
     type(body_mode_type), intent(in) :: mode
@@ -137,7 +171,8 @@ contains
       return
     end if
     call mode%acceleration(f, a)
-    if (scene%held_motion) call drive_accelerations(scene, mode, t, 2, a)
+    if (scene%drives%n > 0) call drive_accelerations(scene, mode, t, 2, a)
+    if (scene%belt_moves) call belt_acc(scene, mode%stuck, t, 2, a)
   end subroutine mode_acceleration
 
   !> mode_acceleration of a geared scene's groups (docs/method.md section 14; no moving
@@ -391,7 +426,7 @@ contains
       end associate
     end do
     ! (one test in nbody_step for both: a second cost the RK4 step of scenes without either)
-    if (scene%belt_moves) call hold_to_belts(scene, mode, a, step, b)
+    if (scene%belt_moves) call belt_hold(scene, mode, a, step, b)
   end subroutine hold_to_drives
 
   !> Stuck bodies on accelerating belts move with them exactly over the step from a to b (by
@@ -650,7 +685,7 @@ contains
       p = mode%sgn(i) * [slip(scene, i, c(1, i), a%t), 2.0_wp * c(2, i), 3.0_wp * c(3, i), 0.0_wp]
       q = [velocity_rounding * max(abs(a%v(i)), abs(b%v(i)), abs(b%v(i) - a%v(i))), 0.0_wp, 0.0_wp, 0.0_wp]
       if (.not. polynomial) q(1) = q(1) + abs(p(1) - mode%sgn(i) * acc0(i))
-      if (scene%belt_moves) call less_belt(scene, i, mode%sgn(i), a%t, step, p, q)
+      if (scene%belt_moves) call belt_less(scene, i, mode%sgn(i), a%t, step, p, q)
       candidate = earliest_crossing(p, step, q)
       if (candidate < theta) then
         theta = candidate

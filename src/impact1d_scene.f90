@@ -162,7 +162,8 @@ module impact1d_scene
     !> engine +0.7%, neither with a belt of sine speed)
     procedure(add_belt_sine), pointer, nopass :: belt_sine => add_belt_sine
     !> a body may be held to a moving ground or stuck on an accelerating belt (drives or
-    !> belt_moves): its acceleration is the motion's (impact1d_body_mode's drive_accelerations)
+    !> belt_moves): the RK4 step moves it with that motion (impact1d_nbody_step's
+    !> hold_to_drives, one test for both)
     logical :: held_motion = .false.
     real(wp), allocatable :: body_v_s(:)             !< (N) Stribeck velocity, m/s (0: none)
     real(wp), allocatable :: body_viscous(:)         !< (N) viscous friction c_v m g, N s/m

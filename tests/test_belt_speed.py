@@ -189,3 +189,23 @@ def test_cli_and_read_output_keep_the_belt_speed(tmp_path):
     assert back.events["t"][:2] == pytest.approx([float(t_b), float(t_s)], abs=1e-12)
     again = impact1d.simulate(back.scene)
     np.testing.assert_allclose(again.events["t"], back.events["t"], rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("dt", [1e-3, 0.05])
+def test_block_on_a_spring_breaks_away_where_the_stick_needs_static_friction(dt):
+    """(a)'s block tied to the ground by a spring k (rest at x = 0), stuck from t = 0: it rides
+    the belt, x = A t - (A / w) sin(w t), while the force the stick needs, m V'(t) + k x(t) =
+    m A w sin(w t) + k (A t - (A / w) sin(w t)), stays within mus m g; slip1 where it reaches
+    it (a root of a sine plus a line: mpmath.findroot at 50 digits), within 1e-15 s at both
+    steps (the mode crossing's bisection on the exact forces); the ledger closes."""
+    k = 40.0
+    scene = dataclasses.replace(block(0.5, 0.3, dt, t_end=0.3), k1=k, x1_rest=0.0)
+    result = impact1d.simulate(scene)
+    with mp.workdps(50):
+        w, a = 2 * mp.pi / mp.mpf(P), mp.mpf(A)
+        need = lambda t: (mp.mpf(M) * a * w * mp.sin(w * t) + mp.mpf(k) * (a * t - a / w * mp.sin(w * t))
+                          - mp.mpf("0.5") * mp.mpf(M) * mp.mpf(G))
+        t_b = mp.findroot(need, mp.mpf("0.06"))
+    assert result.events["kind"][0] == "slip1"
+    assert result.events["t"][0] == pytest.approx(float(t_b), abs=1e-15)
+    assert abs(result.energy_residual) < (1e-9 if dt < 0.01 else 1e-4)
