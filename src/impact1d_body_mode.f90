@@ -177,13 +177,13 @@ contains
   end function same_mode
 
   !> The mode at an instant: forces f and their rate df, velocities v, candidate rows (closed,
-  !> zero normal velocity); bodies with static friction and no slip (v = belt_v, 0 without a
-  !> belt: impact1d_friction_laws) are at rest. status: mode_solved, else the failing
-  !> cluster's LCP status (mode is then not a mode).
-  subroutine solve_body_mode(scene, work, f, df, v, candidate, mode, status)
+  !> zero normal velocity); bodies with static friction and no slip at time t (v = V(t),
+  !> their belt's speed, 0 without a belt: impact1d_friction_laws) are at rest. status:
+  !> mode_solved, else the failing cluster's LCP status (mode is then not a mode).
+  subroutine solve_body_mode(scene, work, f, df, v, t, candidate, mode, status)
     type(scene_type), intent(in) :: scene
     type(mode_work_type), intent(inout) :: work
-    real(wp), intent(in) :: f(:), df(:), v(:)
+    real(wp), intent(in) :: f(:), df(:), v(:), t
     logical, intent(in) :: candidate(:)
     type(body_mode_type), intent(inout) :: mode
     integer, intent(out) :: status
@@ -194,22 +194,22 @@ contains
       ! A body alone: stuck never (a body at rest is in a cluster of its own), sliding on its slip.
       mode%stuck(i) = .false.
       mode%sgn(i) = 0.0_wp
-      if (slip(scene, i, v(i)) /= 0.0_wp .and. scene%body_friction(i) > 0.0_wp) &
-        mode%sgn(i) = sign(1.0_wp, slip(scene, i, v(i)))
+      if (slip(scene, i, v(i), t) /= 0.0_wp .and. scene%body_friction(i) > 0.0_wp) &
+        mode%sgn(i) = sign(1.0_wp, slip(scene, i, v(i), t))
     end do
     if (scene%n_frictions > 0) call friction_directions(scene, work, v, mode)
-    call partition(scene, work, v, candidate)
+    call partition(scene, work, v, t, candidate)
     do c = 1, scene%n_bodies
       if (.not. work%needs_solve(c)) cycle
-      call solve_cluster(scene, work, c, f, df, v, mode, status)
+      call solve_cluster(scene, work, c, f, df, v, t, mode, status)
       if (status /= mode_solved) return
     end do
     ! A moving body with static friction but no sliding friction (mu = 0 < mus) has a
     ! direction too, as in the two-body engine (impact1d_event_point's moving_sign): its stop
     ! is watched, where static friction may hold it (its sliding force -0 sgn stays 0).
     do i = 1, scene%n_bodies
-      if (mode%sgn(i) == 0.0_wp .and. slip(scene, i, v(i)) /= 0.0_wp .and. scene%body_static(i) > 0.0_wp) &
-        mode%sgn(i) = sign(1.0_wp, slip(scene, i, v(i)))
+      if (mode%sgn(i) == 0.0_wp .and. slip(scene, i, v(i), t) /= 0.0_wp .and. scene%body_static(i) > 0.0_wp) &
+        mode%sgn(i) = sign(1.0_wp, slip(scene, i, v(i), t))
     end do
     call set_groups(scene, mode, work%root)
   end subroutine solve_body_mode
@@ -258,11 +258,11 @@ contains
   end function relative_velocity
 
   !> The clusters (module header): bodies joined by candidate rows between bodies, listed by
-  !> root (members in body order, rows in row order), and which need a solve.
-  subroutine partition(scene, work, v, candidate)
+  !> root (members in body order, rows in row order), and which need a solve (at time t).
+  subroutine partition(scene, work, v, t, candidate)
     type(scene_type), intent(in) :: scene
     type(mode_work_type), intent(inout) :: work
-    real(wp), intent(in) :: v(:)
+    real(wp), intent(in) :: v(:), t
     logical, intent(in) :: candidate(:)
     integer :: i, k, r, n
     logical :: joined
@@ -282,7 +282,7 @@ contains
       work%root(i) = uf_find(work%root, i)
       r = work%root(i)
       work%first(r + 1) = work%first(r + 1) + 1
-      if (scene%body_static(i) > 0.0_wp .and. slip(scene, i, v(i)) == 0.0_wp) work%needs_solve(r) = .true.
+      if (scene%body_static(i) > 0.0_wp .and. slip(scene, i, v(i), t) == 0.0_wp) work%needs_solve(r) = .true.
     end do
     do k = 1, scene%n_frictions
       if (resting_pair(scene, k, v)) work%needs_solve(work%root(scene%friction_body(1, k))) = .true.
@@ -317,12 +317,13 @@ contains
     end do
   end subroutine bucket
 
-  !> Cluster c (its root) gathered into a problem of its own, solved, and its mode scattered.
-  subroutine solve_cluster(scene, work, c, f, df, v, mode, status)
+  !> Cluster c (its root) gathered into a problem of its own at time t, solved, and its mode
+  !> scattered.
+  subroutine solve_cluster(scene, work, c, f, df, v, t, mode, status)
     type(scene_type), intent(in) :: scene
     type(mode_work_type), intent(inout) :: work
     integer, intent(in) :: c
-    real(wp), intent(in) :: f(:), df(:), v(:)
+    real(wp), intent(in) :: f(:), df(:), v(:), t
     type(body_mode_type), intent(inout) :: mode
     integer, intent(out) :: status
     integer :: nb, nr, j, i, k
@@ -337,9 +338,9 @@ contains
       work%force(j) = f(i)
       work%rate(j) = df(i)
       ! Friction acts on the slip (impact1d_friction_laws), with its bound there.
-      work%friction(j) = sliding_bound(scene, i, slip(scene, i, v(i)))
+      work%friction(j) = sliding_bound(scene, i, slip(scene, i, v(i), t))
       work%static(j) = scene%body_static(i)
-      work%velocity(j) = slip(scene, i, v(i))
+      work%velocity(j) = slip(scene, i, v(i), t)
     end do
     do j = 1, nr
       k = work%row(work%first_row(c) + j - 1)

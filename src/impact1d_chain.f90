@@ -18,7 +18,8 @@ module impact1d_chain
     a_d_max, a_r_max, a_k_link, a_d_rest, a_c_link, r_a, r_b, r_d_min, r_r_min, r_d_max, r_r_max, r_k, r_d_rest, &
     r_c, contact_fields, spring_fields, r_name, n_contact_fields, n_spring_fields, written_array, text_item, &
     a_f_table, mechanism_records, n_sine_fields, sine_fields, r_body, r_amp, r_period, r_phase, r_stop_k, r_stop_c, &
-    r_ground_v, r_spring_ground_v, n_ground_fields, a_belt_v, a_v_s, a_c_v, n_friction_fields, friction_fields, &
+    r_ground_v, r_spring_ground_v, n_ground_fields, a_belt_v, a_v_s, a_c_v, a_belt_amp, a_belt_period, a_belt_phase, &
+    n_friction_fields, friction_fields, &
     r_mu, r_mus, r_normal, r_friction_name, r_ratio, r_spring_ratio, r_ground_table, r_spring_ground_table
   implicit none
   private
@@ -43,7 +44,7 @@ module impact1d_chain
   integer, parameter :: alias_slots(2, n_arrays) = reshape([i_m1, i_m2, i_mu1, i_mu2, i_mus1, i_mus2, &
     i_x1, i_x2, i_v1, i_v2, i_f1, i_f2, i_f1_amp, i_f2_amp, i_f1_period, i_f2_period, i_f1_phase, i_f2_phase, &
     i_k1, i_k2, i_x1_rest, i_x2_rest, i_c1, i_c2, i_d_min, 0, i_r_min, 0, i_d_max, 0, i_r_max, 0, i_k12, 0, &
-    i_d_rest, 0, i_c12, 0, n_real + i_f1_table, n_real + i_f2_table, 0, 0, 0, 0, 0, 0], [2, n_arrays])
+    i_d_rest, 0, i_c12, 0, n_real + i_f1_table, n_real + i_f2_table, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0], [2, n_arrays])
 
   !> Arrays whose elements must not be negative.
   integer, parameter :: nonnegative_arrays(6) = [a_mu, a_mus, a_k, a_c, a_k_link, a_c_link]
@@ -255,7 +256,7 @@ contains
   pure function element_name(input, j, i) result(name)
     type(scene_input), intent(in) :: input
     integer, intent(in) :: j, i
-    character(len=16) :: name     ! blank padded: callers trim
+    character(len=24) :: name     ! blank padded: callers trim
     if (input%chain%n_bodies > 2) then
       write(name, '(a, "(", i0, ")")') trim(array_names(j)), i
     else
@@ -347,20 +348,21 @@ contains
     call check_link_arrays(input, n, error)
   end subroutine check_arrays
 
-  !> The friction laws' arrays (kept as arrays for any N: fold): belt_v finite, v_s positive,
-  !> c_v not negative (docs/formats.md, "Friction laws").
+  !> The friction laws' arrays (kept as arrays for any N: fold): belt_v, belt_amp,
+  !> belt_phase finite, v_s and belt_period positive, c_v not negative, a belt's sine whole
+  !> (docs/formats.md, "Friction laws").
   subroutine check_laws(input, error)
     type(scene_input), intent(in) :: input
     type(error_type), allocatable, intent(inout) :: error
     integer :: j, i
-    character(len=16) :: name
-    do j = a_belt_v, a_c_v
+    character(len=24) :: name
+    do j = a_belt_v, a_belt_phase
       do i = 1, input%chain%array(j)%n
         write(name, '(a, "(", i0, ")")') trim(array_names(j)), i
         associate (value => input%chain%array(j)%v(i))
           if (.not. ieee_is_finite(value)) then
             call raise(error, status_input, trim(name) // ' = ' // trim(fmt(value)) // ' is not a finite number')
-          else if (j == a_v_s) then
+          else if (j == a_v_s .or. j == a_belt_period) then
             call positive_value(trim(name), value, error)
           else if (j == a_c_v) then
             call nonnegative_value(trim(name), value, error)
@@ -369,6 +371,8 @@ contains
         if (allocated(error)) return
       end do
     end do
+    call together(input, a_belt_amp, a_belt_period, .true., 'a belt''s sine speed needs both', error)
+    call together(input, a_belt_phase, a_belt_amp, .false., 'a phase needs its sine', error)
   end subroutine check_laws
 
   !> Array j1 (say k) needs j2 (x_rest); and j2 needs j1 when both_ways.

@@ -11,6 +11,7 @@ module impact1d_fields
   public :: n_arrays, array_names, array_groups, array_aliases, array_is_link, array_is_text
   public :: a_m, a_mu, a_mus, a_x, a_v, a_f, a_f_amp, a_f_period, a_f_phase, a_k, a_x_rest, a_c
   public :: a_d_min, a_r_min, a_d_max, a_r_max, a_k_link, a_d_rest, a_c_link, a_f_table, a_belt_v, a_v_s, a_c_v
+  public :: a_belt_amp, a_belt_period, a_belt_phase
   public :: n_contact_fields, contact_fields, n_spring_fields, spring_fields, n_sine_fields, sine_fields
   public :: r_a, r_b, r_d_min, r_r_min, r_d_max, r_r_max, r_name, r_k, r_d_rest, r_c, r_stop_k, r_stop_c
   public :: r_body, r_amp, r_period, r_phase, r_ground_v, r_spring_ground_v, n_ground_fields
@@ -25,26 +26,29 @@ module impact1d_fields
   !> The arrays: body arrays hold N values (body i at i), link arrays N-1 (link i between
   !> bodies i and i+1). The alias is the tutorial's name of element i ('#' stands for i,
   !> i = 1, 2); one without '#' names element 1 only (the two-body link). The friction
-  !> laws' arrays (belt_v, v_s, c_v: DESIGN "Laws added on the records") have no tutorial
+  !> laws' arrays (belt_v, v_s, c_v: DESIGN "Laws added on the records"; belt_amp,
+  !> belt_period, belt_phase, the belt's speed belt_v + belt_amp sin(2 pi t / belt_period +
+  !> belt_phase): a design addition, named as the ground's motion is) have no tutorial
   !> name: they stay arrays for any N (impact1d_chain's fold keeps them).
-  integer, parameter :: n_arrays = 23
+  integer, parameter :: n_arrays = 26
   integer, parameter :: a_m = 1, a_mu = 2, a_mus = 3, a_x = 4, a_v = 5, a_f = 6, a_f_amp = 7, &
     a_f_period = 8, a_f_phase = 9, a_k = 10, a_x_rest = 11, a_c = 12, a_d_min = 13, a_r_min = 14, &
     a_d_max = 15, a_r_max = 16, a_k_link = 17, a_d_rest = 18, a_c_link = 19, a_f_table = 20, &
-    a_belt_v = 21, a_v_s = 22, a_c_v = 23
-  character(len=*), parameter :: array_names(n_arrays) = [character(len=8) :: &
+    a_belt_v = 21, a_v_s = 22, a_c_v = 23, a_belt_amp = 24, a_belt_period = 25, a_belt_phase = 26
+  character(len=*), parameter :: array_names(n_arrays) = [character(len=11) :: &
     'm', 'mu', 'mus', 'x', 'v', 'f', 'f_amp', 'f_period', 'f_phase', 'k', 'x_rest', 'c', &
-    'd_min', 'r_min', 'd_max', 'r_max', 'k_link', 'd_rest', 'c_link', 'f_table', 'belt_v', 'v_s', 'c_v']
+    'd_min', 'r_min', 'd_max', 'r_max', 'k_link', 'd_rest', 'c_link', 'f_table', 'belt_v', 'v_s', 'c_v', &
+    'belt_amp', 'belt_period', 'belt_phase']
   character(len=*), parameter :: array_groups(n_arrays) = [character(len=7) :: &
     'bodies', 'bodies', 'bodies', 'initial', 'initial', 'forces', 'forces', 'forces', 'forces', &
     'springs', 'springs', 'springs', 'link', 'link', 'link', 'link', 'springs', 'springs', 'springs', &
-    'forces', 'bodies', 'bodies', 'bodies']
+    'forces', 'bodies', 'bodies', 'bodies', 'bodies', 'bodies', 'bodies']
   character(len=*), parameter :: array_aliases(n_arrays) = [character(len=9) :: &
     'm#', 'mu#', 'mus#', 'x#', 'v#', 'f#', 'f#_amp', 'f#_period', 'f#_phase', 'k#', 'x#_rest', 'c#', &
-    'd_min', 'r_min', 'd_max', 'r_max', 'k12', 'd_rest', 'c12', 'f#_table', '', '', '']
+    'd_min', 'r_min', 'd_max', 'r_max', 'k12', 'd_rest', 'c12', 'f#_table', '', '', '', '', '', '']
   logical, parameter :: array_is_link(n_arrays) = [spread(.false., 1, 12), spread(.true., 1, 7), &
-    spread(.false., 1, 4)]
-  logical, parameter :: array_is_text(n_arrays) = [spread(.false., 1, 19), .true., spread(.false., 1, 3)]
+    spread(.false., 1, 7)]
+  logical, parameter :: array_is_text(n_arrays) = [spread(.false., 1, 19), .true., spread(.false., 1, 6)]
 
   !> The fields of a &contact record (on x_b - x_a; a, b body numbers, 0 the ground; k and
   !> c make it a compliant stop: past a limit it pushes back with max(0, k p + c p')) and of

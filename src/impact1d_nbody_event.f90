@@ -15,7 +15,7 @@ module impact1d_nbody_event
     force_scale
   use impact1d_event_log, only: event_log_type, log_event
   use impact1d_event_point, only: bounce_series_time
-  use impact1d_friction_laws, only: slip
+  use impact1d_friction_laws, only: slip, belt_speed, belt_moving, belt_rate, shift_to_belts, belt_accelerations
   use impact1d_clusters, only: uf_join, uf_find, cluster_set_type, clusters_build
   use impact1d_accumulation, only: join_cycle
   use impact1d_cluster_impact, only: impact_work_type, impact_reserve, cluster_projection
@@ -144,8 +144,8 @@ contains
     entry_scale = abs(s%v) + abs(acc) * scene%dt
     if (same_instant(scene, s%t, work%scale_time)) entry_scale = max(entry_scale, work%scale)
     do i = 1, scene%n_bodies
-      stopped(i) = scene%body_static(i) > 0.0_wp .and. slip(scene, i, s%v(i)) /= 0.0_wp .and. ((found == found_body &
-        .and. index == i) .or. abs(slip(scene, i, s%v(i))) <= velocity_rounding * abs(acc(i)) * scene%dt)
+      stopped(i) = scene%body_static(i) > 0.0_wp .and. slip(scene, i, s%v(i), s%t) /= 0.0_wp .and. ((found == &
+        found_body .and. index == i) .or. abs(slip(scene, i, s%v(i), s%t)) <= velocity_rounding * abs(acc(i)) * scene%dt)
       if (.not. initial) stopped(i) = stopped(i) .and. .not. rides_drive(scene, mode, i, s%t)
       if (stopped(i)) call zero_velocity(scene, s, i)
     end do
@@ -172,6 +172,8 @@ contains
     ! (solved in place: the old mode is not read past here but for its friction contacts'
     ! stuck flags, kept for the log; a failed solve ends the run)
     if (scene%n_frictions > 0 .and. .not. initial) pair_was_stuck = mode%friction_stuck
+    if (scene%belt_moves) call refuse_held_belts(scene, candidate, s, error)
+    if (allocated(error)) return
     ! (geared groups' scaled accelerations are set_groups' alone: no scoped shortcut)
     if (initial .or. .not. work%frictionless .or. scene%drives%n > 0 .or. scene%geared) then
       call solve_mode_at(scene, work%mode, s%t, f, df, s%v, candidate, mode, status)
@@ -251,7 +253,9 @@ contains
   end subroutine switch_stops
 
   !> solve_body_mode at time t: with moving grounds, on the forces as seen from the ground
-  !> the candidate rows hold each body to (impact1d_body_mode's shift_to_drives).
+  !> the candidate rows hold each body to (impact1d_body_mode's shift_to_drives); a body at
+  !> rest on an accelerating belt, as seen from its belt (impact1d_friction_laws'
+  !> shift_to_belts).
   subroutine solve_mode_at(scene, work, t, f, df, v, candidate, mode, status)
     type(scene_type), intent(in) :: scene
     type(mode_work_type), intent(inout) :: work
@@ -260,15 +264,41 @@ contains
     type(body_mode_type), intent(inout) :: mode
     integer, intent(out) :: status
     real(wp), dimension(scene%n_bodies) :: f_seen, df_seen
-    if (scene%drives%n == 0) then
-      call solve_body_mode(scene, work, f, df, v, candidate, mode, status)
+    if (scene%drives%n == 0 .and. .not. scene%belt_moves) then
+      call solve_body_mode(scene, work, f, df, v, t, candidate, mode, status)
       return
     end if
     f_seen = f
     df_seen = df
-    call shift_to_drives(scene, t, candidate, f_seen, df_seen)
-    call solve_body_mode(scene, work, f_seen, df_seen, v, candidate, mode, status)
+    if (scene%drives%n > 0) call shift_to_drives(scene, t, candidate, f_seen, df_seen)
+    if (scene%belt_moves) call shift_to_belts(scene, t, v, f_seen, df_seen)
+    call solve_body_mode(scene, work, f_seen, df_seen, v, t, candidate, mode, status)
   end subroutine solve_mode_at
+
+  !> A body at rest on a belt of sine speed (slip 0 at s%t) may not be an end of a candidate
+  !> row (closed, at rest): the mode solve takes such a body in its belt's frame alone
+  !> (shift_to_belts), and a row would join it to bodies or a wall in other frames, which the
+  !> cluster solves do not take yet: the run ends there, naming the body and the row.
+  subroutine refuse_held_belts(scene, candidate, s, error)
+    type(scene_type), intent(in) :: scene
+    logical, intent(in) :: candidate(:)
+    type(state_type), intent(in) :: s
+    type(error_type), allocatable, intent(inout) :: error
+    integer :: k, e, i
+    do k = 1, scene%n_rows
+      if (.not. candidate(k)) cycle
+      do e = 1, 2
+        i = scene%row_body(e, k)
+        if (i == 0) cycle
+        if (.not. belt_moving(scene, i)) cycle
+        if (slip(scene, i, s%v(i), s%t) /= 0.0_wp) cycle
+        call raise(error, status_simulation, 'at t = ' // trim(fmt(s%t)) // ': body ' // trim(fmt(i)) // &
+          ', at rest on its belt of sine speed (belt_amp), is held by the contact ' // trim(scene%row_name(k)) // &
+          ': a body on such a belt cannot stick while in contact yet (docs/method.md section 12)')
+        return
+      end do
+    end do
+  end subroutine refuse_held_belts
 
   !> The closed rows (the located one, gaps within rounding; at the start, within the
   !> rounding of the user's decimals), a rigid link's two rows together, each snapped onto
@@ -981,8 +1011,8 @@ contains
       if (scene%row_body(1, k) == 0) cycle
       if (abs(row_velocity(scene, k, s%v)) > u_tolerance(scene, k, s%v, acc, entry_scale)) cycle
       do e = 1, 2
-        if (s%v(scene%row_body(e, k)) == rest_velocity(scene, scene%row_body(e, k)) .and. &
-          rest_velocity(scene, scene%row_body(e, k)) == rest_velocity(scene, scene%row_body(3 - e, k))) &
+        if (s%v(scene%row_body(e, k)) == rest_velocity(scene, scene%row_body(e, k), s%t) .and. &
+          rest_velocity(scene, scene%row_body(e, k), s%t) == rest_velocity(scene, scene%row_body(3 - e, k), s%t)) &
           call zero_velocity(scene, s, scene%row_body(3 - e, k))
       end do
     end do
@@ -1131,7 +1161,7 @@ contains
       work%mode%member(1:nb) = body(:nb)
       work%mode%first_row(1:2) = [1, nr + 1]
       work%mode%row(1:nr) = rows(:nr)
-      call solve_cluster(scene, work%mode, 1, f, df, v, work%scratch, status)
+      call solve_cluster(scene, work%mode, 1, f, df, v, t, work%scratch, status)
       if (status /= mode_solved) return
     end if
     do j = 1, nb
@@ -1273,10 +1303,10 @@ contains
         work%mode%member(1:nb) = body(:nb)
         work%mode%first_row(1:2) = [1, nr + 1]
         work%mode%row(1:nr) = rows(:nr)
-        call solve_cluster(scene, work%mode, 1, f, df, v, mode, status)
+        call solve_cluster(scene, work%mode, 1, f, df, v, t, mode, status)
       end if
       if (.not. fits .or. status /= mode_solved) then
-        call solve_body_mode(scene, work%mode, f, df, v, candidate, mode, status)
+        call solve_body_mode(scene, work%mode, f, df, v, t, candidate, mode, status)
         work%mode_tracked = .false.
         return
       end if
@@ -1360,7 +1390,7 @@ contains
     logical :: zeroed(scene%n_bodies)
     integer :: i
     do i = 1, scene%n_bodies
-      zeroed(i) = s%v(i) /= rest_velocity(scene, i) .and. abs(s%v(i) - rest_velocity(scene, i)) <= &
+      zeroed(i) = s%v(i) /= rest_velocity(scene, i, s%t) .and. abs(s%v(i) - rest_velocity(scene, i, s%t)) <= &
         velocity_rounding * max(abs(acc(i)) * scene%dt, entry_scale(i)) .and. .not. rides_drive(scene, mode, i, s%t)
       if (zeroed(i)) call zero_velocity(scene, s, i)
     end do
@@ -1381,13 +1411,14 @@ contains
     if (mode%drive(i) > 0) rides_drive = scene%drives%acceleration(mode%drive(i), t) /= 0.0_wp
   end function rides_drive
 
-  !> The velocity at which body i rests: its belt's when it has one and friction to hold it
-  !> there (impact1d_friction_laws), else 0.
-  pure real(wp) function rest_velocity(scene, i)
+  !> The velocity at which body i rests at time t: its belt's when it has one and friction
+  !> to hold it there (impact1d_friction_laws), else 0.
+  pure real(wp) function rest_velocity(scene, i, t)
     type(scene_type), intent(in) :: scene
     integer, intent(in) :: i
+    real(wp), intent(in) :: t
     rest_velocity = 0.0_wp
-    if (scene%belts .and. scene%body_static(i) > 0.0_wp) rest_velocity = scene%body_belt(i)
+    if (scene%belts .and. scene%body_static(i) > 0.0_wp) rest_velocity = belt_speed(scene, i, t)
   end function rest_velocity
 
   !> Body i is at rest (rest_velocity); the rounding-level energy it had beyond that goes to
@@ -1398,13 +1429,13 @@ contains
     integer, intent(in) :: i
     if (scene%body_static(i) > 0.0_wp .and. scene%belts) then
       call add_compensated(s%friction_loss, s%friction_lo, 0.5_wp * scene%body_mass(i) * &
-        (s%v(i)**2 - rest_velocity(scene, i)**2))
+        (s%v(i)**2 - rest_velocity(scene, i, s%t)**2))
     else if (scene%body_static(i) > 0.0_wp) then
       call add_compensated(s%friction_loss, s%friction_lo, 0.5_wp * scene%body_mass(i) * s%v(i)**2)
     else
       s%impact_loss = s%impact_loss + 0.5_wp * scene%body_mass(i) * s%v(i)**2
     end if
-    s%v(i) = rest_velocity(scene, i)
+    s%v(i) = rest_velocity(scene, i, s%t)
     s%v_lo(i) = 0.0_wp
   end subroutine zero_velocity
 
@@ -1584,12 +1615,12 @@ contains
       if (direction == 0.0_wp) direction = sign(1.0_wp, merge(acc(i), acc_rate(i), acc(i) /= 0.0_wp))
       leaving = direction * acc(i) > tol_a(i) .or. (direction * acc(i) >= -tol_a(i) .and. &
         direction * acc_rate(i) > rate_tol / scene%body_mass(i))
-      resting_now = slip(scene, i, s%v(i)) == 0.0_wp .and. .not. leaving
+      resting_now = slip(scene, i, s%v(i), s%t) == 0.0_wp .and. .not. leaving
       if (resting_now .and. .not. event_log%at_rest(i) .and. .not. initial .and. &
           .not. same_instant(scene, s%t, event_log%rest_lost_time(i))) &
         call log_event(scene, sink, stats, s%t, class_stick, i, s%v, s%v)
       if (.not. resting_now .and. event_log%at_rest(i)) then
-        if (slip(scene, i, s%v(i)) == 0.0_wp) then
+        if (slip(scene, i, s%v(i), s%t) == 0.0_wp) then
           call log_event(scene, sink, stats, s%t, class_slip, i, s%v, s%v)
         else
           event_log%rest_lost_time(i) = s%t
@@ -1611,9 +1642,22 @@ contains
         call new%rate_response(df, acc_rate)
       end if
       if (scene%drives%n > 0) call drive_accelerations(scene, new, s%t, 3, acc_rate)
+      ! (on an accelerating belt a body leaves or rests by its acceleration relative to it)
+      if (scene%belt_moves) call relative_to_belts()
       tol_a = 1.0e3_wp * eps_wp * force_scale(scene, f, df) / scene%body_mass
       rate_tol = 1.0e3_wp * eps_wp * sum(abs(df))
     end subroutine prepare
+
+    !> acc and acc_rate relative to the accelerating belts (a stuck body's: 0).
+    subroutine relative_to_belts()
+      integer :: j
+      call belt_accelerations(scene, new%stuck, s%t, 3, acc_rate)
+      do j = 1, scene%n_bodies
+        if (.not. belt_moving(scene, j)) cycle
+        acc(j) = acc(j) - belt_rate(scene, j, s%t, 2)
+        acc_rate(j) = acc_rate(j) - belt_rate(scene, j, s%t, 3)
+      end do
+    end subroutine relative_to_belts
 
     !> Row j's gap acceleration (order 2) or its rate (3) at the bodies' a (with its moving
     !> ground end's).

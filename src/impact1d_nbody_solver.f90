@@ -17,7 +17,8 @@ module impact1d_nbody_solver
   use impact1d_elements, only: element_potential, stop_potential
   use impact1d_body_mode, only: body_mode_type, new_mode
   use impact1d_nbody_step, only: nbody_step, nbody_force, locate_nbody, refine_nbody, gaps_hold, row_gap, &
-    row_velocity, row_gap_tolerance, found_none, found_row, kept_forces_type, clock_to_stop
+    row_velocity, row_gap_tolerance, found_none, found_row, kept_forces_type, clock_to_stop, &
+    clock_to_belts
   use impact1d_nbody_event, only: point_work_type, new_point_work, nbody_event_point
   use impact1d_nbody_glide, only: glide_type, new_glide, find_quiet_time, glide
   implicit none
@@ -135,7 +136,7 @@ contains
     call new_glide(scene, r%glide)
     call r%event_log%allocate_log(scene%n_rows, scene%n_bodies)
     r%polynomial = scene%forcing%is_polynomial() .and. .not. scene%springs%present .and. scene%drives%polynomial &
-      .and. .not. scene%stribeck
+      .and. .not. scene%stribeck .and. .not. scene%belt_moves
     r%ke0 = 0.5_wp * dot_product(scene%body_mass, s%v**2)
     r%pe0 = potential(scene, s)
   end subroutine start
@@ -226,7 +227,11 @@ contains
     at_stop = found == found_none .and. h == (t_stop - s%t) - s%t_lo
     call take_state(s, trial)
     call r%kept%accept()
-    if (at_stop) call clock_to_stop(scene, r%mode, t_stop, s)
+    if (at_stop) then
+      ! (the stuck bodies on accelerating belts first: moved from the clock as it was)
+      if (scene%belt_moves) call clock_to_belts(scene, r%mode, t_stop, s)
+      call clock_to_stop(scene, r%mode, t_stop, s)
+    end if
     stats%steps = stats%steps + 1
     if (iand(stats%steps, 4095_int64) == 0) then
       call checkpoint(sink, stats, s%t, scene%t_end, error)

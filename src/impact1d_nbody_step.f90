@@ -13,11 +13,13 @@ module impact1d_nbody_step
     add_stop_forces, add_stop_rates, stop_damping_power, stop_release_loss, stop_drive_power
   use impact1d_body_mode, only: body_mode_type, mode_work_type, solve_body_mode, same_mode, mode_solved, &
     drive_accelerations, shift_to_drives, relative_velocity
-  use impact1d_friction_laws, only: slip, add_stribeck_forces, law_powers, contact_loss
+  use impact1d_friction_laws, only: slip, add_stribeck_forces, law_powers, contact_loss, belt_speed, belt_rate, &
+    belt_moving, belt_displacement, shift_to_belts, belt_accelerations
   implicit none
   private
   public :: nbody_force, nbody_rate, nbody_step, row_gap, row_velocity, row_gap_tolerance, locate_nbody, &
-    refine_nbody, gaps_hold, mode_acceleration, ground_motion, row_abs, mode_crossing, clock_to_stop
+    refine_nbody, gaps_hold, mode_acceleration, ground_motion, row_abs, mode_crossing, clock_to_stop, &
+    clock_to_belts
   public :: found_none, found_row, found_body, found_hold, found_stop, found_friction, stop_gap_band, stop_force_band
 
   !> What a location found: a row's gap closing (a compliant stop's too: its engagement), a
@@ -49,6 +51,40 @@ module impact1d_nbody_step
     procedure :: holds => kept_holds
     procedure :: keep => keep_forces
   end type kept_forces_type
+
+  !> The belts of sine speed's work in the hot procedures, called through pointers (set
+  !> here, never assigned): inlined, or called directly, they changed what the compiler
+  !> inlined around them, and scenes without such a belt paid (callgrind, the CLI's run:
+  !> input/stick_slip.nml on the N-body engine +1.1%, drill_string.nml +1.3%; through the
+  !> pointers -0.4% and +0.6%).
+  abstract interface
+    pure subroutine belt_hold_if(scene, mode, a, step, b)
+      import :: scene_type, body_mode_type, state_type, wp
+      type(scene_type), intent(in) :: scene
+      type(body_mode_type), intent(in) :: mode
+      type(state_type), intent(in) :: a
+      real(wp), intent(in) :: step
+      type(state_type), intent(inout) :: b
+    end subroutine belt_hold_if
+    pure subroutine less_belt_if(scene, i, sgn, t, step, p, q)
+      import :: scene_type, wp
+      type(scene_type), intent(in) :: scene
+      integer, intent(in) :: i
+      real(wp), intent(in) :: sgn, t, step
+      real(wp), intent(inout) :: p(0:3), q(0:3)
+    end subroutine less_belt_if
+    pure subroutine belt_acc_if(scene, stuck, t, order, a)
+      import :: scene_type, wp
+      type(scene_type), intent(in) :: scene
+      logical, intent(in) :: stuck(:)
+      real(wp), intent(in) :: t
+      integer, intent(in) :: order
+      real(wp), intent(inout) :: a(:)
+    end subroutine belt_acc_if
+  end interface
+  procedure(belt_hold_if), pointer :: belt_hold => hold_to_belts
+  procedure(less_belt_if), pointer :: belt_less => less_belt
+  procedure(belt_acc_if), pointer :: belt_acc => belt_accelerations
 
 contains
 
@@ -120,7 +156,8 @@ contains
   end subroutine nbody_force
 
   !> Accelerations a in the mode under applied forces f at time t: a body held to a moving
-  !> ground moves with it (impact1d_body_mode's drive_accelerations).
+  !> ground moves with it (impact1d_body_mode's drive_accelerations), a stuck body with its
+  !> accelerating belt (impact1d_friction_laws' belt_accelerations).
   pure subroutine mode_acceleration(scene, mode, t, f, a)
     type(scene_type), intent(in) :: scene
     type(body_mode_type), intent(in) :: mode
@@ -135,6 +172,7 @@ contains
     end if
     call mode%acceleration(f, a)
     if (scene%drives%n > 0) call drive_accelerations(scene, mode, t, 2, a)
+    if (scene%belt_moves) call belt_acc(scene, mode%stuck, t, 2, a)
   end subroutine mode_acceleration
 
   !> mode_acceleration of a geared scene's groups (docs/method.md section 14; no moving
@@ -201,13 +239,14 @@ contains
     real(wp), intent(in) :: t, v(:)
     real(wp), intent(inout) :: f(:)
     real(wp), intent(out) :: a(:)
-    if (scene%stribeck) call add_stribeck_forces(scene, mode%sgn, v, f)
+    if (scene%stribeck) call add_stribeck_forces(scene, mode%sgn, v, t, f)
     if (scene%geared) then
       call geared_acceleration(mode, f, a)
       return
     end if
     call mode%acceleration(f, a)
     if (scene%drives%n > 0) call drive_accelerations(scene, mode, t, 2, a)
+    if (scene%belt_moves) call belt_acc(scene, mode%stuck, t, 2, a)
   end subroutine law_acceleration
 
   !> One classical RK4 step of the mode's equations from a to b (the four stages in full: the
@@ -251,7 +290,7 @@ contains
     call add_compensated(b%t, b%t_lo, step)
     call add_compensated(b%x, b%x_lo, (step / 6.0_wp) * (kx1 + 2.0_wp * (kx2 + kx3) + kx4))
     call add_compensated(b%v, b%v_lo, (step / 6.0_wp) * (kv1 + 2.0_wp * (kv2 + kv3) + kv4))
-    if (scene%drives%n > 0) call hold_to_drives(scene, mode, a, step, b)
+    if (scene%held_motion) call hold_to_drives(scene, mode, a, step, b)
     v1 = b%v + b%v_lo
     f = f1
     kept%valid(3 - kept%now) = .false.
@@ -326,7 +365,7 @@ contains
       call law_acceleration(scene, mode, t, v, f, acc)
       drive_power = drive_power + held_drive_power(scene, mode, t, f, acc)
       if (scene%belts .or. scene%stribeck) call law_powers(scene, mode%f_slide, mode%sgn, mode%group, &
-        mode%drive, f, v, loss(k), belt(k))
+        mode%drive, f, v, t, loss(k), belt(k))
       if ((scene%belts .or. scene%stribeck) .and. scene%n_frictions > 0) &
         loss(k) = loss(k) + contact_loss(scene, mode%friction_sgn, v)
     end subroutine moving_stage
@@ -375,7 +414,8 @@ contains
   !> Bodies held to a moving ground move with it exactly over the step from a to b (by w(t +
   !> step) - w(t), at w'(t + step), a table's slope before a corner there): RK4's quadrature
   !> of w'' would leave their held rows' normal velocity off zero by its error, which the
-  !> event points would take for impacts.
+  !> event points would take for impacts. Stuck bodies on accelerating belts likewise
+  !> (hold_to_belts).
   pure subroutine hold_to_drives(scene, mode, a, step, b)
     type(scene_type), intent(in) :: scene
     type(body_mode_type), intent(in) :: mode
@@ -393,7 +433,33 @@ contains
         b%v_lo(i) = 0.0_wp
       end associate
     end do
+    ! (one test in nbody_step for both: a second cost the RK4 step of scenes without either)
+    if (scene%belt_moves) call belt_hold(scene, mode, a, step, b)
   end subroutine hold_to_drives
+
+  !> Stuck bodies on accelerating belts move with them exactly over the step from a to b (by
+  !> the belt's displacement, at V(b%t), the clock the event point reads their slip at):
+  !> RK4's quadrature of V' would leave them slipping by its error (hold_to_drives for a
+  !> moving ground). The part m V' of the belt's force on such a body does the work of its
+  !> kinetic energy, booked here exactly (law_powers books the rest, -(f + f_slide) V, by the
+  !> stages' quadrature; RK4's quadrature of m V' V was off by 4e-4 J over 2 s at w dt = 0.6).
+  pure subroutine hold_to_belts(scene, mode, a, step, b)
+    type(scene_type), intent(in) :: scene
+    type(body_mode_type), intent(in) :: mode
+    type(state_type), intent(in) :: a
+    real(wp), intent(in) :: step
+    type(state_type), intent(inout) :: b
+    integer :: i
+    do i = 1, scene%n_bodies
+      if (.not. (mode%stuck(i) .and. belt_moving(scene, i))) cycle
+      b%x(i) = a%x(i)
+      b%x_lo(i) = a%x_lo(i)
+      call add_compensated(b%x(i), b%x_lo(i), belt_displacement(scene, i, a%t, step))
+      b%v(i) = belt_speed(scene, i, b%t)
+      b%v_lo(i) = 0.0_wp
+      call add_compensated(b%drive_work, b%drive_lo, 0.5_wp * scene%body_mass(i) * (b%v(i)**2 - a%v(i)**2))
+    end do
+  end subroutine hold_to_belts
 
   !> The clock of s set to a stop t_stop a rounding away from t + t_lo (the run's step to a
   !> stop): the bodies held to moving grounds moved by the same rounding with them, or they
@@ -416,6 +482,28 @@ contains
     s%t = t_stop
     s%t_lo = 0.0_wp
   end subroutine clock_to_stop
+
+  !> clock_to_stop's move for the stuck bodies on accelerating belts (called before it, by
+  !> the run: apart, it costs the scenes without such belts nothing): by the belt's
+  !> displacement over the rounding, at V(t_stop) (the belt's work, as
+  !> hold_to_belts books it).
+  pure subroutine clock_to_belts(scene, mode, t_stop, s)
+    type(scene_type), intent(in) :: scene
+    type(body_mode_type), intent(in) :: mode
+    real(wp), intent(in) :: t_stop
+    type(state_type), intent(inout) :: s
+    real(wp) :: late
+    integer :: i
+    late = (t_stop - s%t) - s%t_lo
+    do i = 1, scene%n_bodies
+      if (.not. (mode%stuck(i) .and. belt_moving(scene, i))) cycle
+      call add_compensated(s%x(i), s%x_lo(i), belt_displacement(scene, i, s%t, late))
+      call add_compensated(s%drive_work, s%drive_lo, 0.5_wp * scene%body_mass(i) * &
+        (belt_speed(scene, i, t_stop)**2 - s%v(i)**2))
+      s%v(i) = belt_speed(scene, i, t_stop)
+      s%v_lo(i) = 0.0_wp
+    end do
+  end subroutine clock_to_belts
 
   !> x + x_lo moved by drive d's w(t + h) - w(t), its v h without rounding (a body held to a
   !> ground moving at constant speed stays on w as position_parts forms it at the clock).
@@ -558,7 +646,7 @@ contains
     else
       call nbody_force(scene, a%t, a%x, a%x_lo, a%v, f, mode%engaged)
     end if
-    if (scene%stribeck) call add_stribeck_forces(scene, mode%sgn, a%v, f)
+    if (scene%stribeck) call add_stribeck_forces(scene, mode%sgn, a%v, a%t, f)
     call mode_acceleration(scene, mode, a%t, f, acc0)
     acc_rounding = 1.0e3_wp * eps_wp * sum(abs(f)) / minval(scene%body_mass)
     do k = 1, scene%n_rows
@@ -592,8 +680,8 @@ contains
         ! (gaps_hold) it stops at once, for the event point to take the new direction.
         if (scene%drives%n == 0) cycle
         if (mode%drive(i) == 0) cycle
-        if (mode%sgn(i) * slip(scene, i, a%v(i)) < 0.0_wp .and. &
-          abs(slip(scene, i, a%v(i))) <= clock_band(scene, mode%drive(i), a%t)) then
+        if (mode%sgn(i) * slip(scene, i, a%v(i), a%t) < 0.0_wp .and. &
+          abs(slip(scene, i, a%v(i), a%t)) <= clock_band(scene, mode%drive(i), a%t)) then
           theta = 0.0_wp
           found = found_body
           index = i
@@ -602,9 +690,10 @@ contains
         cycle
       end if
       ! (the slip: velocity relative to the body's friction surface)
-      p = mode%sgn(i) * [slip(scene, i, c(1, i)), 2.0_wp * c(2, i), 3.0_wp * c(3, i), 0.0_wp]
+      p = mode%sgn(i) * [slip(scene, i, c(1, i), a%t), 2.0_wp * c(2, i), 3.0_wp * c(3, i), 0.0_wp]
       q = [velocity_rounding * max(abs(a%v(i)), abs(b%v(i)), abs(b%v(i) - a%v(i))), 0.0_wp, 0.0_wp, 0.0_wp]
       if (.not. polynomial) q(1) = q(1) + abs(p(1) - mode%sgn(i) * acc0(i))
+      if (scene%belt_moves) call belt_less(scene, i, mode%sgn(i), a%t, step, p, q)
       candidate = earliest_crossing(p, step, q)
       if (candidate < theta) then
         theta = candidate
@@ -615,9 +704,26 @@ contains
     if (scene%n_stops > 0) call locate_stops(scene, mode, a, c, step, acc0, acc_rounding, theta, found, index)
     if (scene%n_frictions > 0) call relative_stops(scene, mode, a, b, step, c, polynomial, acc0, theta, found, index)
     if (mode%held .and. (scene%forcing%varies .or. scene%springs%present .or. .not. scene%drives%polynomial &
-        .or. scene%stribeck)) &
+        .or. scene%stribeck .or. scene%belt_moves)) &
       call mode_crossing(scene, mode, work, a, c, min(theta, step), theta, found)
   end subroutine locate_nbody
+
+  !> The slip cubic p of body i (sliding direction sgn) over the step from t less its
+  !> accelerating belt's: the belt's speed on its own Hermite cubic (V and V' at the step's
+  !> ends), whose root refine_nbody polishes on the exact V (as a moving ground's gap); the
+  !> belt's slope's rounding beside the tolerance q(1) of p's.
+  pure subroutine less_belt(scene, i, sgn, t, step, p, q)
+    type(scene_type), intent(in) :: scene
+    integer, intent(in) :: i
+    real(wp), intent(in) :: sgn, t, step
+    real(wp), intent(inout) :: p(0:3), q(0:3)
+    real(wp) :: belt(3)
+    if (.not. belt_moving(scene, i)) return
+    belt = hermite(belt_speed(scene, i, t + step) - belt_speed(scene, i, t), belt_rate(scene, i, t, 2), &
+      belt_rate(scene, i, t + step, 2), step)
+    p(1:3) = p(1:3) - sgn * belt
+    q(1) = q(1) + abs(belt(1)) * velocity_rounding
+  end subroutine less_belt
 
   !> What the rounding of the clock at t moves drive d's velocity w' by.
   pure real(wp) function clock_band(scene, d, t) result(band)
@@ -806,23 +912,35 @@ contains
       where (mode%stuck) v = 0.0_wp
       if (scene%belts) then
         where (mode%stuck) v = scene%body_belt
+        if (scene%belt_moves) call stuck_on_belts(tau, v)
       end if
       if (scene%n_frictions > 0) call hold_pairs(scene, mode, v)
       call nbody_force(scene, a%t + tau, a%x, dx, v, f, mode%engaged)
       call nbody_rate(scene, a%t + tau, v, df, mode%engaged)
       if (scene%drives%n > 0) call shift_to_drives(scene, a%t + tau, mode%active, f, df)
+      if (scene%belt_moves) call shift_to_belts(scene, a%t + tau, v, f, df)
       probe = mode
-      call solve_body_mode(scene, work, f, df, v, mode%active, probe, status)
+      call solve_body_mode(scene, work, f, df, v, a%t + tau, mode%active, probe, status)
       holds_at = status == mode_solved
       if (holds_at .and. scene%stribeck) then
         ! begun weighs the probe's loads: on the bodies that slide in both modes they hold
         ! Stribeck's part of sliding friction, beyond f_slide's -F sgn (without it a group
         ! pushed by c(u) > F did not break a friction contact away at its bound)
         sliding = merge(probe%sgn, 0.0_wp, .not. mode%stuck)
-        call add_stribeck_forces(scene, sliding, v, f)
+        call add_stribeck_forces(scene, sliding, v, a%t + tau, f)
       end if
       if (holds_at) holds_at = same_mode(probe, mode) .or. .not. begun(probe, f)
     end function holds_at
+
+    !> v of the stuck bodies on accelerating belts: their belt's speed at a%t + tau.
+    subroutine stuck_on_belts(tau, v)
+      real(wp), intent(in) :: tau
+      real(wp), intent(inout) :: v(:)
+      integer :: i
+      do i = 1, scene%n_bodies
+        if (mode%stuck(i) .and. belt_moving(scene, i)) v(i) = belt_speed(scene, i, a%t + tau)
+      end do
+    end subroutine stuck_on_belts
 
     !> Whether the probe's motion has begun. The mode solve calls a force within rounding of
     !> its bound a tie and decides it by the rate, some 1e-12 s before the force reaches the
@@ -921,8 +1039,8 @@ contains
         call nbody_force(scene, b%t, b%x, b%x_lo, b%v, f, mode%engaged)
         call law_acceleration(scene, mode, b%t, b%v, f, acc)
         if (found == found_body) then
-          value = slip(scene, index, b%v(index))
-          slope = acc(index)
+          value = slip(scene, index, b%v(index), b%t)
+          slope = acc(index) - belt_rate(scene, index, b%t, 2)
           tol = velocity_rounding * max(abs(a%v(index)), abs(value))
         else
           ! a contact's stop: its ends' relative velocity v_b - v_a, rounded as relative_stops
@@ -969,7 +1087,7 @@ contains
     end do
     do i = 1, scene%n_bodies
       if (scene%body_static(i) == 0.0_wp .or. mode%sgn(i) == 0.0_wp) cycle
-      if (mode%sgn(i) * slip(scene, i, b%v(i)) < -velocity_rounding * max(abs(s%v(i)), abs(b%v(i)), &
+      if (mode%sgn(i) * slip(scene, i, b%v(i), b%t) < -velocity_rounding * max(abs(s%v(i)), abs(b%v(i)), &
           abs(b%v(i) - s%v(i))) - held_band(i)) gaps_hold = .false.
     end do
     do k = 1, scene%n_frictions

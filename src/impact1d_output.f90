@@ -881,7 +881,7 @@ contains
   end subroutine put_pair_event
 
   !> The number arrays of a scene in the header (of one or two bodies only the friction
-  !> laws': belt_v, v_s, c_v), a line each with its values ('# m = 1.0 2.0 5.0'), so that a
+  !> laws': belt_v, v_s, c_v, belt_amp, belt_period, belt_phase), a line each with its values ('# m = 1.0 2.0 5.0'), so that a
   !> reader rebuilds the scene (read_output);
   !> like the tutorial's table names, the force tables' names are not written.
   subroutine put_arrays(self, input)

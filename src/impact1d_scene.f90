@@ -12,7 +12,7 @@ module impact1d_scene
   use impact1d_drives, only: drive_type
   use impact1d_fields, only: chain_input, mechanism_records, r_k, r_c, r_stop_k, r_stop_c, r_ground_v, &
     r_spring_ground_v, r_ground_table, r_spring_ground_table, array_value, a_m, &
-    a_mu, a_mus, a_x, a_v, a_belt_v, a_v_s, a_c_v, &
+    a_mu, a_mus, a_x, a_v, a_belt_v, a_v_s, a_c_v, a_belt_amp, a_belt_period, a_belt_phase, &
     a_f, a_f_amp, a_f_period, a_f_phase, a_f_table
   use impact1d_stability, only: linear_modes, stable_step, mode_error, coarse_rate
   implicit none
@@ -152,6 +152,19 @@ module impact1d_scene
     logical :: belts = .false.                       !< some body names belt_v
     logical :: stribeck = .false.                    !< some body names v_s or c_v
     real(wp), allocatable :: body_belt(:)            !< (N) its friction surface's velocity, m/s
+    !> some body's belt has a sine speed (belt_amp /= 0): V_i(t) = body_belt_i + belt_amp_i
+    !> sin(belt_omega_i t + belt_phase_i), the three arrays allocated only then
+    logical :: belt_moves = .false.
+    real(wp), allocatable :: body_belt_amp(:), body_belt_omega(:), body_belt_phase(:)   !< (N) m/s, rad/s, rad
+    !> add_belt_sine, called through a pointer (impact1d_friction_laws' belt_speed): inlined,
+    !> its sine made the slip of every friction scene too big to inline where it was
+    !> (callgrind, the CLI's run: input/drill_string.nml +0.8%, stick_slip.nml on the N-body
+    !> engine +0.7%, neither with a belt of sine speed)
+    procedure(add_belt_sine), pointer, nopass :: belt_sine => add_belt_sine
+    !> a body may be held to a moving ground or stuck on an accelerating belt (drives or
+    !> belt_moves): the RK4 step moves it with that motion (impact1d_nbody_step's
+    !> hold_to_drives, one test for both)
+    logical :: held_motion = .false.
     real(wp), allocatable :: body_v_s(:)             !< (N) Stribeck velocity, m/s (0: none)
     real(wp), allocatable :: body_viscous(:)         !< (N) viscous friction c_v m g, N s/m
     ! friction contacts between two bodies (&friction records; docs/method.md section 13),
@@ -747,11 +760,14 @@ contains
     if (allocated(error)) return
     call set_rows(scene, error)
     if (allocated(error)) return
+    if (scene%belt_moves) call refuse_belt_contacts(scene, error)
+    if (allocated(error)) return
     call set_springs(scene, error)
     if (allocated(error)) return
     scene%stage_powers = scene%drives%n > 0 .or. scene%belts .or. scene%stribeck .or. scene%n_stops > 0 .or. &
       scene%geared
     scene%gap_terms = scene%drives%n > 0 .or. scene%geared
+    scene%held_motion = scene%drives%n > 0 .or. scene%belt_moves
 
     scene%t_end = input%value(i_t_end)
     scene%dt = input%value(i_dt)
@@ -784,21 +800,61 @@ contains
     integer :: i, n
     real(wp) :: g
     n = scene%n_bodies
-    scene%belts = input%chain%array(a_belt_v)%n > 0
+    scene%belts = input%chain%array(a_belt_v)%n > 0 .or. input%chain%array(a_belt_amp)%n > 0
     scene%stribeck = input%chain%array(a_v_s)%n > 0 .or. input%chain%array(a_c_v)%n > 0
     if (.not. (scene%belts .or. scene%stribeck)) return
     if (scene%method == 'vissim') then
       call raise(error, status_input, "method = 'vissim' is the tutorial's fixed-step scheme: a scene " // &
-        'with a moving friction surface (belt_v) or Stribeck friction (v_s, c_v) runs with method = ''event''')
+        'with a moving friction surface (belt_v, belt_amp) or Stribeck friction (v_s, c_v) runs with method = ''event''')
       return
     end if
     g = value_or(input, i_g, default_gravity)
     if (scene%belts) scene%body_belt = [(array_value(input%chain, a_belt_v, i, 0.0_wp) + 0.0_wp, i = 1, n)]
+    if (input%chain%array(a_belt_amp)%n > 0) then
+      scene%body_belt_amp = [(array_value(input%chain, a_belt_amp, i, 0.0_wp) + 0.0_wp, i = 1, n)]
+      scene%body_belt_phase = [(array_value(input%chain, a_belt_phase, i, 0.0_wp) + 0.0_wp, i = 1, n)]
+      scene%body_belt_omega = [(angular_frequency(array_value(input%chain, a_belt_period, i, 1.0_wp)), i = 1, n)]
+      ! (belt_amp = 0 everywhere is the constant belt: the same path, the same bits)
+      scene%belt_moves = any(scene%body_belt_amp /= 0.0_wp)
+    end if
     if (scene%stribeck) then
       scene%body_v_s = [(array_value(input%chain, a_v_s, i, 0.0_wp), i = 1, n)]
       scene%body_viscous = [(array_value(input%chain, a_c_v, i, 0.0_wp) * scene%body_mass(i) * g, i = 1, n)]
     end if
   end subroutine set_laws
+
+  !> speed plus body i's belt's sine at t, belt_amp sin(belt_omega t + belt_phase) (0 on a
+  !> belt of constant speed): scene_type's belt_sine.
+  pure real(wp) function add_belt_sine(scene, i, t, speed_in) result(speed)
+    type(scene_type), intent(in) :: scene
+    integer, intent(in) :: i
+    real(wp), intent(in) :: t
+    real(wp), value :: speed_in
+    speed = speed_in
+    if (scene%body_belt_amp(i) /= 0.0_wp) speed = speed + scene%body_belt_amp(i) * &
+      sin(scene%body_belt_omega(i) * t + scene%body_belt_phase(i))
+  end function add_belt_sine
+
+  !> A body on a belt of sine speed (belt_amp /= 0) may not be an end of a &friction record:
+  !> stuck, it accelerates with its own belt, which the mode solve takes body by body (a
+  !> cluster solve holds its bodies in one frame). (Its contacts are refused where one would
+  !> hold it at rest on its belt: impact1d_nbody_event's refuse_held_belts.)
+  subroutine refuse_belt_contacts(scene, error)
+    type(scene_type), intent(in) :: scene
+    type(error_type), allocatable, intent(inout) :: error
+    integer :: k, e, i
+    do k = 1, scene%n_frictions
+      do e = 1, 2
+        i = scene%friction_body(e, k)
+        if (scene%body_belt_amp(i) /= 0.0_wp) then
+          call raise(error, status_input, 'a body on a belt of sine speed (belt_amp) cannot have friction ' // &
+            'contacts yet, but body ' // trim(fmt(i)) // ' is an end of the &friction record ' // &
+            trim(scene%friction_name(k)) // ' (docs/method.md section 12)')
+          return
+        end if
+      end do
+    end do
+  end subroutine refuse_belt_contacts
 
   !> The &friction records (friction contacts between two bodies), which only the N-body
   !> engine runs (impact1d_solver's run): not the vissim method.
@@ -836,7 +892,7 @@ contains
     if (scene%method == 'vissim') what = "method = 'vissim' (the tutorial's scheme)"
     if (scene%drives%n > 0) what = 'a moving ground (ground_v, ground_amp, ground_table, x_left_v ...)'
     if (any(scene%body_static > 0.0_wp) .or. scene%n_frictions > 0) what = 'friction (mu, mus, &friction)'
-    if (scene%belts .or. scene%stribeck) what = 'belt_v, v_s or c_v'
+    if (scene%belts .or. scene%stribeck) what = 'belt_v, belt_amp, v_s or c_v'
     if (len(what) > 0) call raise(error, status_input, 'a gear ratio (ratio other than 1) cannot be ' // &
       'combined with ' // what // ' yet: geared scenes run on the N-body engine''s event method, ' // &
       'frictionless, on still grounds')
@@ -1058,6 +1114,7 @@ contains
     type(scene_input), intent(in) :: input
     integer :: r
     ground_named = any(input%given(i_x_left_v:i_x_right_v + 3)) .or. input%chain%array(a_belt_v)%n > 0 .or. &
+      input%chain%array(a_belt_amp)%n > 0 .or. &
       len_trim(input%text(i_x_left_table)%s) > 0 .or. len_trim(input%text(i_x_right_table)%s) > 0
     if (allocated(input%chain%contacts)) then
       do r = 1, size(input%chain%contacts)

@@ -57,10 +57,11 @@ TEXT_FIELDS = ("title", "f1_table", "f2_table", "method", "substeps", "events", 
 # the &contact, &spring, &sine and &friction records. Checked against _api.input_field_names() at import.
 ARRAY_FIELDS = ("m", "mu", "mus", "x", "v", "f", "f_amp", "f_period", "f_phase", "k", "x_rest", "c",
                 "d_min", "r_min", "d_max", "r_max", "k_link", "d_rest", "c_link", "f_table",
-                "belt_v", "v_s", "c_v")
-# The friction laws' arrays (DESIGN "Laws added on the records"): arrays for any N, with no
-# tutorial name; they go to the core with the records (record_fields).
-LAW_FIELDS = ("belt_v", "v_s", "c_v")
+                "belt_v", "v_s", "c_v", "belt_amp", "belt_period", "belt_phase")
+# The friction laws' arrays (DESIGN "Laws added on the records"; belt_amp, belt_period,
+# belt_phase, a belt's sine speed, are an addition named as the ground's motion is): arrays
+# for any N, with no tutorial name; they go to the core with the records (record_fields).
+LAW_FIELDS = ("belt_v", "v_s", "c_v", "belt_amp", "belt_period", "belt_phase")
 # A record with a ground end (a or b = 0) may move it: GROUND_FIELDS (DESIGN "Laws added");
 # ground_table is the path of a (t, w) table, read as a force table is.
 GROUND_FIELDS = ("ground_v", "ground_amp", "ground_period", "ground_phase", "ground_table")
@@ -183,6 +184,10 @@ class Scene:
     belt_v: Optional[Sequence[float]] = None  # each body's friction surface velocity (m/s; any N)
     v_s: Optional[Sequence[float]] = None     # Stribeck velocity (m/s): mu(u) = mu + (mus - mu) exp(-(u/v_s)^2) + c_v |u|
     c_v: Optional[Sequence[float]] = None     # viscous friction coefficient (s/m)
+    # a belt's sine speed: V(t) = belt_v + belt_amp sin(2 pi t / belt_period + belt_phase)
+    belt_amp: Optional[Sequence[float]] = None     # m/s
+    belt_period: Optional[Sequence[float]] = None  # s
+    belt_phase: Optional[Sequence[float]] = None   # rad
     r_meet: Optional[float] = None
     contacts: Optional[Sequence[dict]] = None
     springs: Optional[Sequence[dict]] = None
