@@ -515,14 +515,15 @@ contains
     is_nbody = input%chain%n_bodies > 2
   end function is_nbody
 
-  !> Whether the N-body engine runs the built scene (run's dispatch): more bodies than the
-  !> two-body kernels' lanes, a moving ground, or a friction law (belt_v, v_s, c_v). Only
-  !> the other scenes are held to the kernels' room (pair_rows, pair_elements). Known once
-  !> build_scene has set the laws and the records' drives.
+  !> Whether the N-body engine runs the built scene (run's dispatch): every scene of the
+  !> event method (one engine, issue 19); the vissim method's one- and two-body form steps on
+  !> the two-body kernels' view (scene%pair), which only its scenes are built with and held
+  !> to the kernels' room (pair_rows, pair_elements). Known once build_scene has set the
+  !> method, the laws and the records' drives.
   pure logical function runs_nbody(scene)
     type(scene_type), intent(in) :: scene
     runs_nbody = scene%n_bodies > max_lanes .or. scene%drives%n > 0 .or. scene%belts .or. scene%stribeck .or. &
-      scene%n_frictions > 0 .or. scene%geared
+      scene%n_frictions > 0 .or. scene%geared .or. scene%method /= 'vissim'
   end function runs_nbody
 
   !> What the event log of a run of this input keeps (&run events; all by default).
