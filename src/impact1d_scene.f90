@@ -516,10 +516,10 @@ contains
   end function is_nbody
 
   !> Whether the N-body engine runs the built scene (run's dispatch): every scene of the
-  !> event method (one engine, issue 19); the vissim method's one- and two-body form steps on
-  !> the two-body kernels' view (scene%pair), which only its scenes are built with and held
-  !> to the kernels' room (pair_rows, pair_elements). Known once build_scene has set the
-  !> method, the laws and the records' drives.
+  !> event method (one engine, issue 19). The vissim method's scenes of one or two bodies,
+  !> which it runs on N-long arrays too, are still built with the two-body kernels' view
+  !> (scene%pair) and held to their room (pair_rows, pair_elements) until the kernels go.
+  !> Known once build_scene has set the method, the laws and the records' drives.
   pure logical function runs_nbody(scene)
     type(scene_type), intent(in) :: scene
     runs_nbody = scene%n_bodies > max_lanes .or. scene%drives%n > 0 .or. scene%belts .or. scene%stribeck .or. &
