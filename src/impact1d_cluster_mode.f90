@@ -14,7 +14,8 @@
 !>
 !> What it guarantees (status = cluster_solved):
 !> - The mode that holds just AFTER the instant: ties (a holding force exactly at its
-!>   bound, a contact force exactly 0) are decided by the rate dy (as the two-body engine's mode solve did).
+!>   bound, a contact force exactly 0) are decided by the rate dy (as the two-body engine's
+!>   mode solve did).
 !> - Static above sliding (METHOD 8), stick preferred: the problem is solved with beta = s
 !>   for every body at rest; bodies it moves break away and are solved again with beta = c
 !>   (their F = -c sgn a), until no more break away (at most n + 1 solves).
@@ -324,7 +325,7 @@ contains
         if (abs(mass(i) * acceleration(i)) <= tol_f) sgn(i) = sign(1.0_wp, work%da(i))
       else if (work%broken(i) .and. .not. still(mass(i), acceleration(i), work%da(i), tol_f, tol_rate)) then
         ! Broken away with no sliding friction (mu = 0 < mus): the way it leaves, as once it
-        ! moves (and as the two-body engine's modes give it), so that its stop is watched and
+        ! moves (as the two-body engine's modes gave it), so that its stop is watched and
         ! the mode just after the instant is this one, not one whose direction differs.
         sgn(i) = sign(1.0_wp, acceleration(i))
         if (abs(mass(i) * acceleration(i)) <= tol_f) sgn(i) = sign(1.0_wp, work%da(i))

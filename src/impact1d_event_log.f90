@@ -4,7 +4,7 @@
 !> opened).
 module impact1d_event_log
   use impact1d_kinds, only: wp
-  use impact1d_scene, only: scene_type
+  use impact1d_scene, only: scene_type, tutorial_bodies
   use impact1d_output, only: sink_type, run_stats, class_rest, class_release, class_stick, class_slip, count_event, &
     class_pair_stick
   use impact1d_yardsticks, only: same_instant
@@ -68,7 +68,7 @@ contains
     integer :: ends(2)
     call count_event(stats, class, index)
     v = 0.0_wp
-    if (scene%n_bodies > 2) then
+    if (scene%n_bodies > tutorial_bodies) then
       ! N bodies: the event's own pair, the row's ends or (body, 0).
       ends = [index, 0]
       if (class /= class_stick .and. class /= class_slip) ends = scene%row_body(:, index)

@@ -7,7 +7,7 @@
 module impact1d_nbody_event
   use impact1d_kinds, only: wp, eps_wp
   use impact1d_error, only: error_type, raise, status_simulation, fmt
-  use impact1d_scene, only: scene_type
+  use impact1d_scene, only: scene_type, tutorial_bodies
   use impact1d_state, only: state_type, add_compensated, product_error
   use impact1d_output, only: sink_type, run_stats, class_impact, class_rest, class_stick, class_slip, class_release, &
     class_pair_stick, class_pair_slip
@@ -193,13 +193,13 @@ contains
     if (scene%n_frictions > 0 .and. .not. initial) call log_pairs(scene, pair_was_stuck, mode, s, sink, stats)
   end subroutine nbody_event_point
 
-  !> The compliant stops at this instant (docs/method.md section 10): an open stop whose gap has closed (located, or
-  !> within its rounding) engages when its ends approach, logged as an impact on its row (no
-  !> velocity changes); an engaged one releases when its force F = -(k gap + c gap') has
-  !> fallen to zero (located, or within rounding), logged as release_<row>; one released
-  !> inside (gap < 0) engages again when F has risen to zero. acc: the accelerations in the
-  !> mode so far (a stop at its limit with its ends at rest relative to each other engages
-  !> when they accelerate into it).
+  !> The compliant stops at this instant (docs/method.md section 10): an open stop whose gap
+  !> has closed (located, or within its rounding) engages when its ends approach, logged as
+  !> an impact on its row (no velocity changes); an engaged one releases when its force
+  !> F = -(k gap + c gap') has fallen to zero (located, or within rounding), logged as
+  !> release_<row>; one released inside (gap < 0) engages again when F has risen to zero.
+  !> acc: the accelerations in the mode so far (a stop at its limit with its ends at rest
+  !> relative to each other engages when they accelerate into it).
   subroutine switch_stops(scene, found, index, s, acc, engaged, sink, stats)
     type(scene_type), intent(in) :: scene
     integer, intent(in) :: found, index
@@ -426,7 +426,7 @@ contains
   !> groups (work%rigid, 0 the ground for a link to it) and their masses; each group moves
   !> with its centre of mass (a relative velocity the link cannot have is absorbed, as by a
   !> plastic impact, booked as impact loss and logged as an impact of the link's row that
-  !> approached, as the two-body engine and tests/exact_nbody.py log it). stopped: the
+  !> approached, as tests/exact_nbody.py logs it). stopped: the
   !> bodies friction has just stopped (their rounding-level speed zeroed); the groups they
   !> move with stop with them, silently: the speed the others kept was that rounding.
   subroutine lock_rigid(scene, closed, stopped, s, work, sink, stats)
@@ -1654,7 +1654,7 @@ contains
       real(wp), intent(in) :: v(:)
       real(wp) :: pair(2)
       pair = 0.0_wp
-      if (scene%n_bodies <= 2) then
+      if (scene%n_bodies <= tutorial_bodies) then
         pair(:scene%n_bodies) = v
         return
       end if

@@ -28,7 +28,7 @@ module impact1d_nbody_glide
   !> How far from its limit (in multiples of its rounding) a gap or a sliding velocity must
   !> stay for the location to find nothing there, whatever the steps' rounding did to the
   !> exact quadratic (a few eps of the distance travelled); the quiet time is then taken 1%
-  !> short of that, as the two-body engine's find_quiet_times does.
+  !> short of that, as the two-body engine's find_quiet_times did.
   real(wp), parameter :: band_factor = 1.0e3_wp, quiet_fraction = 0.99_wp
 
   !> What the glide needs of the scene (once a run) and of the current mode (at each event

@@ -7,6 +7,7 @@ module impact1d_output
   use impact1d_kinds, only: wp
   use impact1d_error, only: error_type, raise, status_input, status_simulation, status_interrupted, fmt, fmt_width
   use impact1d_interrupt, only: interrupt_count
+  use impact1d_scene, only: tutorial_bodies
   use impact1d_scene, only: scene_input, real_names, n_real, i_title, i_method, i_g, i_dt_out, i_x_left_table, &
     i_x_right_table, &
     events_all, events_impacts, events_none, events_kept, name_len, &
@@ -313,7 +314,7 @@ contains
   !> Where the ledger starts in the full row: ke is at row_ledger + 1, residual at + 8.
   pure integer function row_ledger(n_bodies)
     integer, intent(in) :: n_bodies
-    row_ledger = 2 * max(n_bodies, 2) + 1
+    row_ledger = 2 * max(n_bodies, tutorial_bodies) + 1
   end function row_ledger
 
   !> The columns a run writes, as indices into its full row: t; x and v of the bodies named
@@ -607,7 +608,7 @@ contains
     integer, intent(in) :: class, index, a, b
     ! With one or two bodies the pair is every body; with more an event does not say whether
     ! the others move: the samples alone decide (rest_time to the sample).
-    if (self%n_bodies > 2) return
+    if (self%n_bodies > tutorial_bodies) return
     if (any(v(3:4) /= 0.0_wp)) then
       self%rest_event = huge(1.0_wp)
       self%rest_sample = huge(1.0_wp)
@@ -767,12 +768,12 @@ contains
     ! laws', which have no such names: impact1d_chain's fold)
     call put_arrays(self, input)
     call put_records(self, input)
-    if (self%n_bodies > 2) call self%put_line(self%unit, '# bodies = ' // trim(fmt(self%n_bodies)))
+    if (self%n_bodies > tutorial_bodies) call self%put_line(self%unit, '# bodies = ' // trim(fmt(self%n_bodies)))
     call names_of(self%columns, self%n_bodies, header)
     call self%put_line(self%unit, '#' // header)
     if (self%events == events_none) return
     call self%put_line(self%event_unit, '# impact1d events')
-    if (self%n_bodies > 2) then
+    if (self%n_bodies > tutorial_bodies) then
       call self%put_line(self%event_unit, '# t kind a b va_before vb_before va_after vb_after')
     else if (self%n_bodies == 2) then
       call self%put_line(self%event_unit, '# t kind v1_before v2_before v1_after v2_after')
@@ -807,7 +808,7 @@ contains
     if (.not. self%logs_event(class)) return
     ! One or two bodies: the pair is (1, 2), or (1, 0) with one body, whose line has v1 only;
     ! more: the pair's ends, named (a line of its own length, counted as written).
-    if (self%n_bodies > 2) then
+    if (self%n_bodies > tutorial_bodies) then
       call put_pair_event(self, t, event_name(self%row_names, class, index), a, b, v)
       return
     else if (self%n_bodies == 2) then

@@ -26,7 +26,13 @@ module impact1d_scene
   public :: i_title, i_f1_table, i_f2_table, i_method, i_substeps, i_events, default_gravity
   public :: events_all, events_impacts, events_none
   public :: name_len, set_rows, allocate_contacts, set_springs, springs_named, springs_type
+  public :: tutorial_bodies
 
+  !> The tutorial's bodies: a scene of at most this many is written with its scalars (m1,
+  !> x2, k12, ...), and its output keeps their layout (the columns x2 v2, and events that
+  !> report both bodies whatever the event). A format's number, not the engine's: the engine
+  !> runs any N alike.
+  integer, parameter :: tutorial_bodies = 2
   integer, parameter :: n_real = 52, n_text = 8
   !> Names of the real inputs, as in the namelist and in Python's Scene, in this order.
   character(len=*), parameter :: real_names(n_real) = [character(len=15) :: &
@@ -259,7 +265,7 @@ contains
         return
       end if
     end do
-    if (input%chain%n_bodies > 2) then
+    if (input%chain%n_bodies > tutorial_bodies) then
       ! The bodies and links are impact1d_chain's to check (validate_chain), as are the
       ! records of any scene.
       if (require_run) call require(input, [i_t_end, i_dt], error)
@@ -513,7 +519,7 @@ contains
   !> tutorial's scalars, one or two bodies: read, checked and built from those).
   pure logical function is_nbody(input)
     type(scene_input), intent(in) :: input
-    is_nbody = input%chain%n_bodies > 2
+    is_nbody = input%chain%n_bodies > tutorial_bodies
   end function is_nbody
 
   !> What the event log of a run of this input keeps (&run events; all by default).
