@@ -1,7 +1,6 @@
 !> The contact and friction mode of N bodies (docs/method.md section 9): which rows are held
 !> closed, which bodies stick, which way sliding friction acts, and the accelerations within
-!> the mode. The N-body engine's counterpart of impact1d_modes (whose kernel enumerates the
-!> modes of two bodies).
+!> the mode, for any N (the two-body engine's enumeration of two bodies' modes is gone).
 !>
 !> At an event point the bodies fall into clusters joined by candidate rows (closed, zero
 !> normal velocity) between bodies; each cluster with a candidate row or a body at rest with

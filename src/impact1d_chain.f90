@@ -6,6 +6,7 @@ module impact1d_chain
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_value, ieee_quiet_nan
   use impact1d_kinds, only: wp, eps_wp
   use impact1d_error, only: error_type, raise, status_input, fmt, fmt_width
+  use impact1d_scene, only: tutorial_bodies
   use impact1d_scene, only: scene_input, real_names, text_names, n_real, n_text, set_text, name_of, value_or, &
     positive_value, nonnegative_value, unit_interval, resolvable, unresolved, i_m1, i_m2, i_x_left, i_r_left, i_x_right, &
     i_r_right, i_r_min, i_d_min, i_g, default_gravity, i_mu1, i_mu2, i_mus1, i_mus2, i_x1, i_x2, i_v1, i_v2, i_f1, i_f2, &
@@ -64,7 +65,7 @@ contains
       call check_length(input, j, n, error)
       if (allocated(error)) return
     end do
-    if (n > 2) then
+    if (n > tutorial_bodies) then
       call refuse_two_body_names(input, n, error)
       input%chain%n_bodies = n
       return
@@ -211,7 +212,7 @@ contains
   pure integer function n_bodies_of(input)
     type(scene_input), intent(in) :: input
     n_bodies_of = merge(2, 1, input%given(i_m2))
-    if (input%chain%n_bodies > 2) n_bodies_of = input%chain%n_bodies
+    if (input%chain%n_bodies > tutorial_bodies) n_bodies_of = input%chain%n_bodies
   end function n_bodies_of
 
   !> Element i of array j as the scene gives it (given false: absent, value 0).
@@ -223,7 +224,7 @@ contains
     integer :: slot
     value = 0.0_wp
     given = .false.
-    if (input%chain%n_bodies > 2) then
+    if (input%chain%n_bodies > tutorial_bodies) then
       given = input%chain%array(j)%n >= i
       value = array_value(input%chain, j, i, 0.0_wp)
     else
@@ -257,7 +258,7 @@ contains
     type(scene_input), intent(in) :: input
     integer, intent(in) :: j, i
     character(len=24) :: name     ! blank padded: callers trim
-    if (input%chain%n_bodies > 2) then
+    if (input%chain%n_bodies > tutorial_bodies) then
       write(name, '(a, "(", i0, ")")') trim(array_names(j)), i
     else
       name = name_of(input, alias_slot(j, i))
@@ -286,7 +287,7 @@ contains
     type(scene_input), intent(in) :: input
     type(mechanism_records), intent(out) :: records
     type(error_type), allocatable, intent(out) :: error
-    if (input%chain%n_bodies > 2) call check_arrays(input, error)
+    if (input%chain%n_bodies > tutorial_bodies) call check_arrays(input, error)
     if (allocated(error)) return
     call check_laws(input, error)
     if (allocated(error)) return
@@ -989,7 +990,7 @@ contains
     integer :: i, first
     do i = 1, n - 1
       name = 'slot'
-      if (n > 2) write(name, '("link", i0)') i
+      if (n > tutorial_bodies) write(name, '("link", i0)') i
       first = records%n_contacts + 1
       if (has_element(input, a_d_min, i)) then
         call add_contact(records, name, i, i + 1, 1, element_or(input, a_d_min, i, 0.0_wp), &

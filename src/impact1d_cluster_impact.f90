@@ -4,12 +4,12 @@
 !>     min 1/2 (w - v).M (w - v)  subject to  n_k . w >= 0,
 !> whose optimality conditions are the LCP in the impulses P_k >= 0:
 !>     n_k . w = n_k . v + sum_l (n_k M^-1 n_l) P_l >= 0,  P_k (n_k . w) = 0,  w = v + M^-1 N^T P,
-!> solved by impact1d_lcp. Kernel in place: the engine keeps impact1d_impacts'
-!> inelastic_projection for its units of <= 2 bodies and is wired to this in stage 5.
+!> solved by impact1d_lcp. Called by the N-body event point for a closed group of plastic
+!> rows (impact1d_path_impact first, where the rows form a path).
 !>
 !> What it guarantees (status = lcp_solved):
 !> - Nothing changes unless some closed row approaches faster than its rounding level tol_k
-!>   (as impact1d_impacts does).
+!>   (as the two-body engine's impacts did).
 !> - w is the projection to rounding; the kinetic energy does not grow (an M-projection onto a
 !>   convex cone containing 0).
 !> - Exactness: bodies joined by pushed rows that are walls or of the form (-1, 1), (1, -1)

@@ -1,7 +1,6 @@
 !> The mode solve of one cluster of n bodies (issue 19, stage 4; docs/method.md, "N bodies:
 !> the cluster's mode solve"): which closed rows are held, which bodies at rest stick, the
-!> accelerations. Kernel in place; the engine still uses impact1d_modes for its units of
-!> <= 2 bodies (docs/nbody-plan.md, B7) and is wired to this in stage 4.
+!> accelerations. Called per cluster by impact1d_body_mode (impact1d_path_mode for a path).
 !>
 !> The problem at one instant. Bodies i = 1..n: mass m_i, applied force y_i (external and
 !> elastic) with its right derivative dy_i, sliding bound c_i, static bound s_i >= c_i,
@@ -15,7 +14,8 @@
 !>
 !> What it guarantees (status = cluster_solved):
 !> - The mode that holds just AFTER the instant: ties (a holding force exactly at its
-!>   bound, a contact force exactly 0) are decided by the rate dy, as impact1d_modes does.
+!>   bound, a contact force exactly 0) are decided by the rate dy (as the two-body engine's
+!>   mode solve did).
 !> - Static above sliding (METHOD 8), stick preferred: the problem is solved with beta = s
 !>   for every body at rest; bodies it moves break away and are solved again with beta = c
 !>   (their F = -c sgn a), until no more break away (at most n + 1 solves).
@@ -24,8 +24,8 @@
 !>   ground or to a stuck body, else their mass-weighted mean (closed gaps do not creep).
 !> - Active (held) rows: the closed rows carrying force, then, in row order, the closed
 !>   force-free rows whose ends are not yet joined (the ground and stuck bodies counting as
-!>   joined) - the choice of tests/exact_nbody.py and, where the set is unique, of
-!>   impact1d_modes.
+!>   joined) - the choice of tests/exact_nbody.py and, where the set is unique, of the
+!>   two-body engine's enumerator (since removed).
 !> - No allocation: the caller sizes a cluster_work_type once (cluster_reserve).
 module impact1d_cluster_mode
   use impact1d_kinds, only: wp, eps_wp
@@ -38,7 +38,7 @@ module impact1d_cluster_mode
 
   integer, parameter :: cluster_solved = 0    !< otherwise an impact1d_lcp status
 
-  !> Relative size of a zero force (as impact1d_modes' tolerance).
+  !> Relative size of a zero force (as the two-body engine's mode solve's tolerance was).
   real(wp), parameter :: rel_tol = 1.0e3_wp * eps_wp
 
   !> The mode solve's memory, owned by the caller and sized once (cluster_reserve).
@@ -325,7 +325,7 @@ contains
         if (abs(mass(i) * acceleration(i)) <= tol_f) sgn(i) = sign(1.0_wp, work%da(i))
       else if (work%broken(i) .and. .not. still(mass(i), acceleration(i), work%da(i), tol_f, tol_rate)) then
         ! Broken away with no sliding friction (mu = 0 < mus): the way it leaves, as once it
-        ! moves (and as the two-body engine's modes give it), so that its stop is watched and
+        ! moves (as the two-body engine's modes gave it), so that its stop is watched and
         ! the mode just after the instant is this one, not one whose direction differs.
         sgn(i) = sign(1.0_wp, acceleration(i))
         if (abs(mass(i) * acceleration(i)) <= tol_f) sgn(i) = sign(1.0_wp, work%da(i))

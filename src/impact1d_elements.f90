@@ -1,7 +1,7 @@
 !> Springs and dampers of an N-body scene (docs/method.md, "Springs and dampers"), read from
 !> the model's element records (scene_type's element_*): element j pulls its ends a, b (0 the
 !> ground, at x = 0) together with tension k ((x_b - x_a) - rest) + c (v_b - v_a). The
-!> N-body engine's counterpart of impact1d_springs (the two-body kernels' lanes): here the
+!> engine's only springs (the two-body kernels' lanes, impact1d_springs, are gone): the
 !> ends are looked up by index, so a chain's cost is its number of elements, not N^2.
 !> An element whose ground end moves (scene%element_drive) acts on x_b - w(t) and v_b - w'(t)
 !> when the time t is passed (every N-body engine call passes it when the scene has drives).

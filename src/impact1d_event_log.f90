@@ -1,11 +1,10 @@
 !> What the event log has said and still owes (METHOD.md 6): which contacts rest, which
 !> bodies are at rest, rests logged at a bounce series' accumulation time, releases held
 !> back until time moves on (a contact that closes again at the same instant never
-!> opened), and the velocity scale of the instant's impulses.
+!> opened).
 module impact1d_event_log
   use impact1d_kinds, only: wp
-  use impact1d_lanes, only: max_lanes
-  use impact1d_scene, only: scene_type
+  use impact1d_scene, only: scene_type, tutorial_bodies
   use impact1d_output, only: sink_type, run_stats, class_rest, class_release, class_stick, class_slip, count_event, &
     class_pair_stick
   use impact1d_yardsticks, only: same_instant
@@ -22,16 +21,11 @@ module impact1d_event_log
     !> (nr) A rest after an accumulation of impacts, logged when its time comes.
     real(wp), allocatable :: pending_rest(:)
     !> (nr) A release waiting for time to move on (see begin_rest), with the velocities it
-    !> reports (lanes: log_event).
+    !> reports (its pair's: log_event).
     real(wp), allocatable :: release_time(:)
     real(wp), allocatable :: release_v(:, :)       !< (2, nr)
     !> (N) When impulses last moved each body off its rest (see the stick log at the event point).
     real(wp), allocatable :: rest_lost_time(:)
-    !> The last event point's instant and the velocity scale its impulses came from (lanes): a
-    !> further event point at the same instant keeps that scale (impulses redistribute
-    !> velocity but cannot create precision, however many event points they take).
-    real(wp) :: scale_time = -huge(1.0_wp)
-    real(wp) :: scale(max_lanes) = 0.0_wp
     !> The event points with impacts lately (an accumulation over several contacts).
     type(cycle_history_type) :: cycles
   contains
@@ -61,7 +55,8 @@ contains
   !> Event (class, index) at t, counted and sent to the sink with the velocities of the
   !> pair it reports (docs/nbody-plan.md, "The event record"): with one or two bodies that
   !> is (1, 2), or (1, 0) with one body, whatever the event (a wall's impact reports both
-  !> bodies). v_before, v_after: the N bodies' velocities, or lanes (an idle lane is 0).
+  !> bodies). v_before, v_after: the N bodies' velocities, or the pair's two (a release's,
+  !> kept by the log).
   subroutine log_event(scene, sink, stats, t, class, index, v_before, v_after)
     type(scene_type), intent(in) :: scene
     class(sink_type), intent(inout) :: sink
@@ -73,7 +68,7 @@ contains
     integer :: ends(2)
     call count_event(stats, class, index)
     v = 0.0_wp
-    if (scene%n_bodies > 2) then
+    if (scene%n_bodies > tutorial_bodies) then
       ! N bodies: the event's own pair, the row's ends or (body, 0).
       ends = [index, 0]
       if (class /= class_stick .and. class /= class_slip) ends = scene%row_body(:, index)

@@ -6,7 +6,7 @@ module impact1d_events
   use impact1d_kinds, only: wp
   implicit none
   private
-  public :: hermite, earliest_crossing, poly_value, stop_force_cubic
+  public :: hermite, earliest_crossing, poly_value, stop_force_cubic, first_negative
 
 contains
 
@@ -176,4 +176,30 @@ contains
     root = a
     if (poly_value(p, b) >= 0.0_wp .and. fa < 0.0_wp) root = b
   end function bracketed_root
+
+  !> First tau > 0 with g0 + u tau + a tau^2 / 2 < 0, for g0 >= 0 (0 if g0 < 0, huge if never):
+  !> when a gap or a sliding velocity under constant forces can first need watching (the
+  !> closed-form steps' quiet time, impact1d_nbody_glide).
+  pure real(wp) function first_negative(g0, u, a) result(tau)
+    real(wp), intent(in) :: g0, u, a
+    real(wp) :: disc, q
+    tau = huge(1.0_wp)
+    if (g0 < 0.0_wp) then
+      tau = 0.0_wp
+    else if (a == 0.0_wp) then
+      if (u < 0.0_wp) tau = g0 / (-u)
+    else
+      disc = u**2 - 2.0_wp * a * g0
+      if (disc < 0.0_wp) return
+      ! Roots of a/2 tau^2 + u tau + g0 by the stable pair q/(a/2) and g0/q.
+      q = -0.5_wp * (u + sign(sqrt(disc), u))
+      if (a > 0.0_wp) then
+        if (u < 0.0_wp .and. q /= 0.0_wp) tau = g0 / q        ! the smaller positive root
+      else
+        tau = max(q / (0.5_wp * a), merge(g0 / q, 0.0_wp, q /= 0.0_wp))   ! the positive root
+      end if
+      tau = max(tau, 0.0_wp)
+    end if
+    if (tau /= tau) tau = 0.0_wp
+  end function first_negative
 end module impact1d_events

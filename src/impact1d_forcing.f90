@@ -3,7 +3,6 @@
 !> it, so an absent term costs nothing in the stepping loop.
 module impact1d_forcing
   use impact1d_kinds, only: wp
-  use impact1d_lanes, only: max_lanes, to_lanes
   implicit none
   private
   public :: table_type, forcing_type, angular_frequency, table_value, table_slope, segment
@@ -29,12 +28,10 @@ module impact1d_forcing
     procedure(add_sines), pointer, nopass :: sine_terms => null()
     logical :: varies = .false.                 !< some body has a table or a sine (set_varies)
     real(wp) :: fastest = 0.0_wp                !< the largest omega of any sine (0: none; set_varies)
-    real(wp) :: constant_lanes(max_lanes) = 0.0_wp  !< (lanes) constant, for force (set_varies)
   contains
     procedure :: allocate_bodies
     procedure :: set_sines
     procedure :: set_varies
-    procedure :: force
     procedure :: force_all
     procedure :: rate
     procedure :: next_breakpoint
@@ -91,36 +88,13 @@ contains
     end do
   end subroutine set_sines
 
-  !> varies: whether the forces change with time, the fastest sine, and the constants in
-  !> lanes (once the terms are set).
+  !> varies: whether the forces change with time, and the fastest sine (once the terms are
+  !> set).
   pure subroutine set_varies(self)
     class(forcing_type), intent(inout) :: self
     self%varies = any(self%has_table) .or. any(self%has_sine) .or. self%n_sines > 0
     self%fastest = max(maxval(self%omega, mask=self%has_sine, dim=1), maxval(self%sine_omega, dim=1), 0.0_wp)
-    call to_lanes(self%constant, self%constant_lanes)
   end subroutine set_varies
-
-  !> Forces on the bodies at time t, in lanes (impact1d_lanes: an idle lane 0). Small, so
-  !> that the stepping loop inlines it; tables and sines apart (add_varying).
-  pure subroutine force(self, t, f)
-    class(forcing_type), intent(in) :: self
-    real(wp), intent(in) :: t
-    real(wp), intent(out) :: f(max_lanes)
-    f = self%constant_lanes
-    if (self%varies) call add_varying(self, t, f)
-  end subroutine force
-
-  !> f += the tables' and sines' terms at t.
-  pure subroutine add_varying(self, t, f)
-    class(forcing_type), intent(in) :: self
-    real(wp), intent(in) :: t
-    real(wp), intent(inout) :: f(max_lanes)
-    integer :: i
-    do i = 1, max_lanes      ! (a loop of max_lanes trips the compiler unrolls: N <= max_lanes)
-      if (i > size(self%constant)) exit
-      call add_body_varying(self, i, t, f(i))
-    end do
-  end subroutine add_varying
 
   !> fi += body i's table, sine and &sine terms at t (in that order: the order of the sums;
   !> the &sine terms in record order).
@@ -167,7 +141,7 @@ contains
     end do
   end subroutine add_sines
 
-  !> Forces on all N bodies at time t (N-long: the N-body engine's; force's sums).
+  !> Forces on all N bodies at time t (N-long); each body's terms in add_body_varying's order.
   pure subroutine force_all(self, t, f)
     class(forcing_type), intent(in) :: self
     real(wp), intent(in) :: t
@@ -180,14 +154,14 @@ contains
     end do
   end subroutine force_all
 
-  !> Right derivative df/dt at t, in lanes or N-long (a lane past N 0): tells which way a
-  !> force that is exactly at a bound will go.
+  !> Right derivative df/dt at t (N-long): tells which way a force that is exactly at a
+  !> bound will go.
   pure subroutine rate(self, t, df)
     class(forcing_type), intent(in) :: self
     real(wp), intent(in) :: t
     real(wp), intent(out) :: df(:)
     integer :: i, k
-    df = 0.0_wp      ! (and an idle lane)
+    df = 0.0_wp
     do i = 1, size(self%constant)
       if (self%has_table(i)) df(i) = table_slope(self%table(i), segment(self%table(i)%t, t))
       if (self%has_sine(i)) df(i) = df(i) + self%amp(i) * self%omega(i) * cos(self%omega(i) * t + self%phase(i))

@@ -4,6 +4,7 @@ module impact1d_io
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use impact1d_kinds, only: wp
   use impact1d_error, only: error_type, raise, status_input, fmt
+  use impact1d_scene, only: tutorial_bodies
   use impact1d_scene, only: scene_input, scene_type, build_scene, validate, set_text, n_real, n_text, &
     real_names, text_names, i_m1, i_m2, i_mu1, i_mu2, i_g, i_r_left, i_r_right, i_r_min, i_r_max, i_x_left, i_x_right, &
     i_d_min, i_d_max, i_x1, i_x2, i_v1, i_v2, i_f1, i_f2, i_title, i_f1_table, i_f2_table, i_method, &
@@ -101,20 +102,20 @@ contains
     type(mechanism_records) :: records
     character(len=:), allocatable :: path
     integer :: i
-    allocate(tables(max(2, n_bodies_of(input))))
+    allocate(tables(max(tutorial_bodies, n_bodies_of(input))))
     do i = 1, size(tables)
       ! Body i's table: the tutorial's f1_table, f2_table, or f_table(i) of N > 2 bodies.
-      if (input%chain%n_bodies > 2) then
+      if (input%chain%n_bodies > tutorial_bodies) then
         if (input%chain%array(a_f_table)%n < i) cycle
         path = trim(input%chain%array(a_f_table)%t(i)%s)
       else
-        if (i > 2) cycle
+        if (i > tutorial_bodies) cycle
         path = trim(input%text(i_f1_table + i - 1)%s)
       end if
       if (len(path) == 0) cycle
       call read_table(path, tables(i), error)
       if (allocated(error)) then
-        if (input%chain%n_bodies > 2) then
+        if (input%chain%n_bodies > tutorial_bodies) then
           error%message = 'f_table(' // trim(fmt(i)) // '): ' // error%message
         else
           error%message = 'f' // trim(fmt(i)) // '_table: ' // error%message

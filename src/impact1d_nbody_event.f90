@@ -2,19 +2,18 @@
 !> rows snapped, impacts resolved (one joint inelastic impact of the closed rows when all
 !> are plastic, otherwise sequential impulses on the most approaching row), bounce series
 !> whose rest is below the clock's resolution put to rest (Zeno), stopped bodies zeroed, the
-!> new mode (impact1d_body_mode) and the log of what changed. The rules are the two-body
-!> engine's (impact1d_event_point), on N-long arrays and the rows' ends.
+!> new mode (impact1d_body_mode) and the log of what changed, on N-long arrays and the rows'
+!> ends (the two-body engine's rules, whose event point, impact1d_event_point, is gone).
 module impact1d_nbody_event
   use impact1d_kinds, only: wp, eps_wp
   use impact1d_error, only: error_type, raise, status_simulation, fmt
-  use impact1d_scene, only: scene_type
+  use impact1d_scene, only: scene_type, tutorial_bodies
   use impact1d_state, only: state_type, add_compensated, product_error
   use impact1d_output, only: sink_type, run_stats, class_impact, class_rest, class_stick, class_slip, class_release, &
     class_pair_stick, class_pair_slip
   use impact1d_yardsticks, only: gap_rounding, velocity_rounding, time_rounding, energy_rounding, same_instant, &
     force_scale
   use impact1d_event_log, only: event_log_type, log_event
-  use impact1d_event_point, only: bounce_series_time
   use impact1d_friction_laws, only: slip, belt_speed, belt_moving, belt_rate, shift_to_belts, belt_accelerations
   use impact1d_clusters, only: uf_join, uf_find, cluster_set_type, clusters_build
   use impact1d_accumulation, only: join_cycle
@@ -28,7 +27,7 @@ module impact1d_nbody_event
     found_friction
   implicit none
   private
-  public :: point_work_type, new_point_work, nbody_event_point
+  public :: point_work_type, new_point_work, nbody_event_point, bounce_series_time
 
   !> The event point's memory (sized by the run) and what one event point leaves for the
   !> next at the same instant.
@@ -196,14 +195,13 @@ contains
     if (scene%n_frictions > 0 .and. .not. initial) call log_pairs(scene, pair_was_stuck, mode, s, sink, stats)
   end subroutine nbody_event_point
 
-  !> The compliant stops at this instant (docs/method.md section 10; impact1d_event_point's
-  !> switch_stops for the two-body engine): an open stop whose gap has closed (located, or
-  !> within its rounding) engages when its ends approach, logged as an impact on its row (no
-  !> velocity changes); an engaged one releases when its force F = -(k gap + c gap') has
-  !> fallen to zero (located, or within rounding), logged as release_<row>; one released
-  !> inside (gap < 0) engages again when F has risen to zero. acc: the accelerations in the
-  !> mode so far (a stop at its limit with its ends at rest relative to each other engages
-  !> when they accelerate into it).
+  !> The compliant stops at this instant (docs/method.md section 10): an open stop whose gap
+  !> has closed (located, or within its rounding) engages when its ends approach, logged as
+  !> an impact on its row (no velocity changes); an engaged one releases when its force
+  !> F = -(k gap + c gap') has fallen to zero (located, or within rounding), logged as
+  !> release_<row>; one released inside (gap < 0) engages again when F has risen to zero.
+  !> acc: the accelerations in the mode so far (a stop at its limit with its ends at rest
+  !> relative to each other engages when they accelerate into it).
   subroutine switch_stops(scene, found, index, s, acc, engaged, sink, stats)
     type(scene_type), intent(in) :: scene
     integer, intent(in) :: found, index
@@ -458,7 +456,7 @@ contains
   !> groups (work%rigid, 0 the ground for a link to it) and their masses; each group moves
   !> with its centre of mass (a relative velocity the link cannot have is absorbed, as by a
   !> plastic impact, booked as impact loss and logged as an impact of the link's row that
-  !> approached, as the two-body engine and tests/exact_nbody.py log it). stopped: the
+  !> approached, as tests/exact_nbody.py logs it). stopped: the
   !> bodies friction has just stopped (their rounding-level speed zeroed); the groups they
   !> move with stop with them, silently: the speed the others kept was that rounding.
   subroutine lock_rigid(scene, closed, stopped, s, work, sink, stats)
@@ -1034,7 +1032,7 @@ contains
   !> The bounce series on closed row k, if its ends separate slowly: the gap's acceleration
   !> rising (a_up) and falling back (a_down) from the mode with k left free. If what remains
   !> of the series is below the clock's resolution, the row rests now, logged at the
-  !> series' accumulation time (the two-body engine's settle_bounce_series).
+  !> series' accumulation time.
   subroutine settle_bounce_series(scene, mode, k, u, f, df, closed, acc, entry_scale, s, event_log, work, sink, stats)
     type(scene_type), intent(in) :: scene
     type(body_mode_type), intent(in) :: mode
@@ -1092,6 +1090,22 @@ contains
       a_gap = row_velocity(scene, k, a) + ground_motion(scene, k, s%t, 2)
     end function free_gap_acceleration
   end subroutine settle_bounce_series
+
+  !> Total time of a bounce series starting at separating normal speed u > 0, rising
+  !> with gap acceleration a_up < 0 and falling back with a_down, restitution r (huge if it
+  !> does not end). Under constant forces each arc takes u/|a_up| + u/sqrt(a_up a_down) and
+  !> the next impact speed is r u sqrt(a_down/a_up): the series is geometric, its sum
+  !> closed form.
+  pure real(wp) function bounce_series_time(u, a_up, a_down, r) result(remaining)
+    real(wp), intent(in) :: u, a_up, a_down, r
+    real(wp) :: ratio, first_arc
+    remaining = huge(1.0_wp)
+    if (a_down < 0.0_wp) then
+      first_arc = u / (-a_up) + u / sqrt(a_up * a_down)
+      ratio = r * sqrt(a_down / a_up)
+      if (ratio < 1.0_wp) remaining = first_arc / (1.0_wp - ratio)
+    end if
+  end function bounce_series_time
 
   !> settle_bounce_series' free gap acceleration of row k at velocities v from the clusters
   !> of k's ends alone (scoped), not from the mode solve of all N bodies: the solve is per
@@ -1569,7 +1583,7 @@ contains
   end subroutine apply
 
   !> Log what a user can see change between the old mode and new: rows that start or stop
-  !> holding, bodies that come to rest or break away (the two-body engine's rules).
+  !> holding, bodies that come to rest or break away (the rules of docs/method.md section 5).
   subroutine log_mode_change(scene, initial, f, df, candidate, new, s, event_log, sink, stats)
     type(scene_type), intent(in) :: scene
     logical, intent(in) :: initial, candidate(:)
@@ -1684,7 +1698,7 @@ contains
       real(wp), intent(in) :: v(:)
       real(wp) :: pair(2)
       pair = 0.0_wp
-      if (scene%n_bodies <= 2) then
+      if (scene%n_bodies <= tutorial_bodies) then
         pair(:scene%n_bodies) = v
         return
       end if

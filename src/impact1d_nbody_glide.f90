@@ -1,5 +1,5 @@
 !> Closed-form steps of the N-body engine (docs/method.md section 9; the two-body engine's
-!> glide, impact1d_solver): under forces that are constant between stops a mode's
+!> glide, once): under forces that are constant between stops a mode's
 !> accelerations are constant, so its motion is an exact quadratic and the first instant a
 !> row's gap, a sliding body's velocity or a friction contact's relative velocity can reach
 !> zero is known in closed form when the mode starts (the quiet time). The steps that end
@@ -20,7 +20,7 @@ module impact1d_nbody_glide
   use impact1d_yardsticks, only: gap_rounding, velocity_rounding
   use impact1d_body_mode, only: body_mode_type, mode_work_type, relative_velocity
   use impact1d_nbody_step, only: row_gap, row_velocity, row_abs, nbody_step, mode_crossing, kept_forces_type
-  use impact1d_location, only: first_negative
+  use impact1d_events, only: first_negative
   implicit none
   private
   public :: glide_type, new_glide, find_quiet_time, glide
@@ -28,7 +28,7 @@ module impact1d_nbody_glide
   !> How far from its limit (in multiples of its rounding) a gap or a sliding velocity must
   !> stay for the location to find nothing there, whatever the steps' rounding did to the
   !> exact quadratic (a few eps of the distance travelled); the quiet time is then taken 1%
-  !> short of that, as the two-body engine's find_quiet_times does.
+  !> short of that, as the two-body engine's find_quiet_times did.
   real(wp), parameter :: band_factor = 1.0e3_wp, quiet_fraction = 0.99_wp
 
   !> What the glide needs of the scene (once a run) and of the current mode (at each event

@@ -1,10 +1,10 @@
-!> The N-body engine's driver (docs/method.md section 9): the two-body engine's method on
+!> The engine's driver (docs/method.md section 9), for any number of bodies: the method on
 !> N-long arrays. From the current state it picks the next stop (sample time, table corner
 !> or pending rest), takes the steps before the mode's quiet time in closed form under
 !> constant forces or tables (impact1d_nbody_glide), then one RK4 step toward it, locates the earliest
 !> event inside the step on the dense output (impact1d_nbody_step), re-takes the step to it,
 !> and calls the event point (impact1d_nbody_event); samples go to the sink at sample times. impact1d_solver's
-!> run hands scenes of more than two bodies here.
+!> run hands every scene of the event method here.
 module impact1d_nbody_solver
   use, intrinsic :: iso_fortran_env, only: int64
   use impact1d_kinds, only: wp

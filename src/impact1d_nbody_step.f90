@@ -2,7 +2,7 @@
 !> 9): the classical RK4 step of N bodies within a mode, its energy ledger, the rows' exact
 !> gaps, and the earliest event inside a step (a gap closing, a sliding body stopping, the
 !> mode's conditions failing) on the step's Hermite dense output. The state is N-long
-!> (impact1d_state's state_type); the two-body engine's counterparts work in lanes.
+!> (impact1d_state's state_type), for any N.
 module impact1d_nbody_step
   use impact1d_kinds, only: wp, eps_wp
   use impact1d_scene, only: scene_type

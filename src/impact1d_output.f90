@@ -7,6 +7,7 @@ module impact1d_output
   use impact1d_kinds, only: wp
   use impact1d_error, only: error_type, raise, status_input, status_simulation, status_interrupted, fmt, fmt_width
   use impact1d_interrupt, only: interrupt_count
+  use impact1d_scene, only: tutorial_bodies
   use impact1d_scene, only: scene_input, real_names, n_real, i_title, i_method, i_g, i_dt_out, i_x_left_table, &
     i_x_right_table, &
     events_all, events_impacts, events_none, events_kept, name_len, &
@@ -23,7 +24,7 @@ module impact1d_output
   public :: class_impact, class_rest, class_release, class_stick, class_slip, event_name, start_counts, &
     class_pair_stick, class_pair_slip, &
     count_event, event_count, impacts_on
-  public :: emit_sample, emit_bodies, events_path, present_columns, i_pe, i_work, i_friction_loss, i_impact_loss, &
+  public :: emit_bodies, events_path, present_columns, i_pe, i_work, i_friction_loss, i_impact_loss, &
     i_damping_loss, i_drive_work, row_length, row_columns, column_word, bodies_of, row_ledger, check_bodies_out, final_row
 
   !> Every column a run can have; a scene's output carries those it has (present_columns):
@@ -32,8 +33,8 @@ module impact1d_output
     i_damping_loss = 11, i_drive_work = 12
   character(len=*), parameter :: column_names = &
     't x1 v1 x2 v2 ke pe work friction_loss impact_loss damping_loss drive_work residual'
-  !> A run's full row (emit_bodies' for N bodies, emit_sample's 12 for one or two) is
-  !> t, x1 v1 .. xM vM (M = max(N, 2)), then these, the ledger, in this order: its length is
+  !> A run's full row (emit_bodies') is t, x1 v1 .. xM vM (M = max(N, 2): the tutorial's
+  !> columns x2 v2 kept for one body), then these, the ledger, in this order: its length is
   !> row_length(N), the ledger's k-th at row_ledger(N) + k. N <= 2 gives the 13 above.
   integer, parameter :: n_ledger = 8
   character(len=*), parameter :: ledger_words(n_ledger) = [character(len=13) :: 'ke', 'pe', 'work', &
@@ -73,8 +74,7 @@ module impact1d_output
     !> contact j's events at index nr + j); start_counts allocates them.
     integer :: n_events = 0
     integer, allocatable :: row_events(:, :), body_events(:, :), pair_events(:, :)
-    real(wp) :: last_row(n_columns) = 0.0_wp
-    !> An N-body run's last full row (emit_bodies; row_length(N) long), in place of last_row.
+    !> The run's last full row (emit_bodies; row_length(N) long).
     real(wp), allocatable :: row(:)
     real(wp) :: max_residual = 0.0_wp
     !> The interrupt count when the run started (impact1d_interrupt): a run ends when it moves on.
@@ -107,10 +107,9 @@ module impact1d_output
   end type sink_type
 
   abstract interface
-    !> One full row (row_length(N): emit_sample's 12 for one or two bodies, emit_bodies' for
-    !> N); the sink keeps or writes the columns it was given (row_columns). Assumed size,
-    !> not shape: a descriptor per sample cost emit_sample's hot path 10% (case 3, a sample
-    !> every step).
+    !> One full row (row_length(N): emit_bodies'); the sink keeps or writes the columns it
+    !> was given (row_columns). Assumed size, not shape: a descriptor per sample cost the
+    !> sampling's hot path 10% (case 3, a sample every step).
     subroutine put_sample_interface(self, row)
       import :: sink_type, wp
       class(sink_type), intent(inout) :: self
@@ -221,60 +220,15 @@ module impact1d_output
 
 contains
 
-  !> Send one sample (t, x, v and the energy ledger) to a sink, keeping the run's statistics:
-  !> both methods report through here, so their columns cannot drift apart. A row that is not
-  !> finite (v = 1e300 squares to an infinite KE, and the residual becomes NaN) is an error,
-  !> never a result: a NaN would also slip through the max of the residuals.
-  !> springs: [pe, pe0, damping_loss], used when with_springs (a scene with springs or
-  !> dampers: the residual then counts the potential energy and the dampers' loss).
-  subroutine emit_sample(sink, stats, t, x, v, mass, ke0, work, friction_loss, impact_loss, &
-      with_springs, springs, error)
-    class(sink_type), intent(inout) :: sink
-    type(run_stats), intent(inout) :: stats
-    real(wp), intent(in) :: t, x(2), v(2), mass(2), ke0, work, friction_loss, impact_loss
-    logical, intent(in) :: with_springs
-    real(wp), intent(in) :: springs(3)
-    type(error_type), allocatable, intent(out) :: error
-    real(wp) :: ke
-    ke = 0.5_wp * dot_product(mass, v**2)
-    ! Built in place, element by element: an array constructor cost a temporary per sample,
-    ! and a row built on the stack then copied stalled on the copy's wide loads of narrow
-    ! stores (in perf, the copy held about a third of emit_sample's time).
-    associate (row => stats%last_row)
-      row(1) = t
-      row(2) = x(1)
-      row(3) = v(1)
-      row(4) = x(2)
-      row(5) = v(2)
-      row(6) = ke
-      row(i_work) = work
-      row(i_friction_loss) = friction_loss
-      row(i_impact_loss) = impact_loss
-      row(i_drive_work) = 0.0_wp      ! (a moving ground runs on the N-body engine)
-      if (with_springs) then
-        row(i_pe) = springs(1)
-        row(i_damping_loss) = springs(3)
-        row(n_columns) = ((ke + springs(1)) - (ke0 + springs(2))) - work + friction_loss + impact_loss + springs(3)
-      else
-        row(i_pe) = 0.0_wp
-        row(i_damping_loss) = 0.0_wp
-        row(n_columns) = ke - ke0 - work + friction_loss + impact_loss
-      end if
-      if (.not. all(abs(row) <= huge(1.0_wp))) then
-        call not_finite(t, ke, ke0, error)
-        return
-      end if
-      stats%max_residual = max(stats%max_residual, abs(row(n_columns)))
-      call sink%put_sample(row)
-    end associate
-  end subroutine emit_sample
-
-  !> Send one sample of an N-body run (x, v, mass: every body's, N long) to a sink, as
-  !> emit_sample does for one or two: the full row (row_length(N): t, x1 v1 .. xN vN, ke, pe,
-  !> work, friction_loss, impact_loss, damping_loss, residual) in stats%row, the residual by
-  !> emit_sample's formula, max_residual; the sink writes the columns it was given
-  !> (row_columns: the bodies of &run bodies_out, pe and damping_loss with springs), while ke
-  !> and the ledger are over every body. The row is allocated once, at the run's first sample.
+  !> Send one sample (t, x, v and the energy ledger; x, v, mass: every body's, N long) to a
+  !> sink, keeping the run's statistics: both methods report through here, so their columns
+  !> cannot drift apart. The full row (row_length(N): t, x1 v1 .. xN vN (x2 v2 zero for one
+  !> body), ke, pe, work, friction_loss, impact_loss, damping_loss, drive_work, residual) in
+  !> stats%row, max_residual; a row that is not finite (v = 1e300 squares to an infinite KE,
+  !> and the residual becomes NaN) is an error, never a result. The sink writes the columns
+  !> it was given (row_columns: the bodies of &run bodies_out, pe and damping_loss with
+  !> springs), while ke and the ledger are over every body. The row is allocated once, at the
+  !> run's first sample.
   !> drive_work: what moving grounds did on the bodies (given only with one: the residual
   !> then counts it).
   subroutine emit_bodies(sink, stats, t, x, v, mass, ke0, work, friction_loss, impact_loss, &
@@ -296,7 +250,6 @@ contains
       deallocate(stats%row)
       allocate(stats%row(row_length(n)))
     end if
-    ! (dot_product: for N <= 2 the sum emit_sample makes, bit for bit)
     ke = 0.5_wp * dot_product(mass, v**2)
     associate (row => stats%row)
       row(1) = t
@@ -330,15 +283,16 @@ contains
     end associate
   end subroutine emit_bodies
 
-  !> The run's last full row: emit_sample's (one or two bodies: t x1 v1 x2 v2, the ledger)
-  !> or emit_bodies' (N); the ledger's k-th at row_ledger(N) + k either way.
+  !> The run's last full row (emit_bodies'; the ledger's k-th at row_ledger(N) + k), or
+  !> n_columns zeros before any sample.
   pure function final_row(stats) result(row)
     type(run_stats), intent(in) :: stats
     real(wp), allocatable :: row(:)
     if (allocated(stats%row)) then
       row = stats%row
     else
-      row = stats%last_row
+      allocate(row(n_columns))
+      row = 0.0_wp
     end if
   end function final_row
 
@@ -351,7 +305,7 @@ contains
   end subroutine not_finite
 
   !> Length of the full row of a run of n_bodies bodies: t, x and v of max(N, 2) bodies, the
-  !> ledger (12 for one or two bodies: emit_sample's row).
+  !> ledger (n_columns for one or two bodies).
   pure integer function row_length(n_bodies)
     integer, intent(in) :: n_bodies
     row_length = row_ledger(n_bodies) + n_ledger
@@ -360,7 +314,7 @@ contains
   !> Where the ledger starts in the full row: ke is at row_ledger + 1, residual at + 8.
   pure integer function row_ledger(n_bodies)
     integer, intent(in) :: n_bodies
-    row_ledger = 2 * max(n_bodies, 2) + 1
+    row_ledger = 2 * max(n_bodies, tutorial_bodies) + 1
   end function row_ledger
 
   !> The columns a run writes, as indices into its full row: t; x and v of the bodies named
@@ -412,7 +366,7 @@ contains
   !> The columns a scene's output has, as indices into its full row (row_columns): the
   !> bodies of &run bodies_out (every body when it names none), pe and damping_loss only
   !> when the scene names springs or dampers, drive_work only when it names a moving ground (a component a scene does not name is absent
-  !> from its output too). One or two bodies: indices into emit_sample's 12.
+  !> from its output too). One or two bodies: indices into the n_columns above.
   function present_columns(input) result(columns)
     type(scene_input), intent(in) :: input
     integer, allocatable :: columns(:)
@@ -654,7 +608,7 @@ contains
     integer, intent(in) :: class, index, a, b
     ! With one or two bodies the pair is every body; with more an event does not say whether
     ! the others move: the samples alone decide (rest_time to the sample).
-    if (self%n_bodies > 2) return
+    if (self%n_bodies > tutorial_bodies) return
     if (any(v(3:4) /= 0.0_wp)) then
       self%rest_event = huge(1.0_wp)
       self%rest_sample = huge(1.0_wp)
@@ -814,12 +768,12 @@ contains
     ! laws', which have no such names: impact1d_chain's fold)
     call put_arrays(self, input)
     call put_records(self, input)
-    if (self%n_bodies > 2) call self%put_line(self%unit, '# bodies = ' // trim(fmt(self%n_bodies)))
+    if (self%n_bodies > tutorial_bodies) call self%put_line(self%unit, '# bodies = ' // trim(fmt(self%n_bodies)))
     call names_of(self%columns, self%n_bodies, header)
     call self%put_line(self%unit, '#' // header)
     if (self%events == events_none) return
     call self%put_line(self%event_unit, '# impact1d events')
-    if (self%n_bodies > 2) then
+    if (self%n_bodies > tutorial_bodies) then
       call self%put_line(self%event_unit, '# t kind a b va_before vb_before va_after vb_after')
     else if (self%n_bodies == 2) then
       call self%put_line(self%event_unit, '# t kind v1_before v2_before v1_after v2_after')
@@ -854,7 +808,7 @@ contains
     if (.not. self%logs_event(class)) return
     ! One or two bodies: the pair is (1, 2), or (1, 0) with one body, whose line has v1 only;
     ! more: the pair's ends, named (a line of its own length, counted as written).
-    if (self%n_bodies > 2) then
+    if (self%n_bodies > tutorial_bodies) then
       call put_pair_event(self, t, event_name(self%row_names, class, index), a, b, v)
       return
     else if (self%n_bodies == 2) then

@@ -6,15 +6,12 @@ module impact1d_scene
   use impact1d_kinds, only: wp, eps_wp
   use impact1d_error, only: error_type, raise, status_input, fmt, fmt_width
   use impact1d_forcing, only: forcing_type, table_type, angular_frequency
-  use impact1d_springs, only: springs_type, pair_elements, assemble, rate_bound
-  use impact1d_modes, only: pair_type, pair_rows
-  use impact1d_lanes, only: max_lanes
   use impact1d_drives, only: drive_type
   use impact1d_fields, only: chain_input, mechanism_records, r_k, r_c, r_stop_k, r_stop_c, r_ground_v, &
     r_spring_ground_v, r_ground_table, r_spring_ground_table, array_value, a_m, &
     a_mu, a_mus, a_x, a_v, a_belt_v, a_v_s, a_c_v, a_belt_amp, a_belt_period, a_belt_phase, &
     a_f, a_f_amp, a_f_period, a_f_phase, a_f_table
-  use impact1d_stability, only: linear_modes, stable_step, mode_error, coarse_rate
+  use impact1d_stability, only: linear_modes, stable_step, mode_error, coarse_rate, assemble
   implicit none
   private
   public :: n_real, n_text, real_names, text_names, scene_input, scene_type, build_scene, validate
@@ -24,13 +21,18 @@ module impact1d_scene
     i_f1_phase, i_f2_amp, i_f2_period, i_f2_phase, i_t_end, i_dt, i_dt_out, i_mus1, i_mus2, &
     i_k1, i_x1_rest, i_c1, i_k2, i_x2_rest, i_c2, i_k12, i_d_rest, i_c12, i_max_events
   public :: sample_time, step_length, set_text, events_kept, name_of, is_nbody, value_or, ground_named
-  public :: runs_nbody
   public :: positive_value, nonnegative_value, unit_interval, resolvable, unresolved
   public :: i_x_left_v, i_x_right_v, i_x_left_table, i_x_right_table
   public :: i_title, i_f1_table, i_f2_table, i_method, i_substeps, i_events, default_gravity
   public :: events_all, events_impacts, events_none
-  public :: name_len, set_rows, allocate_contacts, set_springs, springs_named
+  public :: name_len, set_rows, allocate_contacts, set_springs, springs_named, springs_type
+  public :: tutorial_bodies
 
+  !> The tutorial's bodies: a scene of at most this many is written with its scalars (m1,
+  !> x2, k12, ...), and its output keeps their layout (the columns x2 v2, and events that
+  !> report both bodies whatever the event). A format's number, not the engine's: the engine
+  !> runs any N alike.
+  integer, parameter :: tutorial_bodies = 2
   integer, parameter :: n_real = 52, n_text = 8
   !> Names of the real inputs, as in the namelist and in Python's Scene, in this order.
   character(len=*), parameter :: real_names(n_real) = [character(len=15) :: &
@@ -75,7 +77,7 @@ module impact1d_scene
   character(len=*), parameter :: contact_names(n_limits) = [character(len=8) :: &
     'left', 'right', 'slot_min', 'slot_max']
   !> Their normals with two bodies: the left wall holds body 1, the right wall body 2. With
-  !> one body both walls hold body 1 (the pair's normal: scene_type's pair%normal).
+  !> one body both walls hold body 1.
   real(wp), parameter :: two_body_normal(2, n_limits) = reshape( &
     [1.0_wp, 0.0_wp, 0.0_wp, -1.0_wp, -1.0_wp, 1.0_wp, 1.0_wp, -1.0_wp], [2, n_limits])
   real(wp), parameter :: one_body_normal(2, n_limits) = reshape( &
@@ -127,6 +129,15 @@ module impact1d_scene
     !> present_columns): not allocated, every body.
     integer, allocatable :: bodies_out(:)
   end type scene_input
+
+  !> What the scene's elements and compliant stops make of its forces (set_springs,
+  !> springs_named); the engine reads the element records themselves (impact1d_elements).
+  type :: springs_type
+    !> Forces that depend on the state: an element record or a compliant stop.
+    logical :: present = .false.
+    !> The scene names a stiffness / a damping (its output has the PE / damping_loss column).
+    logical :: has_spring = .false., has_damper = .false.
+  end type springs_type
 
   !> The checked model: the constant part of a run (what changes is impact1d_state's), as
   !> counts and one array per attribute (MuJoCo's mjModel).
@@ -187,8 +198,8 @@ module impact1d_scene
     real(wp), allocatable :: element_c(:)            !< (ne) damping, N s/m
     real(wp), allocatable :: element_rest(:)         !< (ne) rest length of x_b - x_a, m
     real(wp), allocatable :: element_ratio(:)        !< (ne) gear ratio n: acts on x_b - n x_a (1: none)
-    !> The elements as the two-body kernels see them (set_springs), and whether the scene
-    !> names a stiffness or a damping (present, has_spring, has_damper).
+    !> Whether the elements or stops make the forces depend on the state, and whether the
+    !> scene names a stiffness or a damping (present, has_spring, has_damper).
     type(springs_type) :: springs
     ! contacts: the records as written (docs/nbody-plan.md section 1). Record j constrains
     ! d = x_b - x_a (a ground end is 0: x = 0) between its limits, d_min <= d <= d_max.
@@ -202,8 +213,8 @@ module impact1d_scene
     real(wp), allocatable :: contact_k(:), contact_c(:)
     !> (nc) gear ratio n: the record acts on x_b - n x_a (1: none; docs/method.md section 14)
     real(wp), allocatable :: contact_ratio(:)
-    !> Some contact or element has a gear ratio other than 1: only the N-body engine runs it
-    !> (runs_nbody), its RK4 stages through the elements' geared forces (stage_powers), its
+    !> Some contact or element has a gear ratio other than 1: the event method runs it, its
+    !> RK4 stages through the elements' geared forces (stage_powers), its
     !> modes and impacts on rows of normal (-n, 1) (body_mode_type's scale).
     logical :: geared = .false.
     !> Moving grounds or gear ratios (drives%n > 0 or geared): one test where a gap, a mode's
@@ -236,10 +247,6 @@ module impact1d_scene
     integer, allocatable :: contact_drive(:)            !< (nc) the drive of the record's ground end, else 0
     integer, allocatable :: element_drive(:)            !< (ne) the drive of the element's ground end, else 0
     integer, allocatable :: row_drive(:)                !< (nr) its record's drive
-    !> The bodies and rows as the two-body kernels see them (impact1d_modes' pair_type: in
-    !> lanes, impact1d_lanes): with one body, padded by a phantom (unit mass, at rest, no
-    !> friction, on no row) in the idle lane.
-    type(pair_type) :: pair
     ! run --------------------------------------------------------------------------------
     real(wp) :: t_end, dt, dt_out
     real(wp) :: zero_velocity = default_zero_velocity
@@ -271,7 +278,7 @@ contains
         return
       end if
     end do
-    if (input%chain%n_bodies > 2) then
+    if (input%chain%n_bodies > tutorial_bodies) then
       ! The bodies and links are impact1d_chain's to check (validate_chain), as are the
       ! records of any scene.
       if (require_run) call require(input, [i_t_end, i_dt], error)
@@ -521,22 +528,12 @@ contains
     if (len_trim(input%spelled(i)) > 0) name = input%spelled(i)
   end function name_of
 
-  !> Whether the scene needs the N-body engine: more than two bodies (written as arrays).
-  !> Records on one or two bodies run on the two-body kernels.
+  !> Whether the scene is written as arrays of more than two bodies (else with the
+  !> tutorial's scalars, one or two bodies: read, checked and built from those).
   pure logical function is_nbody(input)
     type(scene_input), intent(in) :: input
-    is_nbody = input%chain%n_bodies > 2
+    is_nbody = input%chain%n_bodies > tutorial_bodies
   end function is_nbody
-
-  !> Whether the N-body engine runs the built scene (run's dispatch): more bodies than the
-  !> two-body kernels' lanes, a moving ground, or a friction law (belt_v, v_s, c_v). Only
-  !> the other scenes are held to the kernels' room (pair_rows, pair_elements). Known once
-  !> build_scene has set the laws and the records' drives.
-  pure logical function runs_nbody(scene)
-    type(scene_type), intent(in) :: scene
-    runs_nbody = scene%n_bodies > max_lanes .or. scene%drives%n > 0 .or. scene%belts .or. scene%stribeck .or. &
-      scene%n_frictions > 0 .or. scene%geared
-  end function runs_nbody
 
   !> What the event log of a run of this input keeps (&run events; all by default).
   pure integer function events_kept(input)
@@ -735,9 +732,9 @@ contains
     scene%title = trim(input%text(i_title)%s)
     scene%method = 'event'
     if (len_trim(input%text(i_method)%s) > 0) scene%method = trim(input%text(i_method)%s)
-    ! Up to two bodies the two-body kernels run any records (set_rows counts their rows);
-    ! more run on the N-body engine (impact1d_nbody_solver), or, with the vissim method, on
-    ! the N-body form of the tutorial's scheme (impact1d_vissim).
+    ! One or two bodies from the tutorial's scalars, more from the arrays; any number runs on
+    ! the N-body engine (impact1d_nbody_solver), or on the vissim method's scheme
+    ! (impact1d_vissim).
     if (is_nbody(input)) then
       call set_chain_bodies(input, tables, scene)
     else
@@ -758,12 +755,10 @@ contains
     if (allocated(error)) return
     call set_gears(records, scene, error)
     if (allocated(error)) return
-    call set_rows(scene, error)
-    if (allocated(error)) return
+    call set_rows(scene)
     if (scene%belt_moves) call refuse_belt_contacts(scene, error)
     if (allocated(error)) return
-    call set_springs(scene, error)
-    if (allocated(error)) return
+    call set_springs(scene)
     scene%stage_powers = scene%drives%n > 0 .or. scene%belts .or. scene%stribeck .or. scene%n_stops > 0 .or. &
       scene%geared
     scene%gap_terms = scene%drives%n > 0 .or. scene%geared
@@ -923,8 +918,7 @@ contains
     end do
   end subroutine refuse_stops
 
-  !> The bodies (N: 2 with m2, else 1), their forces but the &sine records' (build_scene's),
-  !> and the kernels' view of them (pair).
+  !> The bodies (N: 2 with m2, else 1) and their forces but the &sine records' (build_scene's).
   subroutine set_bodies(input, tables, scene)
     type(scene_input), intent(in) :: input
     type(table_type), intent(in) :: tables(:)
@@ -948,12 +942,6 @@ contains
       if (input%given(i_mus1 + i - 1)) scene%body_static(i) = input%value(i_mus1 + i - 1) * scene%body_mass(i) * g
     end do
     scene%body_static = max(scene%body_static, scene%body_friction)
-    ! The kernels' view: the bodies padded to two, the rows' normals on both (with one body
-    ! both walls hold body 1).
-    scene%pair%n = n
-    scene%pair%mass(1:n) = scene%body_mass
-    scene%pair%friction(1:n) = scene%body_friction
-    scene%pair%static_friction(1:n) = scene%body_static
     ! Inputs of -0 enter as +0 (the limits too, in build_scene): sums over bodies and contacts
     ! drop absent terms exactly only when nothing they meet is -0, and a root formula takes
     ! the sign of a zero (docs/architecture.md, "Signed zeros").
@@ -1127,59 +1115,13 @@ contains
     end do
   end function ground_named
 
-  !> The element records as the two-body kernels see them (their ends as lanes: body i is
-  !> lane i, the ground 0), and the rate bound that samples their motion.
-  subroutine set_springs(scene, error)
+  !> Whether the forces depend on the state: element records (the engine reads them
+  !> themselves, impact1d_elements) or compliant stops (their rows, elements of the same kind
+  !> while engaged).
+  subroutine set_springs(scene)
     type(scene_type), intent(inout) :: scene
-    type(error_type), allocatable, intent(inout) :: error
-    integer :: ne
-    ne = scene%n_elements
-    if (runs_nbody(scene)) then
-      ! The N-body engine reads the element records themselves (impact1d_elements), and the
-      ! compliant stops' rows as elements of the same kind.
-      scene%springs%present = ne > 0 .or. scene%n_stops > 0
-      scene%springs%omega = rate_bound(scene%element_body, scene%element_k, scene%element_c, &
-        minval(scene%body_mass))
-      if (scene%n_stops > 0) scene%springs%omega = scene%springs%omega + stops_rate_bound(scene)
-      return
-    end if
-    if (ne > pair_elements) then
-      call raise(error, status_input, 'the scene has ' // trim(fmt(ne)) // ' springs and dampers: a scene ' // &
-        'of one or two bodies has at most ' // trim(fmt(pair_elements)) // ' (the two-body kernels'' elements)')
-      return
-    end if
-    scene%springs%n = ne
-    scene%springs%body(:, :ne) = scene%element_body
-    scene%springs%k(:ne) = scene%element_k
-    scene%springs%c(:ne) = scene%element_c
-    scene%springs%rest(:ne) = scene%element_rest
-    call scene%springs%set_normals()
-    scene%springs%present = ne > 0
-    ! The lightest body's mass (the scene's own: not the kernels' one-body phantom).
-    call scene%springs%set_frequency(minval(scene%body_mass))
-    if (scene%n_stops == 0) return
-    if (ne + scene%n_stops > pair_elements) then
-      call raise(error, status_input, 'the scene has ' // trim(fmt(ne)) // ' springs and dampers and ' // &
-        trim(fmt(scene%n_stops)) // ' compliant stop limits: a scene of one or two bodies has at most ' // &
-        trim(fmt(pair_elements)) // ' of them together (the two-body kernels'' elements)')
-      return
-    end if
-    ! Compliant stops are state-dependent forces too (springs' stepping and sampling; the pe
-    ! and damping_loss columns from springs_named); the sampling rate bounds them as if
-    ! engaged (sqrt(a + b) <= sqrt(a) + sqrt(b)).
-    scene%springs%omega = scene%springs%omega + stops_rate_bound(scene)
-    scene%springs%present = .true.
+    scene%springs%present = scene%n_elements > 0 .or. scene%n_stops > 0
   end subroutine set_springs
-
-  !> The compliant stops' rate bound, as if engaged.
-  pure real(wp) function stops_rate_bound(scene)
-    type(scene_type), intent(in) :: scene
-    integer :: j
-    associate (stops => [(j, j = scene%n_rows + 1, scene%n_rows + scene%n_stops)])
-      stops_rate_bound = rate_bound(scene%row_body(:, stops), scene%row_k(stops), scene%row_c(stops), &
-        minval(scene%body_mass))
-    end associate
-  end function stops_rate_bound
 
   !> Room for nc contact records, none of their limits present yet.
   subroutine allocate_contacts(scene, nc)
@@ -1203,18 +1145,12 @@ contains
   !> limit first (the row order decides ties, docs/nbody-plan.md B4). A lower limit's gap
   !> is (x_b - x_a) - d_min, an upper one's d_max - (x_b - x_a) (x_b - n x_a with a gear
   !> ratio n); a ground end has no coefficient. The two limits of a rigid link (d_min = d_max) are each other's partner.
-  subroutine set_rows(scene, error)
+  subroutine set_rows(scene)
     type(scene_type), intent(inout) :: scene
-    type(error_type), allocatable, intent(inout) :: error
     integer :: j, e, r, nr, pass
     real(wp) :: sgn
     logical :: suffix
     nr = count(scene%contact_has)
-    if (nr > pair_rows .and. .not. runs_nbody(scene)) then
-      call raise(error, status_input, 'the contacts have ' // trim(fmt(nr)) // ' limits: a scene of one or ' // &
-        'two bodies has at most ' // trim(fmt(pair_rows)) // ' (the two-body kernels'' rows)')
-      return
-    end if
     scene%n_stops = count(scene%contact_has .and. spread(scene%contact_k > 0.0_wp, 1, 2))
     scene%n_rows = nr - scene%n_stops
     allocate(scene%row_contact(nr), scene%row_body(2, nr), scene%row_normal(2, nr), scene%row_offset(nr), &
@@ -1251,17 +1187,6 @@ contains
             scene%row_partner(r) = r - 1
           end if
         end if
-      end do
-    end do
-    ! The two-body kernels' view: each row's coefficients on the pair's lanes (body i in
-    ! lane i). The N-body engine reads the rows themselves. The mode solve sees the rigid
-    ! rows only.
-    if (runs_nbody(scene)) return
-    scene%pair%n_rows = scene%n_rows
-    scene%pair%normal = 0.0_wp
-    do r = 1, nr
-      do e = 1, 2
-        if (scene%row_body(e, r) > 0) scene%pair%normal(scene%row_body(e, r), r) = scene%row_normal(e, r)
       end do
     end do
   end subroutine set_rows
@@ -1376,7 +1301,7 @@ contains
 
   !> The spring or damper with the fastest rate of its own ('k12 = 1e4'): sqrt(k / m) or c / m
   !> with m the mass it moves (the body's on a ground element, the reduced mass between
-  !> bodies; the pair's masses as the mode kernel sees them). Named as the tutorial names
+  !> bodies). Named as the tutorial names
   !> it: k<b> or c<b> to the ground, k<a><b> or c<a><b> between bodies.
   pure function fastest_element(scene) result(text)
     type(scene_type), intent(in) :: scene

@@ -10,7 +10,7 @@ module impact1d_stability
   use impact1d_kinds, only: wp, eps_wp
   implicit none
   private
-  public :: linear_modes, stable_step, mode_error, coarse_rate
+  public :: linear_modes, stable_step, mode_error, coarse_rate, assemble
 
   !> Above this |lambda| h the fastest mode is stepped coarsely (a warning, with its error):
   !> RK4's error per step is |z|^5 / 120, so a mode of w h = 0.5 is off by ~1e-3 a period.
@@ -198,4 +198,35 @@ contains
       h(j, j) = h(j, j) + mu
     end do
   end subroutine shifted_qr_step
+
+  !> The matrix of the elements' coefficients: each adds its coefficient to its bodies'
+  !> diagonal entries and takes it from their shared off-diagonal ones, in record order.
+  !> (An off-diagonal entry is set, not summed from +0: a link of coefficient 0 gives -0 there,
+  !> as the matrix written out for the tutorial's elements did.)
+  !> Elements given by their ends body(:, j) (0 the ground) and coefficients (the element
+  !> records, and the compliant stops' rows as if engaged: build_scene's check_step).
+  pure subroutine assemble(body, coefficient, matrix)
+    integer, intent(in) :: body(:, :)
+    real(wp), intent(in) :: coefficient(:)
+    real(wp), intent(out) :: matrix(:, :)
+    integer :: j
+    logical :: coupled(size(matrix, 1), size(matrix, 1))
+    matrix = 0.0_wp
+    coupled = .false.
+    do j = 1, size(coefficient)
+      associate (a => body(1, j), b => body(2, j))
+        matrix(b, b) = matrix(b, b) + coefficient(j)
+        if (a == 0) cycle
+        matrix(a, a) = matrix(a, a) + coefficient(j)
+        if (coupled(a, b)) then
+          matrix(a, b) = matrix(b, a) - coefficient(j)
+        else
+          matrix(a, b) = -coefficient(j)
+        end if
+        matrix(b, a) = matrix(a, b)
+        coupled(a, b) = .true.
+        coupled(b, a) = .true.
+      end associate
+    end do
+  end subroutine assemble
 end module impact1d_stability

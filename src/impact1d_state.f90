@@ -2,13 +2,11 @@
 !> positions, velocities and the ledger integrals are sums of many step increments, each
 !> kept as a value and its rounding error (the _lo parts).
 module impact1d_state
-  use, intrinsic :: iso_fortran_env, only: int64
   use impact1d_kinds, only: wp
-  use impact1d_lanes, only: max_lanes
   implicit none
   private
-  public :: state_type, lane_state_type, load_lanes, new_state, take_state, add_compensated, accumulate, &
-    renormalise, finite_state, constant_step, constant_steps, product_error
+  public :: state_type, new_state, take_state, add_compensated, accumulate, renormalise, finite_state, &
+    product_error
 
   !> Time, positions, velocities and the ledger integrals, compensated: a micrometre bounce
   !> near a wall at x = 10 m keeps its digits, and 10^6 steps of 1e-5 s do not drift the clock
@@ -30,18 +28,6 @@ module impact1d_state
     procedure, private :: copy_state
     generic :: assignment(=) => copy_state
   end type state_type
-
-  !> A state in lanes (impact1d_lanes' max_lanes; a lane past N idle at 0): what a step and
-  !> its location work on, and the run's state from its start on (run loads it from the
-  !> N-long start once); fixed-size, it needs no descriptors and holds two bodies in one
-  !> register.
-  type :: lane_state_type
-    real(wp) :: t = 0.0_wp, t_lo = 0.0_wp
-    real(wp), dimension(max_lanes) :: x = 0.0_wp, x_lo = 0.0_wp, v = 0.0_wp, v_lo = 0.0_wp
-    real(wp) :: work = 0.0_wp, work_lo = 0.0_wp, friction_loss = 0.0_wp, friction_lo = 0.0_wp
-    real(wp) :: impact_loss = 0.0_wp
-    real(wp) :: damping_loss = 0.0_wp, damping_lo = 0.0_wp
-  end type lane_state_type
 
 contains
 
@@ -161,73 +147,6 @@ contains
     lo = lo - (total - hi)
     hi = total
   end subroutine renormalise
-
-  !> The bodies' step of h under the constant acceleration a: RK4 is exact there, and its
-  !> step is the quadratic x + h v + h^2 a / 2, v + h a; both sums compensated and
-  !> renormalised. On the parts, not the state, so that a loop can keep them in registers;
-  !> the clock is the caller's (a step to a stop sets it to the stop).
-  pure subroutine constant_step(h, a, x, x_lo, v, v_lo)
-    real(wp), intent(in) :: h, a(max_lanes)
-    real(wp), dimension(max_lanes), intent(inout) :: x, x_lo, v, v_lo
-    call add_compensated(x, x_lo, h * ((v + v_lo) + (0.5_wp * h) * a))
-    call add_compensated(v, v_lo, h * a)
-  end subroutine constant_step
-
-  !> n steps of h under the constant velocity change dv per step (half_dv = dv / 2): RK4's
-  !> closed form, the sums accumulated but not renormalised (the low parts carry the
-  !> rounding meanwhile; the caller renormalises once at the end). Kept here, next to
-  !> accumulate, so the compiler inlines it into this hottest loop. The bodies in max_lanes
-  !> lanes (fixed-size arrays, unpack_motion's): the compiler keeps them in registers
-  !> through the loop and takes the lanes' chains of additions side by side.
-  pure subroutine constant_steps(n, h, dv, half_dv, t, t_lo, x, x_lo, v, v_lo)
-    integer(int64), intent(in) :: n
-    real(wp), intent(in) :: h, dv(max_lanes), half_dv(max_lanes)
-    real(wp), intent(inout) :: t, t_lo, x(max_lanes), x_lo(max_lanes), v(max_lanes), v_lo(max_lanes)
-    integer(int64) :: j
-    real(wp) :: t_, t_lo_, x_(max_lanes), x_lo_(max_lanes), v_(max_lanes), v_lo_(max_lanes)
-    ! Local copies: the compiler keeps them in registers through the loop.
-    t_ = t
-    t_lo_ = t_lo
-    x_ = x
-    x_lo_ = x_lo
-    v_ = v
-    v_lo_ = v_lo
-    do j = 1, n
-      call accumulate(t_, t_lo_, h)
-      call accumulate(x_, x_lo_, h * ((v_ + v_lo_) + half_dv))
-      call accumulate(v_, v_lo_, dv)
-    end do
-    t = t_
-    t_lo = t_lo_
-    x = x_
-    x_lo = x_lo_
-    v = v_
-    v_lo = v_lo_
-  end subroutine constant_steps
-
-  !> ls = s in lanes (a lane past N at 0). Lane by lane in a loop of max_lanes trips: moves
-  !> the compiler unrolls (a loop of N trips became calls to memcpy).
-  pure subroutine load_lanes(s, ls)
-    type(state_type), intent(in) :: s
-    type(lane_state_type), intent(out) :: ls
-    integer :: i
-    ls%t = s%t
-    ls%t_lo = s%t_lo
-    do i = 1, max_lanes
-      if (i > size(s%x)) exit
-      ls%x(i) = s%x(i)
-      ls%x_lo(i) = s%x_lo(i)
-      ls%v(i) = s%v(i)
-      ls%v_lo(i) = s%v_lo(i)
-    end do
-    ls%work = s%work
-    ls%work_lo = s%work_lo
-    ls%friction_loss = s%friction_loss
-    ls%friction_lo = s%friction_lo
-    ls%impact_loss = s%impact_loss
-    ls%damping_loss = s%damping_loss
-    ls%damping_lo = s%damping_lo
-  end subroutine load_lanes
 
   !> All of the state a run reports is finite.
   pure logical function finite_state(x, v, work)

@@ -5,20 +5,14 @@
 !> one-step delay); walls are limited integrators (positions clamped); friction follows the
 !> diagram's rules with a zero-velocity threshold (static friction's bound when at rest).
 !> Springs and dampers add their forces to the applied ones. Its errors are O(dt) by design.
-!> One or two bodies: on the bodies in lanes (impact1d_lanes) and the pair's view of the scene
-!> (scene%pair): one body is the pair with an idle second lane, which nothing moves. More
-!> bodies: the same rules on N-long arrays and the rows' ends (run_vissim_bodies).
+!> Any number of bodies, on N-long arrays and the rows' ends.
 module impact1d_vissim
   use, intrinsic :: iso_fortran_env, only: int64
   use impact1d_kinds, only: wp
-  use impact1d_lanes, only: max_lanes, to_lanes
   use impact1d_error, only: error_type, raise, status_simulation, fmt
   use impact1d_scene, only: scene_type, sample_time
-  use impact1d_modes, only: pair_rows
-  use impact1d_impacts, only: impulse, kinetic_energy
-  use impact1d_output, only: sink_type, run_stats, emit_sample, emit_bodies, class_impact, checkpoint
+  use impact1d_output, only: sink_type, run_stats, emit_bodies, class_impact, checkpoint
   use impact1d_event_log, only: log_event
-  use impact1d_loads, only: applied_force
   use impact1d_elements, only: element_potential, element_damping_power
   use impact1d_nbody_step, only: nbody_force
   implicit none
@@ -31,162 +25,26 @@ module impact1d_vissim
 contains
 
   !> Run a scene by the tutorial's scheme from t = 0 to t_end, every dt_out sample and every
-  !> impact to sink.
+  !> impact to sink, on N-long arrays and the rows' ends (docs/method.md section 7). Each step
+  !> is RK4 on x' = thr(v), v' = (f + friction) / m; a row whose gap went from >= 0 to < 0 over
+  !> the step takes Newton's impulse on its two ends from their velocities before the step
+  !> (rows between bodies first, in row order, then the walls, which clamp their body's
+  !> position); after a collision every body's velocity before is its velocity now, for any
+  !> later row of the same step. Memory allocated once: nothing per step.
   subroutine run_vissim(scene, sink, stats, error)
     type(scene_type), intent(in) :: scene
     class(sink_type), intent(inout) :: sink
     type(run_stats), intent(inout) :: stats   !< fresh from run (its interrupt epoch set)
     type(error_type), allocatable, intent(out) :: error
-    real(wp), dimension(max_lanes) :: x, v, v_prev, x_new, v_new, v_hit
-    real(wp) :: t, work, friction_loss, impact_loss
-    real(wp) :: ke0, pe0, h, t_sample, gap_before(pair_rows), dwork, dfriction
-    real(wp) :: damping_loss, ddamping
-    integer :: j_sample, k, n_order, order(pair_rows)
-
-    if (scene%n_bodies > max_lanes) then
-      call run_vissim_bodies(scene, sink, stats, error)
-      return
-    end if
-    call collision_order(scene, order, n_order)
-
-    ! v is the velocity integrator's state; the diagram passes it through the zero-velocity
-    ! threshold before anything uses it (Figure 13), so what moves the bodies is threshold(v).
-    t = 0.0_wp
-    call to_lanes(scene%body_x0, x)
-    call to_lanes(scene%body_v0, v)
-    work = 0.0_wp
-    friction_loss = 0.0_wp
-    impact_loss = 0.0_wp
-    damping_loss = 0.0_wp
-    ke0 = kinetic_energy(scene, threshold(v))
-    pe0 = scene%springs%potential(x, [0.0_wp, 0.0_wp])
-    j_sample = 0
-    call emit()
-    if (allocated(error)) return
-    do while (j_sample < scene%n_samples)
-      t_sample = sample_time(scene, j_sample)
-      h = step_toward(scene, t, t_sample)
-      v_prev = v
-      do k = 1, scene%n_rows
-        gap_before(k) = gap(k, x)
-      end do
-      call rk4(t, x, v, h, x_new, v_new, dwork, dfriction, ddamping)
-      t = t + h
-      if (t_sample - t <= sample_snap * scene%dt) t = t_sample
-      x = x_new
-      v = v_new
-      work = work + dwork
-      friction_loss = friction_loss + dfriction
-      damping_loss = damping_loss + ddamping
-      call count_step(scene, sink, stats, t, error)
-      if (allocated(error)) return
-      if (.not. all(abs([x, v]) <= huge(1.0_wp))) then
-        call raise(error, status_simulation, 'at t = ' // trim(fmt(t)) // ': the state is no longer finite')
-        return
-      end if
-      ! Collisions seen at the step's end: the slot's first, then the walls on what it left.
-      do k = 1, n_order
-        associate (c => order(k))
-          if (.not. (gap_before(c) >= 0.0_wp .and. gap(c, x) < 0.0_wp)) cycle
-          v_hit = threshold(v)
-          ! A wall clamps the body it faces: normal . x + offset = 0.
-          if (scene%row_body(1, c) == 0) x(scene%row_body(2, c)) = -scene%row_offset(c) / scene%row_normal(2, c)
-          call impulse(scene, c, scene%row_restitution(c), threshold(v_prev), v_new)
-          where (scene%pair%normal(:, c) == 0.0_wp) v_new = v
-          impact_loss = impact_loss + kinetic_energy(scene, threshold(v)) - kinetic_energy(scene, threshold(v_new))
-          v = v_new
-          v_prev = v
-          call log_event(scene, sink, stats, t, class_impact, c, v_hit, threshold(v))
-        end associate
-      end do
-      if (t == t_sample) then
-        call emit()
-        if (allocated(error)) return
-      end if
-    end do
-    call sink%end_progress()
-
-  contains
-
-    subroutine emit()
-      call emit_sample(sink, stats, t, x, threshold(v), scene%pair%mass, ke0, work, friction_loss, impact_loss, &
-        scene%springs%present, [scene%springs%potential(x, [0.0_wp, 0.0_wp]), pe0, damping_loss], error)
-      j_sample = j_sample + 1
-    end subroutine emit
-
-    pure real(wp) function gap(k, positions)
-      integer, intent(in) :: k
-      real(wp), intent(in) :: positions(max_lanes)
-      gap = dot_product(scene%pair%normal(:, k), positions) + scene%row_offset(k)
-    end function gap
-
-    !> The diagram's "no movement on zero velocity": |v| <= threshold reads as zero.
-    pure function threshold(velocity) result(thresholded)
-      real(wp), intent(in) :: velocity(max_lanes)
-      real(wp) :: thresholded(max_lanes)
-      thresholded = zero_below(velocity, scene%zero_velocity)
-    end function threshold
-
-    pure function friction(velocity, f) result(force)
-      real(wp), intent(in) :: velocity(max_lanes), f(max_lanes)
-      real(wp) :: force(max_lanes)
-      force = friction_block(velocity, f, scene%pair%friction, scene%pair%static_friction, scene%zero_velocity)
-    end function friction
-
-    !> Classical RK4 on x' = thr(v), v' = (f + friction(thr(v), f)) / m, with the work, friction
-    !> and damping dissipation integrated by the same stages (f: the applied forces, springs'
-    !> and dampers' included; the work is the external forces' only).
-    subroutine rk4(t0, x0, v0, step, x1, v1, dw, dd, dc)
-      real(wp), intent(in) :: t0, x0(max_lanes), v0(max_lanes), step
-      real(wp), intent(out) :: x1(max_lanes), v1(max_lanes), dw, dd, dc
-      real(wp) :: kx(max_lanes, 4), kv(max_lanes, 4), kw(4), kd(4), kc(4), f(max_lanes), fr(max_lanes)
-      real(wp) :: vs(max_lanes), ts, dx(max_lanes), f_ext(max_lanes)
-      integer :: stage
-      real(wp), parameter :: c(4) = [0.0_wp, 0.5_wp, 0.5_wp, 1.0_wp], b(4) = [1.0_wp, 2.0_wp, 2.0_wp, 1.0_wp]
-      do stage = 1, 4
-        ts = t0 + c(stage) * step
-        vs = v0
-        dx = 0.0_wp
-        if (stage > 1) vs = v0 + c(stage) * step * kv(:, stage - 1)
-        if (stage > 1) dx = c(stage) * step * kx(:, stage - 1)
-        vs = threshold(vs)
-        call applied_force(scene, ts, x0, dx, vs, f)
-        fr = friction(vs, f)
-        kx(:, stage) = vs
-        kv(:, stage) = (f + fr) / scene%pair%mass
-        call scene%forcing%force(ts, f_ext)
-        kw(stage) = dot_product(f_ext, vs)
-        kd(stage) = -dot_product(fr, vs)
-        kc(stage) = scene%springs%damping_power(vs)
-      end do
-      dc = step / 6.0_wp * dot_product(kc, b)
-      x1 = x0 + step / 6.0_wp * matmul(kx, b)
-      v1 = v0 + step / 6.0_wp * matmul(kv, b)
-      dw = step / 6.0_wp * dot_product(kw, b)
-      dd = step / 6.0_wp * dot_product(kd, b)
-    end subroutine rk4
-  end subroutine run_vissim
-
-  !> run_vissim on more than two bodies: the same rules on N-long arrays and the rows' ends
-  !> (docs/method.md section 7). Each step is RK4 on x' = thr(v), v' = (f + friction) / m; a
-  !> row whose gap went from >= 0 to < 0 over the step takes Newton's impulse on its two ends
-  !> from their velocities before the step (rows between bodies first, in row order, then the
-  !> walls, which clamp their body's position); after a collision every body's velocity
-  !> before is its velocity now, for any later row of the same step. Memory allocated once:
-  !> nothing per step.
-  subroutine run_vissim_bodies(scene, sink, stats, error)
-    type(scene_type), intent(in) :: scene
-    class(sink_type), intent(inout) :: sink
-    type(run_stats), intent(inout) :: stats
-    type(error_type), allocatable, intent(out) :: error
-    real(wp), allocatable, dimension(:) :: x, v, v_prev, x_new, v_new, v_out, zero, gap_before, f, fr, f_ext, vs, dx
+    real(wp), allocatable, dimension(:) :: x, v, v_prev, x_new, v_new, v_out, v_hit, zero, gap_before, f, fr, &
+      f_ext, vs, dx
     real(wp), allocatable :: kx(:, :), kv(:, :)
     integer, allocatable :: order(:)
     real(wp) :: t, h, t_sample, work, friction_loss, impact_loss, damping_loss, ke0, pe0
     integer :: n, j_sample, k, n_order
 
     n = scene%n_bodies
-    allocate(x(n), v(n), v_prev(n), x_new(n), v_new(n), v_out(n), zero(n), f(n), fr(n), f_ext(n), vs(n), &
+    allocate(x(n), v(n), v_prev(n), x_new(n), v_new(n), v_out(n), v_hit(n), zero(n), f(n), fr(n), f_ext(n), vs(n), &
       dx(n), kx(n, 4), kv(n, 4), gap_before(scene%n_rows), order(scene%n_rows))
     call collision_order(scene, order, n_order)
     t = 0.0_wp
@@ -252,7 +110,9 @@ contains
     end function gap
 
     !> Row c crossed in the last step: a wall clamps its body onto the limit; Newton's impulse
-    !> with the row's restitution on the ends' thresholded velocities before the step.
+    !> with the row's restitution on the ends' thresholded velocities before the step. The
+    !> log takes every body's thresholded velocities at the hit and after (log_event reports
+    !> the row's ends from them, or with one or two bodies the bodies, as the tutorial's log).
     subroutine collide(c)
       integer, intent(in) :: c
       real(wp) :: before(2), after(2), hit(2), n_end(2), m(2), u, p
@@ -271,6 +131,7 @@ contains
         hit(e) = zero_below(v(ends(e)), scene%zero_velocity)
         m(e) = scene%body_mass(ends(e))
       end do
+      v_hit = zero_below(v, scene%zero_velocity)
       if (ends(1) == 0) x(ends(2)) = -scene%row_offset(c) / scene%row_normal(2, c)
       u = dot_product(n_end, before)
       p = -(1.0_wp + scene%row_restitution(c)) * u / dot_product(n_end**2, 1.0_wp / m)
@@ -281,12 +142,14 @@ contains
         after(e) = zero_below(after(e), scene%zero_velocity)
         impact_loss = impact_loss + 0.5_wp * m(e) * (hit(e)**2 - after(e)**2)
       end do
-      v_prev = v     ! (O(N) a collision: run_vissim's rule, which later rows of the step see)
-      call log_event(scene, sink, stats, t, class_impact, c, hit, after)
+      v_prev = v     ! (O(N) a collision: the diagram's rule, which later rows of the step see)
+      v_out = zero_below(v, scene%zero_velocity)
+      call log_event(scene, sink, stats, t, class_impact, c, v_hit, v_out)
     end subroutine collide
 
     !> One classical RK4 step of length h from (t, x, v) to (x_new, v_new), the work, friction
-    !> and damping dissipation integrated by the same stages (as run_vissim's rk4).
+    !> and damping dissipation integrated by the same stages (the work is the external forces'
+    !> only: f holds the springs' and dampers' too).
     subroutine rk4()
       real(wp) :: kw(4), kd(4), kc(4), ts
       integer :: stage
@@ -301,11 +164,18 @@ contains
           dx = c(stage) * h * kx(:, stage - 1)
         end if
         vs = zero_below(vs, scene%zero_velocity)
-        call nbody_force(scene, ts, x, dx, vs, f)
+        call scene%forcing%force_all(ts, f_ext)
+        f = f_ext
+        if (scene%springs%present) then
+          ! The elements' pulls summed from +0, then added to the external forces: the order
+          ! the tutorial's scenes were first run in (tests/golden), which adding each pull
+          ! to f in turn would round otherwise.
+          call nbody_force(scene, ts, x, dx, vs, f, external=zero)
+          f = f_ext + f
+        end if
         fr = friction_block(vs, f, scene%body_friction, scene%body_static, scene%zero_velocity)
         kx(:, stage) = vs
         kv(:, stage) = (f + fr) / scene%body_mass
-        call scene%forcing%force_all(ts, f_ext)
         kw(stage) = dot_product(f_ext, vs)
         kd(stage) = -dot_product(fr, vs)
         if (scene%springs%present) kc(stage) = element_damping_power(scene, vs)
@@ -316,7 +186,7 @@ contains
       friction_loss = friction_loss + h / 6.0_wp * (((kd(1) + 2.0_wp * kd(2)) + 2.0_wp * kd(3)) + kd(4))
       damping_loss = damping_loss + h / 6.0_wp * (((kc(1) + 2.0_wp * kc(2)) + 2.0_wp * kc(3)) + kc(4))
     end subroutine rk4
-  end subroutine run_vissim_bodies
+  end subroutine run_vissim
 
   !> A step taken at t: counted, and every 4096th a checkpoint (progress, Ctrl-C).
   subroutine count_step(scene, sink, stats, t, error)

@@ -102,7 +102,8 @@ def test_three_bilinear_oscillators_converge_at_order_four():
 
 
 # ---------------------------------------------------------------------------------------
-# (b) The two-body engine's compliant scenes through the N-body engine.
+# (b) One- and two-body compliant scenes, on a still ground and on one moving at 0 m/s (the
+# two-body engine's scenes once, compared with the N-body engine through that record).
 def two_body_scenes():
     bilinear = dict(m1=1.0, x1=1.0, v1=0.0, k1=4.0, x1_rest=0.0, t_end=10.0)
     thrown = dict(m1=1.0, x1=1.0, v1=-2.0, t_end=2.0)
@@ -127,10 +128,9 @@ def two_body_scenes():
 @pytest.mark.parametrize("dt", [1e-3, 0.02])
 @pytest.mark.parametrize("name", sorted(two_body_scenes()))
 def test_two_body_compliant_scenes_agree_across_engines(name, dt):
-    """The same scene on the two-body engine and, its ground-end record moving at 0 m/s, on
-    the N-body engine: the same events (kinds, times to 1e-12 s, velocities to 1e-12), the
-    same samples and ledger to 1e-10 (the integrator's own rounding: the two engines sum the
-    same RK4 stages in another order)."""
+    """The same scene on a still ground and with its ground-end record moving at 0 m/s (the
+    moving-ground path: the drives' exact w(t), the stages' drive power): the same events
+    (kinds, times to 1e-12 s, velocities to 1e-12), the same samples and ledger to 1e-10."""
     scene = impact1d.Scene(dt=dt, **two_body_scenes()[name])
     contacts = [dict(c) for c in scene.contacts]
     ground = next(c for c in contacts if c["a"] == 0)
@@ -360,8 +360,7 @@ def test_set_down_at_rest_on_a_compliant_floor(bodies, ground_v):
     again, and the run ended at the work limit) and the stack sinks to p_eq = M g / k as
     the damped oscillator from rest: p = p_eq (1 - e^(-zeta wn t) (cos(wd t) + zeta wn / wd
     sin(wd t))), wn = sqrt(k / M), zeta = c / (2 sqrt(k M)), wd = wn sqrt(1 - zeta^2). One
-    body on the two-body engine and on the N-body one (ground_v = 0), three on the N-body
-    one; the samples within 1e-9 m of the closed form at dt = 1e-3, no other floor event."""
+    body on a still floor and on one moving at 0 m/s (ground_v = 0), three on a still one; the samples within 1e-9 m of the closed form at dt = 1e-3, no other floor event."""
     masses = [6.0] if bodies == 1 else [1.0, 2.0, 3.0]
     k, c = 1000.0, 20.0
     floor = dict(a=0, b=1, d_min=0.0, k=k, c=c, name="floor")

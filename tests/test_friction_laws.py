@@ -87,8 +87,8 @@ def test_coulomb_belt_stick_slip_cycle_has_its_closed_form(dt, tol):
 
 
 def test_belt_at_zero_speed_runs_as_the_still_ground():
-    """belt_v = 0 sends a Coulomb stick-slip scene to the N-body engine: the same events and
-    motion as the two-body engine on the still ground, to 1e-9."""
+    """belt_v = 0 (the belt law's path: the slip v - belt_v) on a Coulomb stick-slip scene:
+    the same events and motion as on the still ground, to 1e-9."""
     still = dataclasses.replace(block_on_belt(1e-3, 3.0), belt_v=None, v1=0.6, x1=0.0, k1=K)
     belt = dataclasses.replace(still, belt_v=[0.0])
     a, b = impact1d.simulate(still), impact1d.simulate(belt)

@@ -146,9 +146,8 @@ def three_bodies(contacts=(), springs=(), **extra):
 
 
 def test_a_ratio_of_one_is_no_ratio():
-    """(b): ratio = 1 written on every record gives the bits of the records without it, on
-    the N-body engine (three bodies) and on the two-body engine (which keeps it: ratio 1
-    does not send a scene to the N-body engine)."""
+    """(b): ratio = 1 written on every record gives the bits of the records without it
+    (ratio 1 does not make a scene geared)."""
     contacts = [{"a": 1, "b": 2, "d_min": 0.1, "r_min": 0.7, "d_max": 0.5, "r_max": 0.9},
                 {"a": 2, "b": 3, "d_min": 0.2, "r_min": 0.5}]
     springs = [{"a": 1, "b": 3, "k": 30.0, "d_rest": 1.0, "c": 0.3}]

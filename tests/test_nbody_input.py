@@ -135,8 +135,8 @@ def test_records_are_repeatable_and_given_twice_is_per_record(tmp_path):
 
 @pytest.mark.parametrize("extra", ["&contact a = 1, b = 2, d_min = -1 /", "&spring a = 0, b = 1, k = 1, d_rest = 1 /"])
 def test_records_on_two_bodies_run(tmp_path, extra):
-    """Records on one or two bodies run on the two-body kernels (tests/test_records_run.py
-    checks what they give); the scene read back keeps them."""
+    """Records on one or two bodies run (tests/test_records_run.py checks what they give);
+    the scene read back keeps them."""
     scene = impact1d.load_scene(scene_file(tmp_path, CASE3 + extra + "\n"))
     res = impact1d.simulate(scene)
     assert res.events.size > 0 and (res.scene.contacts or res.scene.springs)

@@ -7,8 +7,8 @@ ground, no compliant stop, no friction law), each on its own: body 1 a damped sp
 under a sine force bouncing on a wall (each impact changes its velocity, so its damper's
 force), body 2 a block on a spring under a sine force with dry friction (it sticks and
 slips: each time the mode changes its acceleration), body 3 free and far away. Each of the
-first two run alone is a one-body scene of the two-body engine, whose kept force is keyed on
-the whole state: the same events, each within 1e-9 s, and samples within 1e-9 (measured
+first two run alone is a one-body scene (the two-body engine's once, whose kept force was keyed
+on the whole state): the same events, each within 1e-9 s, and samples within 1e-9 (measured
 6e-13 m, 4e-12 m/s; with the event point's forgetting left out, 3e-4 m and 3e-3 m/s, and
 body 2's stick-slip sequence changed).
 """

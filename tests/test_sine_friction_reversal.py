@@ -1,6 +1,6 @@
 """A block sliding under a sine force and Coulomb friction (no stops), against its exact
-motion: both engines (issue 19's one engine: the scene as written runs on the two-body
-engine, with `ground_v = 0` on a record on the N-body engine).
+motion: on a still ground and with `ground_v = 0` on a record (the moving-ground path; the
+two engines these were before issue 19's one engine).
 
 Body 2 (m = 2 kg, mu = 0.1, g = 9.81) is pushed by F sin(w t), F = 10 N, w = 2 pi / 0.7;
 body 1 stays stuck (nothing pushes it) and the buffer between them never closes. Between

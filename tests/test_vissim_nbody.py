@@ -158,3 +158,15 @@ def test_a_compliant_stop_is_refused_by_name():
                            contacts=[dict(a=1, b=2, d_min=0.5, k=1.0e4, name="buffer")], t_end=1.0, dt=1e-3)
     with pytest.raises(impact1d.InputError, match="the &contact 'buffer' has k = 10000"):
         impact1d.simulate(scene, method="vissim")
+
+
+def test_two_body_wall_impact_reports_both_bodies():
+    """One rule for every N, the tutorial's log for one and two bodies: a wall's impact in a
+    two-body scene reports (v1, v2) before and after, body 2's velocity where the row's ends
+    would give the wall's 0 (the N > 2 record: a, b and the ends' velocities)."""
+    scene = impact1d.Scene(m1=1.0, m2=2.0, x1=0.5, v1=-1.0, x2=5.0, v2=0.75, x_left=0.0,
+                           r_left=0.5, t_end=0.75, dt=1.0 / 64, dt_out=0.25)
+    res = vissim(scene, 1.0 / 64, 0.25)
+    assert [str(k) for k in res.events["kind"]] == ["left"]
+    e = res.events[0]
+    assert (e["v1_before"], e["v2_before"], e["v1_after"], e["v2_after"]) == (-1.0, 0.75, 0.5, 0.75)

@@ -1,27 +1,18 @@
-!> The cluster mode solve (impact1d_cluster_mode) against today's exact enumerator
-!> (impact1d_modes' solve_mode, through its pair_type) on random 1- and 2-body problems, and
-!> on closed forms with N bodies: a chain pushed along the ground breaks away when the push
-!> exceeds sum s_i, a stack resting on the floor carries its weight, its top lifted off; and
+!> The cluster mode solve (impact1d_cluster_mode) on closed forms with N bodies: a chain
+!> pushed along the ground breaks away when the push exceeds sum s_i, a stack resting on the floor carries its weight, its top lifted off; and
 !> random chains of 3 to 8 bodies checked against the conditions that define a mode.
 program test_cluster_mode
   use impact1d_kinds, only: wp
-  use impact1d_modes, only: mode_type, pair_type, solve_mode, pair_rows
   use impact1d_clusters, only: row_rate
   use impact1d_cluster_mode, only: cluster_work_type, cluster_reserve, cluster_mode, cluster_solved
   use testing, only: check, finish, seed_random
   implicit none
-  integer, parameter :: max_n = 8, trials = 20000
-  !> Rows a random problem picks from: ends (a, b) and coefficients (n_a, n_b) on x_b - x_a.
-  integer, parameter :: menu_body(2, 6) = reshape([0, 1, 0, 1, 0, 2, 0, 2, 1, 2, 1, 2], [2, 6])
-  real(wp), parameter :: menu_normal(2, 6) = reshape([0.0_wp, 1.0_wp, 0.0_wp, -1.0_wp, 0.0_wp, 1.0_wp, &
-    0.0_wp, -1.0_wp, -1.0_wp, 1.0_wp, 1.0_wp, -1.0_wp], [2, 6])
+  integer, parameter :: max_n = 8
   type(cluster_work_type) :: work
-  integer :: i
 
   call seed_random(104729, 3)
   call cluster_reserve(work, max_n, 2 * max_n)
 
-  call against_enumerator()
   call longer_outputs()
   call random_chains()
   call pushed_chain()
@@ -30,161 +21,6 @@ program test_cluster_mode
   call finish('test_cluster_mode')
 
 contains
-
-  !> trials random problems of 1 or 2 bodies: the accelerations of the two solvers agree to
-  !> 1e-13 of the problem's acceleration scale, and where the LCP's mode is strict (no force
-  !> at a bound, no closed row without force, held rows independent) so do held rows and
-  !> stuck bodies.
-  subroutine against_enumerator()
-    type(pair_type) :: pair
-    type(mode_type) :: mode
-    real(wp) :: f(2), df(2), v(2), a_enum(2), a(2), sgn(2), lambda(4), friction_force(2), scale, worst
-    real(wp) :: row_normal(2, 4)
-    integer :: row_body(2, 4), n, nr, status, unique, same_set, not_found, bad
-    logical :: candidate(4), active(4), stuck(2), found, resting(2), candidate_rows(pair_rows)
-    worst = 0.0_wp
-    unique = 0
-    same_set = 0
-    not_found = 0
-    bad = 0
-    do i = 1, trials
-      call random_problem(pair, f, df, v, row_body, row_normal, candidate, n, nr)
-      resting = v == 0.0_wp .and. pair%static_friction > 0.0_wp
-      ! The enumerator's arrays are pair_rows long: the problem's rows first, none after.
-      candidate_rows = .false.
-      candidate_rows(1:4) = candidate
-      call solve_mode(pair, f, df, candidate_rows, resting, merge(0.0_wp, sign(1.0_wp, v), v == 0.0_wp), mode, found)
-      if (.not. found) then
-        not_found = not_found + 1
-        cycle
-      end if
-      call mode%acceleration(f, a_enum)
-      call cluster_mode(work, pair%mass(1:n), f(1:n), df(1:n), pair%friction(1:n), pair%static_friction(1:n), &
-        v(1:n), row_body(:, 1:nr), row_normal(:, 1:nr), candidate(1:nr), a, active, stuck, sgn, lambda, &
-        friction_force, status)
-      scale = (sum(abs(f(1:n))) + 2.0_wp * sum(pair%static_friction(1:n))) / minval(pair%mass(1:n)) + tiny(1.0_wp)
-      if (status /= cluster_solved) then
-        print *, 'status', status, i, n, nr
-        print *, pair%mass(1:n), f(1:n), df(1:n), pair%friction(1:n), pair%static_friction(1:n), v(1:n)
-        print *, row_body(:, 1:nr), row_normal(:, 1:nr), candidate(1:nr)
-        bad = bad + 1
-        cycle
-      end if
-      worst = max(worst, maxval(abs(a(1:n) - a_enum(1:n))) / scale)
-      if (maxval(abs(a(1:n) - a_enum(1:n))) > 1.0e-13_wp * scale .and. bad < 5) then
-        bad = bad + 1
-        print '(a, i0, a, i0, 2(a, 2es12.4))', 'trial ', i, ' n ', n, ': LCP a = ', a, ' enumerator a = ', a_enum
-        print '(a, 2es12.4, a, 2es12.4, a, 2es12.4, a, 2es12.4)', '  m', pair%mass, ' f', f, ' c', pair%friction, &
-          ' s', pair%static_friction
-        print '(a, 2es12.4, a, 2es12.4, a, 4l2, a, 8f5.1)', '  v', v, ' df', df, ' cand', candidate, ' normals', pair%normal
-        print *, ' enum active', mode%active, ' stuck', mode%stuck, ' lcp active', active, ' stuck', stuck
-      end if
-      if (.not. strict(pair, f, v, candidate, n, nr, a, lambda, friction_force, stuck, active)) cycle
-      unique = unique + 1
-      if (all(active(1:nr) .eqv. mode%active(1:nr)) .and. all(stuck(1:n) .eqv. mode%stuck(1:n))) then
-        same_set = same_set + 1
-      else if (unique - same_set < 6) then
-        print '(a, i0, a, i0, 2(a, 2es12.4))', 'trial ', i, ' n ', n, ': LCP a = ', a, ' enumerator a = ', a_enum
-        print '(a, 2es12.4, a, 2es12.4, a, 2es12.4, a, 2es12.4)', '  m', pair%mass, ' f', f, ' c', pair%friction, &
-          ' s', pair%static_friction
-        print '(a, 2es12.4, a, 2es12.4, a, 4l2, a, 8f5.1)', '  v', v, ' df', df, ' cand', candidate, ' normals', pair%normal
-        print *, ' enum active', mode%active, ' stuck', mode%stuck, ' lcp active', active, ' stuck', stuck, 'lam', lambda
-      end if
-    end do
-    print '(a, i0, a, es10.3, a, i0, a, i0, a, i0)', 'random problems: ', trials, ', worst |a - a_enum| / scale ', &
-      worst, ', unique modes ', unique, ' of which the same ', same_set, ', enumerator found none ', not_found
-    call check(bad == 0, 'random 1-2 body problems: the LCP mode solve ends and agrees to 1e-13')
-    call check(not_found == 0, 'random 1-2 body problems: the enumerator finds a mode')
-    call check(unique > trials / 4 .and. same_set == unique, 'random problems: the same held rows and stuck bodies where unique')
-  end subroutine against_enumerator
-
-  !> A random problem of n = 1 or 2 bodies (masses 0.2..5, bounds 0..3 with s = c or up to
-  !> 2c, forces -8..8, half at rest) and up to 4 rows from the menu (n = 1: its walls),
-  !> each a candidate with probability 0.7; a tenth of the forces exactly at a bound.
-  subroutine random_problem(pair, f, df, v, row_body, row_normal, candidate, n, nr)
-    type(pair_type), intent(out) :: pair
-    real(wp), intent(out) :: f(2), df(2), v(2), row_normal(2, 4)
-    integer, intent(out) :: row_body(2, 4), n, nr
-    logical, intent(out) :: candidate(4)
-    real(wp) :: u(16)
-    integer :: j, pick, b
-    logical :: taken(6)
-    call random_number(u)
-    n = merge(1, 2, u(1) < 0.3_wp)
-    pair%n = n
-    pair%n_rows = 4       ! the four rows random rows are drawn into (unused ones: no normal, never candidates)
-    f = 0.0_wp
-    df = 0.0_wp
-    v = 0.0_wp
-    do b = 1, n
-      pair%mass(b) = 0.2_wp * 25.0_wp**u(1 + b)
-      pair%friction(b) = merge(0.0_wp, 3.0_wp * u(3 + b), u(5 + b) < 0.2_wp)
-      pair%static_friction(b) = pair%friction(b) * merge(1.0_wp, 1.0_wp + u(7 + b), u(9 + b) < 0.5_wp)
-      f(b) = 16.0_wp * u(11 + b) - 8.0_wp
-      if (u(13 + b) < 0.1_wp) f(b) = sign(pair%static_friction(b), f(b))
-      if (u(13 + b) > 0.5_wp) df(b) = 2.0_wp * u(13 + b) - 1.5_wp
-      if (u(9 + b) > 0.6_wp) v(b) = sign(0.5_wp, u(9 + b) - 0.8_wp)
-    end do
-    call random_number(u)
-    nr = int(5.0_wp * u(1))
-    taken = .false.
-    pair%normal = 0.0_wp
-    row_body = 0
-    row_normal = 0.0_wp
-    candidate = .false.
-    do j = 1, nr
-      do
-        call random_number(u(2))
-        pick = 1 + int(6.0_wp * u(2))
-        if (n == 1 .and. pick > 2) cycle
-        if (.not. taken(pick) .or. count(taken(1:merge(2, 6, n == 1))) == merge(2, 6, n == 1)) exit
-      end do
-      taken(pick) = .true.
-      row_body(:, j) = menu_body(:, pick)
-      row_normal(:, j) = menu_normal(:, pick)
-      ! The enumerator's normal is on the pair's two bodies; the LCP's on the row's ends.
-      pair%normal(menu_body(2, pick), j) = menu_normal(2, pick)
-      if (menu_body(1, pick) > 0) pair%normal(menu_body(1, pick), j) = menu_normal(1, pick)
-      candidate(j) = u(2 + j) < 0.7_wp
-    end do
-  end subroutine random_problem
-
-  !> Whether the LCP's mode is the only one: every candidate row pushes or separates clearly,
-  !> every body at rest sticks inside its bound or moves clearly, and the rows held and the
-  !> stuck bodies are independent (no row held between two already joined ends).
-  logical function strict(pair, f, v, candidate, n, nr, a, lambda, friction_force, stuck, active)
-    type(pair_type), intent(in) :: pair
-    real(wp), intent(in) :: f(2), v(2), a(2), lambda(4), friction_force(2)
-    integer, intent(in) :: n, nr
-    logical, intent(in) :: candidate(4), stuck(2), active(4)
-    real(wp) :: delta, na, rows(2, 6)
-    integer :: k, b, locked
-    delta = 1.0e-9_wp * (sum(abs(f)) + sum(pair%static_friction)) / minval(pair%mass(1:n))
-    strict = .false.
-    locked = 0
-    do b = 1, n
-      if (.not. stuck(b)) cycle
-      locked = locked + 1
-      rows(:, locked) = 0.0_wp
-      rows(b, locked) = 1.0_wp
-    end do
-    do k = 1, nr
-      if (.not. candidate(k)) cycle
-      na = dot_product(pair%normal(:, k), a)
-      if (lambda(k) <= delta * pair%mass(1) .and. na <= delta) return
-      if (.not. active(k)) cycle
-      locked = locked + 1
-      rows(:, locked) = pair%normal(:, k)
-    end do
-    do b = 1, n
-      if (v(b) /= 0.0_wp .or. pair%static_friction(b) == 0.0_wp) cycle
-      if (stuck(b) .and. abs(friction_force(b)) >= pair%static_friction(b) - delta * pair%mass(b)) return
-      if (.not. stuck(b) .and. abs(a(b)) <= delta) return
-    end do
-    ! The locked rows (stuck bodies' e_i, held rows' normals) independent.
-    strict = locked <= 1 .or. (locked == 2 .and. rows(1, 1) * rows(2, 2) /= rows(2, 1) * rows(1, 2))
-    if (n == 1 .and. locked == 2) strict = .false.
-  end function strict
 
   !> Output arrays longer than the problem's rows, after a problem with more rows: the rows
   !> beyond get no contact force (they read the earlier problem's numbering, and under

@@ -1,7 +1,7 @@
-!> The bounce series' time in closed form, against the sum of its arcs.
+!> The bounce series' time in closed form (impact1d_nbody_event), against the sum of its arcs.
 program test_event_point
   use impact1d_kinds, only: wp
-  use impact1d_event_point, only: bounce_series_time
+  use impact1d_nbody_event, only: bounce_series_time
   use testing, only: check, finish
   implicit none
   ! The closed form and a summed geometric series differ by rounding: some ulps.

@@ -1,8 +1,8 @@
 !> Event location: the earliest root of a cubic on a step, including two roots inside one
-!> step (a fast bounce) and a graze that must not count.
+!> step (a fast bounce) and a graze that must not count; the quiet time of a falling body.
 program test_events
-  use impact1d_kinds, only: wp
-  use impact1d_events, only: earliest_crossing, hermite, poly_value
+  use impact1d_kinds, only: wp, eps_wp
+  use impact1d_events, only: earliest_crossing, hermite, poly_value, first_negative
   use testing, only: check, finish
   implicit none
   ! Roots of these cubics are known to the last bit; bisection should land within a few ulps.
@@ -42,6 +42,11 @@ program test_events
   ! Hermite dense output reproduces a cubic motion exactly: x = 2 t - 3 t^2 + 0.5 t^3 on [0, 0.7].
   c = hermite(motion(0.7_wp), velocity(0.0_wp), velocity(0.7_wp), 0.7_wp)
   call check(all(abs(c - [2.0_wp, -3.0_wp, 0.5_wp]) < 1.0e-13_wp), 'Hermite is exact for a cubic')
+
+  ! A gap of 5 closing at 1 m/s under -2 m/s^2: 5 - t - t^2 = 0 at t = (sqrt(21) - 1) / 2.
+  call check(abs(first_negative(5.0_wp, -1.0_wp, -2.0_wp) - (sqrt(21.0_wp) - 1.0_wp) / 2.0_wp) <= 32.0_wp * eps_wp, &
+    'quiet time: the closing root of the quadratic')
+  call check(first_negative(5.0_wp, 1.0_wp, 2.0_wp) == huge(1.0_wp), 'quiet time: a gap that never closes')
 
   call finish('test_events')
 

@@ -3,7 +3,6 @@
 !> varies, is_polynomial and fastest.
 program test_forcing
   use impact1d_kinds, only: wp
-  use impact1d_lanes, only: max_lanes
   use impact1d_forcing, only: forcing_type, angular_frequency
   use testing, only: check, finish
   implicit none
@@ -15,7 +14,7 @@ program test_forcing
   integer, parameter :: body(3) = [2, 1, 2]
   real(wp), parameter :: amp(3) = [1.5_wp, -0.25_wp, 3.0_wp], period(3) = [0.7_wp, 1.9_wp, 0.2_wp], &
     phase(3) = [0.0_wp, 0.4_wp, -1.1_wp]
-  real(wp) :: f(2), lanes(max_lanes), df(2), want(2), want_rate(2), w(3)
+  real(wp) :: f(2), df(2), want(2), want_rate(2), w(3)
   integer :: j
 
   call forcing%allocate_bodies(2)
@@ -42,8 +41,6 @@ program test_forcing
   want(2) = want(2) + amp(3) * sin(w(3) * t + phase(3))
   call forcing%force_all(t, f)
   call check(all(f == want), 'force_all: each body its own sine, then its records in record order')
-  call forcing%force(t, lanes)
-  call check(all(lanes(:2) == f), 'force (lanes): the same bits as force_all')
 
   ! The rate: d/dt of each term, against a central difference of the force.
   want_rate(1) = forcing%amp(1) * forcing%omega(1) * cos(forcing%omega(1) * t + forcing%phase(1)) + &

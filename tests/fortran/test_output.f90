@@ -1,15 +1,15 @@
 !> The N-body output path the engine's results pass through: emit_bodies' full row (t, x1 v1
 !> .. xN vN, ke, pe, work, friction_loss, impact_loss, damping_loss, residual) into a memory
 !> sink and a file sink, with and without bodies_out, and the events of a scene of five
-!> bodies (the pair a, b and its velocities) in both; emit_bodies of two bodies is
-!> emit_sample's row bit for bit.
+!> bodies (the pair a, b and its velocities) in both; one and two bodies in the tutorial's
+!> row (t x1 v1 x2 v2, then the ledger; x2, v2 zero for one body).
 program test_output
   use, intrinsic :: iso_fortran_env, only: int64
   use, intrinsic :: ieee_arithmetic, only: ieee_is_nan
   use impact1d_kinds, only: wp
   use impact1d_error, only: error_type
   use impact1d_scene, only: scene_input
-  use impact1d_output, only: memory_sink, file_sink, summary_sink, run_stats, emit_bodies, emit_sample, &
+  use impact1d_output, only: memory_sink, file_sink, summary_sink, run_stats, emit_bodies, &
     present_columns, row_length, class_impact, class_stick, column_word, final_row
   use impact1d_fields, only: a_m
   use testing, only: check, finish
@@ -30,7 +30,7 @@ program test_output
   call file_rows()
   deallocate(input%bodies_out)
   call file_rows()
-  call two_bodies_as_emit_sample()
+  call tutorial_rows()
   call summary_of_five_bodies()
   call finish('test_output')
 
@@ -152,22 +152,28 @@ contains
     end do
   end function count_words
 
-  !> Two bodies through emit_bodies give emit_sample's row, bit for bit.
-  subroutine two_bodies_as_emit_sample()
+  !> One and two bodies: the tutorial's 13 columns, x2 and v2 zero for one body, the ledger
+  !> after them (ke, pe, work, friction_loss, impact_loss, damping_loss, drive_work, residual).
+  subroutine tutorial_rows()
     type(memory_sink) :: sink
     type(run_stats) :: stats
     type(error_type), allocatable :: error
     real(wp), parameter :: x2(2) = [0.1_wp, 0.7_wp], v2(2) = [0.3_wp, -1.1_wp], m2(2) = [1.3_wp, 0.9_wp]
+    real(wp) :: ke2
     integer :: k
-    call sink%reserve(2, [(k, k = 1, 12)])
-    call emit_sample(sink, stats, 0.3_wp, x2, v2, m2, 0.2_wp, 0.1_wp, 0.01_wp, 0.02_wp, .true., &
-      [0.4_wp, 0.3_wp, 0.05_wp], error)
+    call sink%reserve(2, [(k, k = 1, 13)])
+    ke2 = 0.5_wp * (m2(1) * v2(1)**2 + m2(2) * v2(2)**2)
     call emit_bodies(sink, stats, 0.3_wp, x2, v2, m2, 0.2_wp, 0.1_wp, 0.01_wp, 0.02_wp, .true., &
       [0.4_wp, 0.3_wp, 0.05_wp], error)
-    call check(all(stats%row == stats%last_row), 'two bodies: emit_bodies'' row is emit_sample''s')
-    call check(all(transfer(sink%samples(1, :), 1_int64, 12) == transfer(sink%samples(2, :), 1_int64, 12)), &
-      'two bodies: the same bits in the sink')
-  end subroutine two_bodies_as_emit_sample
+    call check(size(stats%row) == 13 .and. all(stats%row(1:5) == [0.3_wp, x2(1), v2(1), x2(2), v2(2)]) .and. &
+      abs(stats%row(6) - ke2) <= 4.0_wp * epsilon(1.0_wp) * ke2 .and. all(stats%row(7:12) == [0.4_wp, 0.1_wp, &
+      0.01_wp, 0.02_wp, 0.05_wp, 0.0_wp]), 'two bodies: t x1 v1 x2 v2, then the ledger')
+    call emit_bodies(sink, stats, 0.4_wp, x2(:1), v2(:1), m2(:1), 0.2_wp, 0.1_wp, 0.01_wp, 0.02_wp, .false., &
+      [0.0_wp, 0.0_wp, 0.0_wp], error)
+    call check(size(stats%row) == 13 .and. all(stats%row(1:5) == [0.4_wp, x2(1), v2(1), 0.0_wp, 0.0_wp]), &
+      'one body: x2 and v2 zero in the same 13 columns')
+    call check(sink%n_samples == 2 .and. all(sink%samples(2, 1:5) == stats%row(1:5)), 'both rows in the sink')
+  end subroutine tutorial_rows
 
   !> A sweep's summary of five bodies: at rest only when every body is (v1 = v2 = 0 with v4
   !> moving is not rest), from the samples (an event reports its pair only).

@@ -1,14 +1,10 @@
-!> The compensated state: a clock advanced by 10^6 steps of 1e-5 s keeps its digits, and
-!> the bulk constant-force steps of the glide give the bits of the step-by-step path, and a
+!> The compensated state: a clock advanced by 10^6 steps of 1e-5 s keeps its digits, and a
 !> state assigned to another is copied whole, into the arrays it has when their size fits;
 !> product_error is the exact rounding error of a product (a gear ratio's gap).
 program test_state
-  use, intrinsic :: iso_fortran_env, only: int64
   use, intrinsic :: iso_c_binding, only: c_ptr, c_loc, c_associated
   use impact1d_kinds, only: wp
-  use impact1d_lanes, only: max_lanes
-  use impact1d_state, only: state_type, new_state, lane_state_type, add_compensated, renormalise, constant_step, &
-    constant_steps, product_error
+  use impact1d_state, only: state_type, new_state, add_compensated, product_error
   use testing, only: check, finish
   implicit none
   integer, parameter :: n_steps = 1000000
@@ -29,10 +25,6 @@ program test_state
   call check(abs(t - 10.0_wp) <= spacing(10.0_wp), 'compensated clock: 10^6 steps of 1e-5 s give 10 s')
   call check(abs(naive - 10.0_wp) > naive_drift_floor, 'the plain sum does drift (the check can fail)')
 
-  ! Bulk steps (accumulated, renormalised once, in lanes) against step by step, for one
-  ! body and two.
-  call bulk_against_steps(1)
-  call bulk_against_steps(2)
   call assignment_copies()
   call product_errors()
   call finish('test_state')
@@ -92,35 +84,4 @@ contains
     b = none
     call check(.not. allocated(b%x) .and. .not. allocated(b%v), 'state assignment: a state of no bodies frees them')
   end subroutine assignment_copies
-
-  !> n bodies in lanes (the other lane idle): 1000 steps of constant_step against one call
-  !> of constant_steps, renormalised.
-  subroutine bulk_against_steps(n)
-    integer, intent(in) :: n
-    real(wp), parameter :: acc(2) = [-9.81_wp, 0.37_wp], x0(2) = [0.3_wp, 10.0_wp], v0(2) = [1.7_wp, -0.2_wp]
-    type(lane_state_type) :: stepped, bulk
-    real(wp), dimension(max_lanes) :: a, dv, half_dv
-    character(len=8) :: bodies
-    integer :: j
-    write(bodies, '(i0, a)') n, ' bodies'
-    a = 0.0_wp
-    a(:n) = acc(:n)
-    stepped%x(:n) = x0(:n)
-    stepped%v(:n) = v0(:n)
-    bulk = stepped
-    do j = 1, 1000
-      call add_compensated(stepped%t, stepped%t_lo, dt)
-      call constant_step(dt, a, stepped%x, stepped%x_lo, stepped%v, stepped%v_lo)
-    end do
-    dv = dt * a
-    half_dv = 0.5_wp * dv
-    call constant_steps(1000_int64, dt, dv, half_dv, bulk%t, bulk%t_lo, bulk%x, bulk%x_lo, bulk%v, bulk%v_lo)
-    call renormalise(bulk%t, bulk%t_lo)
-    call renormalise(bulk%x, bulk%x_lo)
-    call renormalise(bulk%v, bulk%v_lo)
-    call check(bulk%t == stepped%t .and. bulk%t_lo == stepped%t_lo, 'bulk steps, ' // trim(bodies) // &
-      ': same clock bits')
-    call check(all(bulk%x == stepped%x) .and. all(bulk%v == stepped%v), 'bulk steps, ' // trim(bodies) // &
-      ': same position and velocity bits as step by step')
-  end subroutine bulk_against_steps
 end program test_state

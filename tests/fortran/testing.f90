@@ -6,13 +6,12 @@ module testing
   use impact1d_kinds, only: wp
   use impact1d_error, only: error_type
   use impact1d_forcing, only: table_type
-  use impact1d_modes, only: pair_rows
   use impact1d_scene, only: scene_input, scene_type, build_scene, real_names, n_real, i_f1_table, set_text, n_text, &
     i_m2, i_x2
   use impact1d_chain, only: input_records, mechanism_records
   implicit none
   private
-  public :: check, finish, two_body, on_rows, row_values, row_of, seed_random
+  public :: check, finish, two_body, row_of, seed_random
 
   integer, save :: failures = 0
   !> What two_body starts from: two unit masses a metre apart, a second's run at 1 ms steps.
@@ -79,22 +78,6 @@ contains
       error stop 1
     end if
   end subroutine two_body
-
-  !> Flags for a scene's first rows in the kernels' per-row size (pair_rows), the rest false.
-  pure function on_rows(flags) result(padded)
-    logical, intent(in) :: flags(:)
-    logical :: padded(pair_rows)
-    padded = .false.
-    padded(:size(flags)) = flags
-  end function on_rows
-
-  !> Values for a scene's first rows in the kernels' per-row size (pair_rows), the rest 0.
-  pure function row_values(values) result(padded)
-    real(wp), intent(in) :: values(:)
-    real(wp) :: padded(pair_rows)
-    padded = 0.0_wp
-    padded(:size(values)) = values
-  end function row_values
 
   !> The index of the scene's row with this name ('left', 'slot_min', ...); 0 if none.
   pure integer function row_of(scene, name)

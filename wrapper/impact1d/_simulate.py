@@ -70,8 +70,8 @@ _OVERRIDABLE_SET = frozenset(_OVERRIDABLE)
 # most kept go back to this after the run (their memory is kept between calls).
 _EVENT_CAPACITY = 256
 _EVENT_CAPACITY_KEPT = 1 << 16
-# Rows a scene has (the flat API says when it has more): at most pair_rows = 8 (the
-# tutorial's four, and records on one or two bodies).
+# Rows a scene starts with room for (the flat API says when it has more, and the buffer
+# grows): the tutorial's four and a few records.
 _ROW_CAPACITY = 8
 # Room for the message and the warnings (the api's message_length).
 _TEXT_ROOM = 16384
