@@ -8,7 +8,7 @@ module impact1d_state
   implicit none
   private
   public :: state_type, lane_state_type, load_lanes, new_state, take_state, add_compensated, accumulate, &
-    renormalise, finite_state, constant_step, constant_steps, product_error
+    renormalise, finite_state, constant_step, constant_steps, product_error, copy_scalars
 
   !> Time, positions, velocities and the ledger integrals, compensated: a micrometre bounce
   !> near a wall at x = 10 m keeps its digits, and 10^6 steps of 1e-5 s do not drift the clock
