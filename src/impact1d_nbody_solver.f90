@@ -68,11 +68,10 @@ contains
     window_events = 0
     window_start = 0.0_wp
     t_break = min(scene%forcing%next_breakpoint(s%t), scene%drives%next_corner(s%t))
+    t_rest = next_rest(scene, r)
     do while (j_sample < scene%n_samples)
       sample_t = sample_time(scene, j_sample)
       if (t_break <= s%t) t_break = min(scene%forcing%next_breakpoint(s%t), scene%drives%next_corner(s%t))
-      t_rest = huge(1.0_wp)
-      if (scene%n_rows > 0) t_rest = minval(r%event_log%pending_rest)
       t_stop = min(sample_t, t_break, t_rest)
       ! The steps that can meet no event in closed form; then one located step (advance).
       at_stop = .false.
@@ -105,6 +104,7 @@ contains
         if (allocated(error)) return
         call r%kept%forget()
         call find_quiet_time(scene, r%mode, r%work%mode, s, r%glide)
+        t_rest = next_rest(scene, r)
       end if
       if (at_stop .and. s%t == sample_t) then
         call emit(scene, s, r, j_sample, sink, stats, error)
@@ -139,6 +139,15 @@ contains
     r%ke0 = 0.5_wp * dot_product(scene%body_mass, s%v**2)
     r%pe0 = potential(scene, s)
   end subroutine start
+
+  !> The earliest rest pending at an accumulation time (huge: none). Only the event point
+  !> and flush_pending_rest change them: formed after them, not every step.
+  pure real(wp) function next_rest(scene, r) result(t_rest)
+    type(scene_type), intent(in) :: scene
+    type(nbody_run_type), intent(in) :: r
+    t_rest = huge(1.0_wp)
+    if (scene%n_rows > 0) t_rest = minval(r%event_log%pending_rest)
+  end function next_rest
 
   !> Sample j_sample (then the next one is due).
   subroutine emit(scene, s, r, j_sample, sink, stats, error)
