@@ -131,7 +131,7 @@ contains
       r%mode%engaged = .false.
     end if
     call new_point_work(scene%n_bodies, r%work)
-    call r%kept%reserve(scene%n_bodies)
+    call r%kept%reserve(scene%n_bodies, .not. scene%forcing%varies)
     call new_glide(scene, r%glide)
     call r%event_log%allocate_log(scene%n_rows, scene%n_bodies)
     r%polynomial = scene%forcing%is_polynomial() .and. .not. scene%springs%present .and. scene%drives%polynomial &

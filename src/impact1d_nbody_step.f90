@@ -38,10 +38,15 @@ module impact1d_nbody_step
   !> calls `forget`. Kept where the stages' forces are the external and the elements' only
   !> (not scene%stage_powers): the same inputs and arithmetic as the stage it replaces.
   !> nbody_step works in the slots themselves (no copies in or out); under
-  !> scene%stage_powers they are its scratch, never valid.
+  !> scene%stage_powers they are its scratch, never valid. Where the external forces are
+  !> constants (no table, no sine: `timeless`) a slot holds at any time: the end's forces
+  !> serve the next step also where the compensated clock's b%t is not a%t + step (a third
+  !> of the steps; under forces that vary, f(b%t) differs from f(a%t + step) in its last
+  !> bits, and a slot keyed on its time is all that keeps the bits).
   type, public :: kept_forces_type
     integer :: now = 1
     logical :: valid(2) = .false.
+    logical :: timeless = .false.
     real(wp) :: t(2) = 0.0_wp
     real(wp), allocatable :: f(:, :), acc(:, :)      !< (N, 2)
   contains
@@ -53,12 +58,15 @@ module impact1d_nbody_step
 
 contains
 
-  !> The slots of n bodies, both empty (the run's one allocation of them).
-  pure subroutine reserve_kept(self, n)
+  !> The slots of n bodies, both empty (the run's one allocation of them); timeless: the
+  !> external forces are constants.
+  pure subroutine reserve_kept(self, n, timeless)
     class(kept_forces_type), intent(inout) :: self
     integer, intent(in) :: n
+    logical, intent(in) :: timeless
     if (allocated(self%f)) deallocate(self%f, self%acc)
     allocate(self%f(n, 2), self%acc(n, 2))
+    self%timeless = timeless
     call self%forget()
   end subroutine reserve_kept
 
@@ -80,7 +88,7 @@ contains
     class(kept_forces_type), intent(in) :: self
     real(wp), intent(in) :: t
     kept_holds = self%valid(self%now)
-    if (kept_holds) kept_holds = self%t(self%now) == t
+    if (kept_holds .and. .not. self%timeless) kept_holds = self%t(self%now) == t
   end function kept_holds
 
   !> Applied forces f (external and elements') at time t, positions x + dx, velocities v;
