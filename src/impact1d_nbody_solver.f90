@@ -79,7 +79,10 @@ contains
       if (allocated(error)) return
       found = found_none
       index = 0
-      if (.not. at_stop) call advance(scene, r, t_stop, s, trial, found, index, at_stop, sink, stats, error)
+      if (.not. at_stop) then
+        r%glide%fixed = .false.
+        call advance(scene, r, t_stop, s, trial, found, index, at_stop, sink, stats, error)
+      end if
       if (allocated(error)) return
       event_due = found /= found_none
       if (.not. event_due .and. at_stop) event_due = t_stop == t_break .or. t_stop == t_rest .or. &
