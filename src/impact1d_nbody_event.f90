@@ -272,8 +272,8 @@ contains
   end subroutine solve_mode_at
 
   !> The closed rows (the located one, gaps within rounding; at the start, within the
-  !> rounding of the user's decimals; in a geared scene with friction the rows the mode held), a rigid
-  !> link's two rows together, each snapped onto its constraint.
+  !> rounding of the user's decimals; in a geared scene with friction the rows the mode
+  !> held), a rigid link's two rows together, each snapped onto its constraint.
   pure subroutine close_rows(scene, initial, located, held, s, closed, rows, n_closed)
     type(scene_type), intent(in) :: scene
     logical, intent(in) :: initial

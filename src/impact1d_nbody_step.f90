@@ -831,7 +831,8 @@ contains
       real(wp) :: acc(scene%n_bodies), way(scene%n_bodies), lead(0:scene%n_bodies), s(scene%n_bodies)
       logical :: against
       integer :: i, k
-      ! (a geared group's load is sum s_i f_i, body i moving s_i times its coordinate: docs/method.md section 14)
+      ! (a geared group's load is sum s_i f_i, body i moving s_i times its coordinate:
+      ! docs/method.md section 14)
       s = 1.0_wp
       if (scene%geared) then
         call probe%geared_response(f + probe%f_slide, acc)
