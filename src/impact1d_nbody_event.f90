@@ -132,7 +132,8 @@ contains
     end if
     call nbody_force(scene, s%t, s%x, s%x_lo, s%v, f, mode%engaged)
     call nbody_rate(scene, s%t, s%v, df, mode%engaged)
-    call close_rows(scene, initial, merge(index, 0, found == found_row), s, closed, work%closed_rows, work%n_closed)
+    call close_rows(scene, initial, merge(index, 0, found == found_row), mode%active, s, closed, work%closed_rows, &
+      work%n_closed)
     ! Velocity scale of each body entering this event point: impulses redistribute velocity
     ! but cannot create precision, so what is below its rounding is zero.
     if (initial) then
@@ -299,17 +300,21 @@ contains
   end subroutine refuse_held_belts
 
   !> The closed rows (the located one, gaps within rounding; at the start, within the
-  !> rounding of the user's decimals), a rigid link's two rows together, each snapped onto
-  !> its constraint.
-  pure subroutine close_rows(scene, initial, located, s, closed, rows, n_closed)
+  !> rounding of the user's decimals; in a geared scene with friction the rows the mode
+  !> held), a rigid link's two rows together, each snapped onto its constraint.
+  pure subroutine close_rows(scene, initial, located, held, s, closed, rows, n_closed)
     type(scene_type), intent(in) :: scene
     logical, intent(in) :: initial
     integer, intent(in) :: located
+    logical, intent(in) :: held(:)      !< the rows the mode held up to here
     type(state_type), intent(inout) :: s
     logical, intent(out) :: closed(:)
     integer, intent(out) :: rows(:), n_closed    !< the closed rows in row order
     integer :: k
     real(wp) :: size_scale
+    logical :: keep_held
+    keep_held = scene%geared .and. .not. initial
+    if (keep_held) keep_held = any(scene%body_static > 0.0_wp)
     do k = 1, scene%n_rows
       closed(k) = k == located .or. row_gap(scene, k, s) <= row_gap_tolerance(scene, k, s, 0.0_wp)
       if (initial .and. .not. closed(k)) then
@@ -317,6 +322,12 @@ contains
         if (scene%row_body(1, k) > 0) size_scale = max(size_scale, abs(s%x(scene%row_body(1, k))))
         closed(k) = row_gap(scene, k, s) <= gap_rounding * size_scale
       end if
+      ! A held geared row's ends move at s_b V and s_a V, each rounded: its gap drifts from
+      ! the limit by that rounding, beyond the low parts' (a unit row's ends move alike), and
+      ! would open a mesh that a geared group pressed at a stop. (With friction only: without
+      ! it the same rule merges input/geared_train.nml's mesh1 impact one ulp after mesh2's
+      ! into mesh2's event point, which moves its golden bits; docs/method.md section 14.)
+      if (keep_held) closed(k) = closed(k) .or. held(k)
     end do
     do k = 1, scene%n_rows
       if (scene%row_partner(k) > 0) closed(k) = closed(k) .or. closed(scene%row_partner(k))

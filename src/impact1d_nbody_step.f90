@@ -1045,11 +1045,15 @@ contains
     logical function begun(probe, f)
       type(body_mode_type), intent(in) :: probe
       real(wp), intent(in) :: f(:)
-      real(wp) :: acc(scene%n_bodies), way(scene%n_bodies), lead(0:scene%n_bodies)
+      real(wp) :: acc(scene%n_bodies), way(scene%n_bodies), lead(0:scene%n_bodies), s(scene%n_bodies)
       logical :: against
       integer :: i, k
+      ! (a geared group's load is sum s_i f_i, body i moving s_i times its coordinate:
+      ! docs/method.md section 14)
+      s = 1.0_wp
       if (scene%geared) then
         call probe%geared_response(f + probe%f_slide, acc)
+        s = probe%scale
       else
         call probe%acceleration(f, acc)
       end if
@@ -1059,16 +1063,16 @@ contains
         way(i) = probe%sgn(i)
         if (way(i) == 0.0_wp) way(i) = sign(1.0_wp, acc(i))
         if (mode%stuck(i) .and. .not. probe%stuck(i)) then
-          lead(probe%group(i)) = lead(probe%group(i)) + (f(i) - scene%body_static(i) * way(i))
+          lead(probe%group(i)) = lead(probe%group(i)) + s(i) * (f(i) - scene%body_static(i) * way(i))
         else
-          lead(probe%group(i)) = lead(probe%group(i)) + (f(i) + probe%f_slide(i))
+          lead(probe%group(i)) = lead(probe%group(i)) + s(i) * (f(i) + probe%f_slide(i))
           if (mode%sgn(i) /= probe%sgn(i)) begun = .true.
         end if
       end do
       against = .false.
       do i = 1, scene%n_bodies
         if (mode%stuck(i) .and. .not. probe%stuck(i) .and. probe%group(i) > 0) &
-          against = against .or. way(i) * lead(probe%group(i)) < 0.0_wp
+          against = against .or. way(i) * s(i) * lead(probe%group(i)) < 0.0_wp
       end do
       do k = 1, scene%n_rows
         if (mode%active(k) .and. .not. probe%active(k)) against = against .or. row_velocity(scene, k, acc) < 0.0_wp
