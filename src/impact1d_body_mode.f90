@@ -23,7 +23,7 @@ module impact1d_body_mode
   use impact1d_cluster_mode, only: cluster_work_type, cluster_reserve, cluster_mode, cluster_solved
   use impact1d_lcp, only: lcp_too_large
   use impact1d_path_mode, only: path_work_type, path_reserve, path_order, path_mode
-  use impact1d_friction_laws, only: slip, sliding_bound
+  use impact1d_friction_laws, only: slip, sliding_bound, belt_moving, belt_rate
   implicit none
   private
   public :: body_mode_type, mode_work_type, new_mode, solve_body_mode, same_mode, mode_solved
@@ -359,6 +359,8 @@ contains
       work%row_normal(2, j) = scene%row_normal(2, k)
     end do
     if (scene%n_frictions > 0) call gather_pairs(scene, work, c, nb, nr, v)
+    work%cluster%biased = .false.
+    if (scene%belt_moves) call gather_belt_frames(scene, work, c, nb, nr, v, t)
     call gathered_mode(work, nb, nr, status)
     if (status /= cluster_solved) return
     do j = 1, nb
@@ -371,6 +373,36 @@ contains
     end do
     if (scene%n_frictions > 0) call scatter_pairs(scene, work, c, v, mode)
   end subroutine solve_cluster
+
+  !> Cluster c's rows between frames that accelerate apart: a body at rest on a belt of sine
+  !> speed is solved in its belt's frame (its force shifted by -m V': impact1d_friction_laws'
+  !> shift_to_belts), so a row's acceleration n.a is n.a' + n.b, b_i = V_i'(t) for such a
+  !> body, else 0 (the dense solve's row_bias; a wall, or a body in another frame, stays
+  !> where it is while the belt carries its neighbour on). O(rows) per such cluster.
+  subroutine gather_belt_frames(scene, work, c, nb, nr, v, t)
+    type(scene_type), intent(in) :: scene
+    type(mode_work_type), intent(inout) :: work
+    integer, intent(in) :: c, nb, nr
+    real(wp), intent(in) :: v(:), t
+    integer :: j, k, e, i
+    call cluster_reserve(work%cluster, nb, max(nr, 1))
+    do j = 1, nr
+      k = work%row(work%first_row(c) + j - 1)
+      work%cluster%row_bias(j) = 0.0_wp
+      work%cluster%row_bias_rate(j) = 0.0_wp
+      do e = 1, 2
+        i = scene%row_body(e, k)
+        if (i == 0) cycle
+        if (.not. belt_moving(scene, i)) cycle
+        if (slip(scene, i, v(i), t) /= 0.0_wp) cycle
+        work%cluster%row_bias(j) = work%cluster%row_bias(j) + scene%row_normal(e, k) * belt_rate(scene, i, t, 2)
+        work%cluster%row_bias_rate(j) = work%cluster%row_bias_rate(j) + scene%row_normal(e, k) * &
+          belt_rate(scene, i, t, 3)
+      end do
+      work%cluster%biased = work%cluster%biased .or. work%cluster%row_bias(j) /= 0.0_wp .or. &
+        work%cluster%row_bias_rate(j) /= 0.0_wp
+    end do
+  end subroutine gather_belt_frames
 
   !> Cluster c's friction contacts (&friction): the force of those that slide added to
   !> their ends' applied forces, those at relative rest given to the dense solve as boxes
@@ -438,8 +470,9 @@ contains
     integer, intent(out) :: status
     work%candidate(1:nr) = .true.
     ! (a cluster with friction contacts at relative rest takes the dense solve: the path
-    ! solve has no boxes on relative coordinates)
-    if (.not. work%dense_only .and. work%cluster%n_pairs == 0) then
+    ! solve has no boxes on relative coordinates; one with rows between belts' frames too:
+    ! it has no row_bias)
+    if (.not. work%dense_only .and. work%cluster%n_pairs == 0 .and. .not. work%cluster%biased) then
       if (path_order(work%path, nb, work%row_body(:, 1:nr), work%row_normal(:, 1:nr))) then
         call path_mode(work%path, work%mass(1:nb), work%force(1:nb), work%rate(1:nb), work%friction(1:nb), &
           work%static(1:nb), work%velocity(1:nb), work%row_body(:, 1:nr), work%row_normal(:, 1:nr), &

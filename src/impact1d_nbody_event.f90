@@ -142,6 +142,7 @@ contains
       call mode_acceleration(scene, mode, s%t, f, acc)
     end if
     entry_scale = abs(s%v) + abs(acc) * scene%dt
+    if (scene%belt_moves) call belt_scale(scene, s%t, entry_scale)
     if (same_instant(scene, s%t, work%scale_time)) entry_scale = max(entry_scale, work%scale)
     do i = 1, scene%n_bodies
       stopped(i) = scene%body_static(i) > 0.0_wp .and. slip(scene, i, s%v(i), s%t) /= 0.0_wp .and. ((found == &
@@ -172,8 +173,6 @@ contains
     ! (solved in place: the old mode is not read past here but for its friction contacts'
     ! stuck flags, kept for the log; a failed solve ends the run)
     if (scene%n_frictions > 0 .and. .not. initial) pair_was_stuck = mode%friction_stuck
-    if (scene%belt_moves) call refuse_held_belts(scene, candidate, s, error)
-    if (allocated(error)) return
     ! (geared groups' scaled accelerations are set_groups' alone: no scoped shortcut)
     if (initial .or. .not. work%frictionless .or. scene%drives%n > 0 .or. scene%geared) then
       call solve_mode_at(scene, work%mode, s%t, f, df, s%v, candidate, mode, status)
@@ -192,6 +191,9 @@ contains
         ': no consistent contact and friction state (complementarity problem has no solution)')
       return
     end if
+    if (scene%belt_moves) call refuse_held_belts(scene, mode, s, error)
+    if (allocated(error)) return
+    if (scene%belt_moves) call still_on_belts(scene, mode, s)
     call log_mode_change(scene, initial, f, df, candidate, mode, s, event_log, sink, stats)
     if (scene%n_frictions > 0 .and. .not. initial) call log_pairs(scene, pair_was_stuck, mode, s, sink, stats)
   end subroutine nbody_event_point
@@ -274,30 +276,84 @@ contains
     call solve_body_mode(scene, work, f_seen, df_seen, v, t, candidate, mode, status)
   end subroutine solve_mode_at
 
-  !> A body at rest on a belt of sine speed (slip 0 at s%t) may not be an end of a candidate
-  !> row (closed, at rest): the mode solve takes such a body in its belt's frame alone
-  !> (shift_to_belts), and a row would join it to bodies or a wall in other frames, which the
-  !> cluster solves do not take yet: the run ends there, naming the body and the row.
-  subroutine refuse_held_belts(scene, candidate, s, error)
+  !> A body stuck on a belt of sine speed may not be an end of a held row, but for a row
+  !> between two bodies stuck on belts of the same acceleration: the mode solve takes such
+  !> rows (impact1d_body_mode's gather_belt_frames), but a body held against a stuck one
+  !> would ride its belt, which the groups' motion (group 0 still but for each stuck body's
+  !> own belt) does not take yet: the run ends there, naming the body and the row. A row
+  !> that the belt carries its body away from, or a body that slides on its belt against a
+  !> wall or a neighbour, runs.
+  subroutine refuse_held_belts(scene, mode, s, error)
     type(scene_type), intent(in) :: scene
-    logical, intent(in) :: candidate(:)
+    type(body_mode_type), intent(in) :: mode
     type(state_type), intent(in) :: s
     type(error_type), allocatable, intent(inout) :: error
     integer :: k, e, i
     do k = 1, scene%n_rows
-      if (.not. candidate(k)) cycle
+      if (.not. mode%active(k)) cycle
+      if (same_belt_frame(k)) cycle
       do e = 1, 2
         i = scene%row_body(e, k)
         if (i == 0) cycle
-        if (.not. belt_moving(scene, i)) cycle
-        if (slip(scene, i, s%v(i), s%t) /= 0.0_wp) cycle
+        if (.not. (mode%stuck(i) .and. belt_moving(scene, i))) cycle
         call raise(error, status_simulation, 'at t = ' // trim(fmt(s%t)) // ': body ' // trim(fmt(i)) // &
-          ', at rest on its belt of sine speed (belt_amp), is held by the contact ' // trim(scene%row_name(k)) // &
-          ': a body on such a belt cannot stick while in contact yet (docs/method.md section 12)')
+          ', stuck on its belt of sine speed (belt_amp), holds the contact ' // trim(scene%row_name(k)) // &
+          ' closed: a body held against one stuck on such a belt cannot ride it yet (docs/method.md section 12)')
         return
       end do
     end do
+
+  contains
+
+    !> Row k joins two stuck bodies whose belts accelerate alike (their row's n.b and its
+    !> rate zero: each rides its own belt, the row stays closed).
+    logical function same_belt_frame(k)
+      integer, intent(in) :: k
+      integer :: a, b
+      a = scene%row_body(1, k)
+      b = scene%row_body(2, k)
+      same_belt_frame = .false.
+      if (a == 0) return
+      if (.not. (mode%stuck(a) .and. mode%stuck(b))) return
+      same_belt_frame = scene%row_normal(1, k) * belt_rate(scene, a, s%t, 2) + &
+        scene%row_normal(2, k) * belt_rate(scene, b, s%t, 2) == 0.0_wp .and. &
+        scene%row_normal(1, k) * belt_rate(scene, a, s%t, 3) + scene%row_normal(2, k) * belt_rate(scene, b, s%t, 3) &
+        == 0.0_wp
+    end function same_belt_frame
   end subroutine refuse_held_belts
+
+  !> A body on a belt of sine speed that the mode holds still (against a wall) and slides:
+  !> its velocity exactly 0, not its belt's speed within rounding of 0 where it stopped on
+  !> its belt (else it creeps off the wall by that rounding); the rounding's energy is
+  !> friction's, as zero_velocity books it.
+  pure subroutine still_on_belts(scene, mode, s)
+    type(scene_type), intent(in) :: scene
+    type(body_mode_type), intent(in) :: mode
+    type(state_type), intent(inout) :: s
+    integer :: i
+    do i = 1, scene%n_bodies
+      if (mode%group(i) /= 0 .or. mode%stuck(i) .or. s%v(i) == 0.0_wp) cycle
+      if (mode%drive(i) /= 0 .or. .not. belt_moving(scene, i)) cycle
+      call add_compensated(s%friction_loss, s%friction_lo, 0.5_wp * scene%body_mass(i) * s%v(i)**2)
+      s%v(i) = 0.0_wp
+      s%v_lo(i) = 0.0_wp
+    end do
+  end subroutine still_on_belts
+
+  !> A body on a belt of sine speed has the belt's velocity scale too, that of V's terms
+  !> (|belt_v| + |belt_amp|, its rounding's) and of a step's change |V'| dt: held still
+  !> against a wall while it slides, it stops on its belt where the belt's speed is within
+  !> rounding of 0, not at 0 (a rounding of approach, no impact).
+  pure subroutine belt_scale(scene, t, scale)
+    type(scene_type), intent(in) :: scene
+    real(wp), intent(in) :: t
+    real(wp), intent(inout) :: scale(:)
+    integer :: i
+    do i = 1, scene%n_bodies
+      if (belt_moving(scene, i)) scale(i) = scale(i) + abs(scene%body_belt(i)) + abs(scene%body_belt_amp(i)) + &
+        abs(belt_rate(scene, i, t, 2)) * scene%dt
+    end do
+  end subroutine belt_scale
 
   !> The closed rows (the located one, gaps within rounding; at the start, within the
   !> rounding of the user's decimals; in a geared scene with friction the rows the mode
@@ -1138,7 +1194,9 @@ contains
     a_gap = 0.0_wp
     a_end = 0.0_wp
     ! (friction contacts between bodies join clusters the rows' incidence lists do not see)
-    scoped = scene%drives%n == 0 .and. scene%n_frictions == 0 .and. .not. scene%geared
+    ! (belts of sine speed: the bodies at rest on them are solved in their frames, which
+    ! solve_mode_at shifts to, this not)
+    scoped = scene%drives%n == 0 .and. scene%n_frictions == 0 .and. .not. scene%geared .and. .not. scene%belt_moves
     if (.not. scoped) return
     do e = 1, 2
       if (scene%row_body(e, k) == 0) cycle
@@ -1685,12 +1743,18 @@ contains
     end subroutine relative_to_belts
 
     !> Row j's gap acceleration (order 2) or its rate (3) at the bodies' a (with its moving
-    !> ground end's).
+    !> ground end's; the accelerating belts' taken back: a is relative to them).
     real(wp) function row_acceleration(j, a, order)
       integer, intent(in) :: j, order
       real(wp), intent(in) :: a(:)
+      integer :: e
       row_acceleration = row_velocity(scene, j, a)
       if (scene%drives%n > 0) row_acceleration = row_acceleration + ground_motion(scene, j, s%t, order)
+      if (.not. scene%belt_moves) return
+      do e = 1, 2
+        if (scene%row_body(e, j) > 0) row_acceleration = row_acceleration + scene%row_normal(e, j) * &
+          belt_rate(scene, scene%row_body(e, j), s%t, order)
+      end do
     end function row_acceleration
 
     !> Row j's |n| . tol (its ends' tolerances).

@@ -832,8 +832,9 @@ contains
 
   !> A body on a belt of sine speed (belt_amp /= 0) may not be an end of a &friction record:
   !> stuck, it accelerates with its own belt, which the mode solve takes body by body (a
-  !> cluster solve holds its bodies in one frame). (Its contacts are refused where one would
-  !> hold it at rest on its belt: impact1d_nbody_event's refuse_held_belts.)
+  !> cluster solve holds its bodies in one frame). (Its contacts are refused where one is held
+  !> between it stuck and a body that would ride its belt: impact1d_nbody_event's
+  !> refuse_held_belts.)
   subroutine refuse_belt_contacts(scene, error)
     type(scene_type), intent(in) :: scene
     type(error_type), allocatable, intent(inout) :: error
