@@ -33,7 +33,9 @@ module impact1d_nbody_event
   !> next at the same instant.
   type :: point_work_type
     type(mode_work_type) :: mode
-    type(impact_work_type) :: impact
+    !> (allocated by the first joint impact of a closed group: a run that has none, a short
+    !> call's, does not copy its default-initialised 4.7 kB in and out)
+    type(impact_work_type), allocatable :: impact
     !> The last event point's instant and the velocity scale its impulses came from (N).
     real(wp) :: scale_time = -huge(1.0_wp)
     real(wp), allocatable :: scale(:)
@@ -899,6 +901,7 @@ contains
     ! (with moving grounds the projection is taken in their frame: frame_velocity)
     frame = 0.0_wp
     if (scene%drives%n > 0) frame = frame_velocity(scene, closed, t)
+    if (.not. allocated(work%impact)) allocate(work%impact)
     call path_impact_reserve(work%impact%path, nb)
     call path_projection(work%impact%path, scene%body_mass(body(:nb)), v(body(:nb)) - frame(body(:nb)), row_local(:, :nr), &
       scene%row_normal(:, rows(:nr)), tol(rows(:nr)), v_local(:nb), impulse_local(:nr), pushed_local(:nr), fits)
