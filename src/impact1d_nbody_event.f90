@@ -33,7 +33,9 @@ module impact1d_nbody_event
   !> next at the same instant.
   type :: point_work_type
     type(mode_work_type) :: mode
-    type(impact_work_type) :: impact
+    !> (allocated by the first joint impact of a closed group: a run that has none, a short
+    !> call's, does not copy its default-initialised 4.7 kB in and out)
+    type(impact_work_type), allocatable :: impact
     !> The last event point's instant and the velocity scale its impulses came from (N).
     real(wp) :: scale_time = -huge(1.0_wp)
     real(wp), allocatable :: scale(:)
@@ -78,15 +80,17 @@ contains
   end subroutine new_point_work
 
   !> What the event points of a run share, set at its first: the rows on each body, the
-  !> rigid groups when there are no rigid links (each body alone), a scratch mode.
+  !> rigid groups when there are no rigid links (each body alone); the scratch mode at its
+  !> first use (scratch_mode).
   subroutine first_point(scene, mode, work)
     type(scene_type), intent(in) :: scene
     type(body_mode_type), intent(in) :: mode
     type(point_work_type), intent(inout) :: work
     integer :: i
+    ! (an earlier run's scratch made anew at its first use: scratch_mode)
+    if (allocated(work%scratch%stuck)) deallocate(work%scratch%stuck)
     ! (the rigid rows only: the compliant stops' rows after them are elements, never closed)
     call clusters_build(work%incidence, scene%n_bodies, scene%row_body(:, 1:scene%n_rows))
-    work%scratch = mode
     if (allocated(work%closed_rows)) deallocate(work%closed_rows, work%local)
     allocate(work%closed_rows(max(scene%n_rows, 1)), work%local(0:scene%n_bodies))
     work%local = 0
@@ -966,6 +970,7 @@ contains
     ! (with moving grounds the projection is taken in their frame: frame_velocity)
     frame = 0.0_wp
     if (scene%drives%n > 0) frame = frame_velocity(scene, closed, t)
+    if (.not. allocated(work%impact)) allocate(work%impact)
     call path_impact_reserve(work%impact%path, nb)
     call path_projection(work%impact%path, scene%body_mass(body(:nb)), v(body(:nb)) - frame(body(:nb)), row_local(:, :nr), &
       scene%row_normal(:, rows(:nr)), tol(rows(:nr)), v_local(:nb), impulse_local(:nr), pushed_local(:nr), fits)
@@ -1114,6 +1119,7 @@ contains
     type(run_stats), intent(inout) :: stats
     real(wp) :: a_up, a_down, remaining, v_bounce(scene%n_bodies)
     type(error_type), allocatable :: unchecked
+    call scratch_mode(mode, work)
     a_up = free_gap_acceleration(s%v)
     if (a_up >= 0.0_wp) return
     call impulse(scene, work, k, 1.0_wp, s%t, s%v, v_bounce)
@@ -1209,6 +1215,15 @@ contains
     if (scene%row_body(1, k) > 0) a_gap = a_gap + scene%row_normal(1, k) * a_end(1)
     a_gap = a_gap + 0.0_wp
   end subroutine scoped_gap_acceleration
+
+  !> work%scratch (cluster_acceleration's mode) made a copy of mode at the run's first scoped
+  !> solve, not at its first event point (seven allocations a short call need not make): its
+  !> entries are written before they are read, so any mode of the run's sizes serves.
+  subroutine scratch_mode(mode, work)
+    type(body_mode_type), intent(in) :: mode
+    type(point_work_type), intent(inout) :: work
+    if (.not. allocated(work%scratch%stuck)) work%scratch = mode
+  end subroutine scratch_mode
 
   !> Body i's acceleration in the mode of its cluster (the bodies joined to it by candidate
   !> rows: closed, other than row k, normal velocity within rounding at v), the cluster
@@ -1354,6 +1369,7 @@ contains
     integer, intent(out) :: status
     integer :: body(max_scope), rows(max_scope_rows), nb, nr, p, i, k
     logical :: fits
+    call scratch_mode(mode, work)
     if (work%mode_tracked) then
       do p = 1, work%n_mode_bodies
         call alone(work%mode_bodies(p))
