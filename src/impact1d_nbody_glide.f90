@@ -15,7 +15,7 @@ module impact1d_nbody_glide
   use impact1d_kinds, only: wp
   use impact1d_error, only: error_type, raise, status_simulation, fmt
   use impact1d_scene, only: scene_type, step_length
-  use impact1d_state, only: state_type, add_compensated, finite_state, take_state
+  use impact1d_state, only: state_type, add_compensated, finite_state, take_state, renormalise
   use impact1d_output, only: sink_type, run_stats, checkpoint
   use impact1d_yardsticks, only: gap_rounding, velocity_rounding
   use impact1d_body_mode, only: body_mode_type, mode_work_type, relative_velocity
@@ -47,6 +47,10 @@ module impact1d_nbody_glide
     real(wp), allocatable :: acc(:)     !< (N) the mode's accelerations under them
     real(wp), allocatable :: rate(:)    !< (N) the forces' rate until the next corner (tables)
     real(wp), allocatable :: jerk(:)    !< (N) the accelerations' rate under it (0: constant forces)
+    !> The state is closed_step's fixed point (find_quiet_time's fixed_point): a step moves the
+    !> clock alone, until the state changes otherwise (an event point; a located step:
+    !> run_nbody sets it false).
+    logical :: fixed = .false.
   end type glide_type
 
 contains
@@ -86,6 +90,7 @@ contains
     if (g%table) call segment(scene, mode, s, g, t_corner, span)
     call mode%acceleration(g%force, g%acc)
     g%sliding = any(mode%f_slide /= 0.0_wp)
+    g%fixed = .not. g%table .and. fixed_point(scene, g, s)
     tau = huge(1.0_wp)
     do k = 1, scene%n_rows
       if (mode%active(k)) cycle
@@ -219,6 +224,8 @@ contains
         call nbody_step(scene, mode, s, h, trial, kept)
         call take_state(s, trial)
         call kept%accept()
+      else if (g%fixed) then
+        call add_compensated(s%t, s%t_lo, h)     ! (closed_step's clock)
       else
         call closed_step(scene, mode, g, h, s)
         call kept%forget()
@@ -240,6 +247,44 @@ contains
     if (.not. finite_state(s%x, s%v, s%work)) call raise(error, status_simulation, 'at t = ' // &
       trim(fmt(s%t)) // ': the state is no longer finite')
   end subroutine glide
+
+  !> Whether state s is closed_step's fixed point under g's accelerations (a step of any
+  !> length changes nothing but the clock): every body at rest (v and v_lo +0) with
+  !> acceleration 0, and each compensated pair closed_step adds to (positions, work,
+  !> friction's loss) no -0 and renormalised (renormalise leaves it as it is). Then each
+  !> increment is +0 whatever h (v0 = +0, so the stages' velocities and the powers are +0),
+  !> dv a zero of acc's sign, and a two-sum of such a pair and a zero leaves it unchanged.
+  !> Bodies stuck under forces within their friction bounds (the tutorial's case 1, all its
+  !> run) or in a run's final rest take the clock's steps alone.
+  logical function fixed_point(scene, g, s)
+    type(scene_type), intent(in) :: scene
+    type(glide_type), intent(in) :: g
+    type(state_type), intent(in) :: s
+    integer :: i
+    fixed_point = .false.
+    do i = 1, scene%n_bodies
+      if (.not. (same_bits(s%v(i), 0.0_wp) .and. same_bits(s%v_lo(i), 0.0_wp) .and. g%acc(i) == 0.0_wp .and. &
+        settled(s%x(i), s%x_lo(i)))) return
+    end do
+    fixed_point = settled(s%work, s%work_lo) .and. settled(s%friction_loss, s%friction_lo)
+  end function fixed_point
+
+  !> The compensated pair hi + lo has no -0 and renormalise leaves it as it is.
+  elemental logical function settled(hi, lo)
+    real(wp), intent(in) :: hi, lo
+    real(wp) :: h, l
+    h = hi
+    l = lo
+    call renormalise(h, l)
+    settled = same_bits(h, hi) .and. same_bits(l, lo) .and. .not. (hi == 0.0_wp .and. sign(1.0_wp, hi) < 0.0_wp) &
+      .and. .not. (lo == 0.0_wp .and. sign(1.0_wp, lo) < 0.0_wp)
+  end function settled
+
+  !> a and b are the same double (a zero's sign too).
+  elemental logical function same_bits(a, b)
+    real(wp), intent(in) :: a, b
+    same_bits = a == b .and. sign(1.0_wp, a) == sign(1.0_wp, b)
+  end function same_bits
 
   !> nbody_step's RK4 step of h when every stage's acceleration is g%acc: its stages' sums,
   !> ledger (Simpson's rule on the Hermite velocity, with the end acceleration's term

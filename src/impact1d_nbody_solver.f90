@@ -69,11 +69,10 @@ contains
     window_events = 0
     window_start = 0.0_wp
     t_break = min(scene%forcing%next_breakpoint(s%t), scene%drives%next_corner(s%t))
+    t_rest = next_rest(scene, r)
     do while (j_sample < scene%n_samples)
       sample_t = sample_time(scene, j_sample)
       if (t_break <= s%t) t_break = min(scene%forcing%next_breakpoint(s%t), scene%drives%next_corner(s%t))
-      t_rest = huge(1.0_wp)
-      if (scene%n_rows > 0) t_rest = minval(r%event_log%pending_rest)
       t_stop = min(sample_t, t_break, t_rest)
       ! The steps that can meet no event in closed form; then one located step (advance).
       at_stop = .false.
@@ -81,7 +80,10 @@ contains
       if (allocated(error)) return
       found = found_none
       index = 0
-      if (.not. at_stop) call advance(scene, r, t_stop, s, trial, found, index, at_stop, sink, stats, error)
+      if (.not. at_stop) then
+        r%glide%fixed = .false.
+        call advance(scene, r, t_stop, s, trial, found, index, at_stop, sink, stats, error)
+      end if
       if (allocated(error)) return
       event_due = found /= found_none
       if (.not. event_due .and. at_stop) event_due = t_stop == t_break .or. t_stop == t_rest .or. &
@@ -106,6 +108,7 @@ contains
         if (allocated(error)) return
         call r%kept%forget()
         call find_quiet_time(scene, r%mode, r%work%mode, s, r%glide)
+        t_rest = next_rest(scene, r)
       end if
       if (at_stop .and. s%t == sample_t) then
         call emit(scene, s, r, j_sample, sink, stats, error)
@@ -132,7 +135,7 @@ contains
       r%mode%engaged = .false.
     end if
     call new_point_work(scene%n_bodies, r%work)
-    call r%kept%reserve(scene%n_bodies)
+    call r%kept%reserve(scene%n_bodies, .not. scene%forcing%varies)
     call new_glide(scene, r%glide)
     call r%event_log%allocate_log(scene%n_rows, scene%n_bodies)
     r%polynomial = scene%forcing%is_polynomial() .and. .not. scene%springs%present .and. scene%drives%polynomial &
@@ -140,6 +143,15 @@ contains
     r%ke0 = 0.5_wp * dot_product(scene%body_mass, s%v**2)
     r%pe0 = potential(scene, s)
   end subroutine start
+
+  !> The earliest rest pending at an accumulation time (huge: none). Only the event point
+  !> and flush_pending_rest change them: formed after them, not every step.
+  pure real(wp) function next_rest(scene, r) result(t_rest)
+    type(scene_type), intent(in) :: scene
+    type(nbody_run_type), intent(in) :: r
+    t_rest = huge(1.0_wp)
+    if (scene%n_rows > 0) t_rest = minval(r%event_log%pending_rest)
+  end function next_rest
 
   !> Sample j_sample (then the next one is due).
   subroutine emit(scene, s, r, j_sample, sink, stats, error)

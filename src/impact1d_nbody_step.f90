@@ -6,7 +6,7 @@
 module impact1d_nbody_step
   use impact1d_kinds, only: wp, eps_wp
   use impact1d_scene, only: scene_type
-  use impact1d_state, only: state_type, add_compensated, product_error
+  use impact1d_state, only: state_type, add_compensated, product_error, copy_scalars
   use impact1d_events, only: hermite, earliest_crossing, stop_force_cubic
   use impact1d_yardsticks, only: gap_rounding, velocity_rounding, time_rounding
   use impact1d_elements, only: add_element_forces, add_moving_element_forces, add_element_rates, element_damping_power, &
@@ -39,9 +39,16 @@ module impact1d_nbody_step
   !> while valid: whatever changes the state or the mode without a step (an event point)
   !> calls `forget`. Kept where the stages' forces are the external and the elements' only
   !> (not scene%stage_powers): the same inputs and arithmetic as the stage it replaces.
+  !> nbody_step works in the slots themselves (no copies in or out); under
+  !> scene%stage_powers they are its scratch, never valid. Where the external forces are
+  !> constants (no table, no sine: `timeless`) a slot holds at any time: the end's forces
+  !> serve the next step also where the compensated clock's b%t is not a%t + step (a third
+  !> of the steps; under forces that vary, f(b%t) differs from f(a%t + step) in its last
+  !> bits, and a slot keyed on its time is all that keeps the bits).
   type, public :: kept_forces_type
     integer :: now = 1
     logical :: valid(2) = .false.
+    logical :: timeless = .false.
     real(wp) :: t(2) = 0.0_wp
     real(wp), allocatable :: f(:, :), acc(:, :)      !< (N, 2)
   contains
@@ -49,7 +56,6 @@ module impact1d_nbody_step
     procedure :: accept => accept_kept
     procedure :: forget => forget_kept
     procedure :: holds => kept_holds
-    procedure :: keep => keep_forces
   end type kept_forces_type
 
   !> The belts of sine speed's work in the hot procedures, called through pointers (set
@@ -88,12 +94,15 @@ module impact1d_nbody_step
 
 contains
 
-  !> The slots of n bodies, both empty (the run's one allocation of them).
-  pure subroutine reserve_kept(self, n)
+  !> The slots of n bodies, both empty (the run's one allocation of them); timeless: the
+  !> external forces are constants.
+  pure subroutine reserve_kept(self, n, timeless)
     class(kept_forces_type), intent(inout) :: self
     integer, intent(in) :: n
+    logical, intent(in) :: timeless
     if (allocated(self%f)) deallocate(self%f, self%acc)
     allocate(self%f(n, 2), self%acc(n, 2))
+    self%timeless = timeless
     call self%forget()
   end subroutine reserve_kept
 
@@ -115,19 +124,8 @@ contains
     class(kept_forces_type), intent(in) :: self
     real(wp), intent(in) :: t
     kept_holds = self%valid(self%now)
-    if (kept_holds) kept_holds = self%t(self%now) == t
+    if (kept_holds .and. .not. self%timeless) kept_holds = self%t(self%now) == t
   end function kept_holds
-
-  !> Slot e holds the external forces f at time t and the accelerations acc.
-  pure subroutine keep_forces(self, e, t, f, acc)
-    class(kept_forces_type), intent(inout) :: self
-    integer, intent(in) :: e
-    real(wp), intent(in) :: t, f(:), acc(:)
-    self%f(:, e) = f
-    self%acc(:, e) = acc
-    self%t(e) = t
-    self%valid(e) = .true.
-  end subroutine keep_forces
 
   !> Applied forces f (external and elements') at time t, positions x + dx, velocities v;
   !> engaged: the compliant stops engaged (a mode's; absent: none); external: the external
@@ -255,7 +253,12 @@ contains
   !> RK4 is. With a friction law (belt_v, v_s, c_v) friction's loss and the belts' work are
   !> RK4's own quadrature of their power at the stages (law_ledger). The first stage's
   !> forces are kept's when it holds them for a (the last step's end, or a step already
-  !> taken from a), and the end's go into kept for the next step.
+  !> taken from a), and the end's go into kept for the next step. The stages' forces and
+  !> accelerations live in kept's slots (the start's in slot now, the end's in 3 - now, valid
+  !> only without scene%stage_powers), and the state's arithmetic runs body by body in one
+  !> loop a stage (each body's operations in the order of the array statements they
+  !> replace: the same bits; at small N each array statement was a loop of its own with its
+  !> descriptor, or a call to memcpy). b has a's size (the run's trial state).
   subroutine nbody_step(scene, mode, a, step, b, kept)
     type(scene_type), intent(in) :: scene
     type(body_mode_type), intent(in) :: mode
@@ -263,99 +266,166 @@ contains
     real(wp), intent(in) :: step
     type(state_type), intent(inout) :: b
     type(kept_forces_type), intent(inout) :: kept
-    real(wp), dimension(scene%n_bodies) :: v0, v1, vm, f, dx, kx1, kx2, kx3, kx4, kv1, kv2, kv3, kv4, &
-      f0, fm, f1, acc_end
+    real(wp), dimension(scene%n_bodies) :: v0, v1, vm, f, dx, kx2, kx3, kx4, kv2, kv3, kv4, fm
     real(wp) :: half, power(4), loss(4), belt(4)
+    integer :: now, e, i
     half = 0.5_wp * step
-    v0 = a%v + a%v_lo
-    kx1 = v0
-    if (kept%holds(a%t)) then
-      f0 = kept%f(:, kept%now)
-      kv1 = kept%acc(:, kept%now)
-    else
-      call scene%forcing%force_all(a%t, f0)
-      call stage(f0, a%x_lo, kx1, kv1, 0.0_wp, 1)
+    now = kept%now
+    e = 3 - now
+    do i = 1, scene%n_bodies
+      v0(i) = a%v(i) + a%v_lo(i)
+    end do
+    if (.not. kept%holds(a%t)) then
+      call scene%forcing%force_all(a%t, kept%f(:, now))
+      if (scene%springs%present) dx = a%x_lo
+      call stage(kept%f(:, now), v0, kept%acc(:, now), 0.0_wp, 1)
       ! (for the retries and refinements of this step, and the location)
-      if (.not. scene%stage_powers) call kept%keep(kept%now, a%t, f0, kv1)
+      kept%t(now) = a%t
+      kept%valid(now) = .not. scene%stage_powers
     end if
+    kept%valid(e) = .false.
     call scene%forcing%force_all(a%t + half, fm)
-    call scene%forcing%force_all(a%t + step, f1)
-    kx2 = v0 + half * kv1
-    call stage(fm, a%x_lo + half * kx1, kx2, kv2, half, 2)
-    kx3 = v0 + half * kv2
-    call stage(fm, a%x_lo + half * kx2, kx3, kv3, half, 3)
-    kx4 = v0 + step * kv3
-    call stage(f1, a%x_lo + step * kx3, kx4, kv4, step, 4)
-    b = a
-    call add_compensated(b%t, b%t_lo, step)
-    call add_compensated(b%x, b%x_lo, (step / 6.0_wp) * (kx1 + 2.0_wp * (kx2 + kx3) + kx4))
-    call add_compensated(b%v, b%v_lo, (step / 6.0_wp) * (kv1 + 2.0_wp * (kv2 + kv3) + kv4))
-    if (scene%held_motion) call hold_to_drives(scene, mode, a, step, b)
-    v1 = b%v + b%v_lo
-    f = f1
-    kept%valid(3 - kept%now) = .false.
+    call scene%forcing%force_all(a%t + step, kept%f(:, e))
+    call next_stage(kept%acc(:, now), v0, half, kx2)
+    call stage(fm, kx2, kv2, half, 2)
+    call next_stage(kv2, kx2, half, kx3)
+    call stage(fm, kx3, kv3, half, 3)
+    call next_stage(kv3, kx3, step, kx4)
+    call stage(kept%f(:, e), kx4, kv4, step, 4)
+    call step_state(kept%acc(:, now))
+    if (scene%held_motion) then
+      call hold_to_drives(scene, mode, a, step, b)
+      v1 = b%v + b%v_lo
+    end if
     ! (geared scenes take the stage_powers path, whose accelerations are mode_acceleration's)
     if (scene%stage_powers) then
-      call drive_step_ledger()
+      call drive_step_ledger(kept%f(:, e), kept%acc(:, e))
     else
       ! (stage 1's forces and arithmetic at b: the next step's first stage)
-      if (scene%springs%present) call add_element_forces(scene, b%x, b%x_lo, v1, f)
-      call mode%acceleration(f, acc_end)
-      call kept%keep(3 - kept%now, a%t + step, f1, acc_end)
+      if (scene%springs%present) then
+        f = kept%f(:, e)
+        call add_element_forces(scene, b%x, b%x_lo, v1, f)
+        call mode%acceleration(f, kept%acc(:, e))
+      else
+        call mode%acceleration(kept%f(:, e), kept%acc(:, e))
+      end if
+      kept%t(e) = a%t + step
+      kept%valid(e) = .true.
     end if
-    vm = 0.5_wp * (v0 + v1) + 0.125_wp * step * (kv1 - acc_end)
-    call add_compensated(b%work, b%work_lo, step / 6.0_wp * (dot_product(f0, v0) + &
-      4.0_wp * dot_product(fm, vm) + dot_product(f1, v1)))
-    if (scene%belts .or. scene%stribeck) then
-      call law_ledger()
-    else if (any(mode%f_slide /= 0.0_wp)) then
-      call add_compensated(b%friction_loss, b%friction_lo, step / 6.0_wp * &
-        dot_product(-mode%f_slide, v0 + 4.0_wp * vm + v1))
-    end if
-    if (scene%gap_terms) then
-      if (scene%springs%present) call add_compensated(b%damping_loss, b%damping_lo, step / 6.0_wp * &
-        (element_damping_power(scene, v0, a%t) + 4.0_wp * element_damping_power(scene, vm, a%t + half) + &
-        element_damping_power(scene, v1, drive_time(a%t, step))))
-    else if (scene%springs%present) then
-      call add_compensated(b%damping_loss, b%damping_lo, step / 6.0_wp * &
-        (element_damping_power(scene, v0) + 4.0_wp * element_damping_power(scene, vm) + &
-        element_damping_power(scene, v1)))
-    end if
-    if (scene%n_stops > 0 .and. scene%springs%has_damper) call stop_ledger()
+    call step_ledger(kept%f(:, now), kept%acc(:, now), kept%f(:, e), kept%acc(:, e))
 
   contains
 
-    !> Stage k's accelerations acc at external forces fx, positions a%x + dx', velocities v,
-    !> time a%t + tau (moving grounds and compliant stops apart: moving_stage; tested as one
-    !> sum, since a second test here, or the stops' forces below, and the compiler no longer
-    !> inlined stage: input/train.nml's run took 1.5% more instructions).
-    subroutine stage(fx, dx_stage, v, acc, tau, k)
-      real(wp), intent(in) :: fx(:), dx_stage(:), v(:), tau
+    !> The next stage's velocities kx = v0 + tau kv and, with springs, its displacements
+    !> dx = a%x_lo + tau kx_prev (kx_prev: the previous stage's velocities).
+    subroutine next_stage(kv, kx_prev, tau, kx)
+      real(wp), intent(in) :: kv(:), kx_prev(:), tau
+      real(wp), intent(out) :: kx(:)
+      if (scene%springs%present) then
+        do i = 1, scene%n_bodies
+          kx(i) = v0(i) + tau * kv(i)
+          dx(i) = a%x_lo(i) + tau * kx_prev(i)
+        end do
+      else
+        do i = 1, scene%n_bodies
+          kx(i) = v0(i) + tau * kv(i)
+        end do
+      end if
+    end subroutine next_stage
+
+    !> b: a advanced by the step, RK4's sums of the stages (kv1: stage 1's accelerations),
+    !> compensated; v1 its velocities.
+    subroutine step_state(kv1)
+      real(wp), intent(in) :: kv1(:)
+      real(wp) :: hi, lo
+      call copy_scalars(b, a)
+      call add_compensated(b%t, b%t_lo, step)
+      do i = 1, scene%n_bodies
+        hi = a%x(i)
+        lo = a%x_lo(i)
+        call add_compensated(hi, lo, (step / 6.0_wp) * (v0(i) + 2.0_wp * (kx2(i) + kx3(i)) + kx4(i)))
+        b%x(i) = hi
+        b%x_lo(i) = lo
+        hi = a%v(i)
+        lo = a%v_lo(i)
+        call add_compensated(hi, lo, (step / 6.0_wp) * (kv1(i) + 2.0_wp * (kv2(i) + kv3(i)) + kv4(i)))
+        b%v(i) = hi
+        b%v_lo(i) = lo
+        v1(i) = hi + lo
+      end do
+    end subroutine step_state
+
+    !> The step's ledger: the external forces' work (f0, fm, f1 at the start, the middle
+    !> and the end) and sliding friction's loss by Simpson's rule on the Hermite velocity
+    !> (kv1, acc_end: the start's and the end's accelerations), the dampers' and the stops'.
+    subroutine step_ledger(f0, kv1, f1, acc_end)
+      real(wp), intent(in) :: f0(:), kv1(:), f1(:), acc_end(:)
+      real(wp) :: power0, power_m, power1, slide_loss
+      logical :: sliding
+      power0 = 0.0_wp
+      power_m = 0.0_wp
+      power1 = 0.0_wp
+      slide_loss = 0.0_wp
+      sliding = .false.
+      ! (each sum in the order of the dot_product it replaces)
+      do i = 1, scene%n_bodies
+        vm(i) = 0.5_wp * (v0(i) + v1(i)) + 0.125_wp * step * (kv1(i) - acc_end(i))
+        power0 = power0 + f0(i) * v0(i)
+        power_m = power_m + fm(i) * vm(i)
+        power1 = power1 + f1(i) * v1(i)
+        slide_loss = slide_loss + (-mode%f_slide(i)) * (v0(i) + 4.0_wp * vm(i) + v1(i))
+        sliding = sliding .or. mode%f_slide(i) /= 0.0_wp
+      end do
+      call add_compensated(b%work, b%work_lo, step / 6.0_wp * (power0 + 4.0_wp * power_m + power1))
+      if (scene%belts .or. scene%stribeck) then
+        call law_ledger()
+      else if (sliding) then
+        call add_compensated(b%friction_loss, b%friction_lo, step / 6.0_wp * slide_loss)
+      end if
+      if (scene%gap_terms) then
+        if (scene%springs%present) call add_compensated(b%damping_loss, b%damping_lo, step / 6.0_wp * &
+          (element_damping_power(scene, v0, a%t) + 4.0_wp * element_damping_power(scene, vm, a%t + half) + &
+          element_damping_power(scene, v1, drive_time(a%t, step))))
+      else if (scene%springs%present) then
+        call add_compensated(b%damping_loss, b%damping_lo, step / 6.0_wp * &
+          (element_damping_power(scene, v0) + 4.0_wp * element_damping_power(scene, vm) + &
+          element_damping_power(scene, v1)))
+      end if
+      if (scene%n_stops > 0 .and. scene%springs%has_damper) call stop_ledger()
+    end subroutine step_ledger
+
+    !> Stage k's accelerations acc at external forces fx, positions a%x + dx (dx: the
+    !> caller's, with springs), velocities v, time a%t + tau (moving grounds and compliant
+    !> stops apart: moving_stage; tested as one sum, since a second test here, or the stops'
+    !> forces below, and the compiler no longer inlined stage: input/train.nml's run took
+    !> 1.5% more instructions).
+    subroutine stage(fx, v, acc, tau, k)
+      real(wp), intent(in) :: fx(:), v(:), tau
       real(wp), intent(out) :: acc(:)
       integer, intent(in) :: k
       if (scene%stage_powers) then
-        call moving_stage(fx, dx_stage, v, acc, drive_time(a%t, tau), power(k), k)
+        call moving_stage(fx, v, acc, drive_time(a%t, tau), power(k), k)
         return
       end if
-      f = fx
       if (scene%springs%present) then
-        dx = dx_stage
+        f = fx
         call add_element_forces(scene, a%x, dx, v, f)
+        call mode%acceleration(f, acc)
+      else
+        call mode%acceleration(fx, acc)
       end if
-      call mode%acceleration(f, acc)
     end subroutine stage
 
     !> stage with moving grounds, compliant stops or a friction law at time t: and the power
     !> the grounds put in (a still ground's element ends are at w = 0 here, the same bits);
     !> with a friction law, friction's loss and the belts' power (loss(k), belt(k)).
-    subroutine moving_stage(fx, dx_stage, v, acc, t, drive_power, k)
-      real(wp), intent(in) :: fx(:), dx_stage(:), v(:), t
+    subroutine moving_stage(fx, v, acc, t, drive_power, k)
+      real(wp), intent(in) :: fx(:), v(:), t
       real(wp), intent(out) :: acc(:), drive_power
       integer, intent(in) :: k
       f = fx
       drive_power = 0.0_wp
       if (scene%springs%present) then
-        dx = dx_stage
         call add_moving_element_forces(scene, a%x, dx, v, f, t, drive_power)
         if (scene%n_stops > 0) then
           call add_stop_forces(scene, mode%engaged, a%x, dx, v, f, t)
@@ -389,9 +459,13 @@ contains
 
     !> The step's end with moving grounds, compliant stops or a friction law (moving_stage):
     !> the accelerations there, and the work the prescribed motion did, by RK4's own
-    !> quadrature of the stages' power (0 without moving grounds).
-    subroutine drive_step_ledger()
+    !> quadrature of the stages' power (0 without moving grounds). f1: the external forces
+    !> at the end, acc_end: the accelerations there.
+    subroutine drive_step_ledger(f1, acc_end)
+      real(wp), intent(in) :: f1(:)
+      real(wp), intent(out) :: acc_end(:)
       real(wp) :: t_end
+      f = f1
       t_end = b%t
       if (scene%drives%tables) t_end = drive_time(a%t, step)
       if (scene%springs%present) call add_moving_element_forces(scene, b%x, b%x_lo, v1, f, t_end)
@@ -623,7 +697,10 @@ contains
 
   !> Earliest event in (0, step] of the step from a to b: a gap of a row not held closing, a
   !> body sliding with friction stopping, or (forces that vary) the mode failing; found and
-  !> index say what and where (found_none: theta past the step).
+  !> index say what and where (found_none: theta past the step). The mode's accelerations
+  !> at a (the tolerances' acc0, acc_rounding) are formed when a test first needs them
+  !> (start_forces): most steps of a few bodies have every row clear of its gap and no
+  !> body sliding, and need none.
   subroutine locate_nbody(scene, mode, work, polynomial, a, b, step, kept, theta, found, index)
     type(scene_type), intent(in) :: scene
     type(body_mode_type), intent(in) :: mode
@@ -637,18 +714,12 @@ contains
     real(wp) :: c(3, scene%n_bodies), p(0:3), q(0:3), candidate, acc0(scene%n_bodies), f(scene%n_bodies), &
       acc_rounding
     integer :: k, i
+    logical :: started
     theta = huge(1.0_wp)
     found = found_none
     index = 0
+    started = .false.
     call dense_output(a, b, step, c)
-    if (kept%holds(a%t)) then
-      call nbody_force(scene, a%t, a%x, a%x_lo, a%v, f, mode%engaged, kept%f(:, kept%now))
-    else
-      call nbody_force(scene, a%t, a%x, a%x_lo, a%v, f, mode%engaged)
-    end if
-    if (scene%stribeck) call add_stribeck_forces(scene, mode%sgn, a%v, a%t, f)
-    call mode_acceleration(scene, mode, a%t, f, acc0)
-    acc_rounding = 1.0e3_wp * eps_wp * sum(abs(f)) / minval(scene%body_mass)
     do k = 1, scene%n_rows
       if (mode%active(k)) cycle
       call gap_cubic(scene, k, a, c, step, p, q)
@@ -658,6 +729,7 @@ contains
       ! no crossing of a constant p(0) >= 0 whatever the tolerances (all >= 0), and a
       ! result past the step is dropped (advance), so skipping it changes nothing.
       if (p(0) >= 0.0_wp .and. all(p(1:3) == 0.0_wp)) cycle
+      call start_forces()
       q(0) = row_gap_tolerance(scene, k, a, 0.0_wp)
       q(2) = q(2) + acc_rounding
       ! A motion that is not a cubic is only approximated by it: the dips the cubic's wrong
@@ -692,7 +764,10 @@ contains
       ! (the slip: velocity relative to the body's friction surface)
       p = mode%sgn(i) * [slip(scene, i, c(1, i), a%t), 2.0_wp * c(2, i), 3.0_wp * c(3, i), 0.0_wp]
       q = [velocity_rounding * max(abs(a%v(i)), abs(b%v(i)), abs(b%v(i) - a%v(i))), 0.0_wp, 0.0_wp, 0.0_wp]
-      if (.not. polynomial) q(1) = q(1) + abs(p(1) - mode%sgn(i) * acc0(i))
+      if (.not. polynomial) then
+        call start_forces()
+        q(1) = q(1) + abs(p(1) - mode%sgn(i) * acc0(i))
+      end if
       if (scene%belt_moves) call belt_less(scene, i, mode%sgn(i), a%t, step, p, q)
       candidate = earliest_crossing(p, step, q)
       if (candidate < theta) then
@@ -701,11 +776,29 @@ contains
         index = i
       end if
     end do
+    if (scene%n_stops > 0 .or. scene%n_frictions > 0) call start_forces()
     if (scene%n_stops > 0) call locate_stops(scene, mode, a, c, step, acc0, acc_rounding, theta, found, index)
     if (scene%n_frictions > 0) call relative_stops(scene, mode, a, b, step, c, polynomial, acc0, theta, found, index)
     if (mode%held .and. (scene%forcing%varies .or. scene%springs%present .or. .not. scene%drives%polynomial &
         .or. scene%stribeck .or. scene%belt_moves)) &
       call mode_crossing(scene, mode, work, a, c, min(theta, step), theta, found)
+
+  contains
+
+    !> The applied forces f and the mode's accelerations acc0 at a, and their rounding
+    !> acc_rounding (once a location).
+    subroutine start_forces()
+      if (started) return
+      started = .true.
+      if (kept%holds(a%t)) then
+        call nbody_force(scene, a%t, a%x, a%x_lo, a%v, f, mode%engaged, kept%f(:, kept%now))
+      else
+        call nbody_force(scene, a%t, a%x, a%x_lo, a%v, f, mode%engaged)
+      end if
+      if (scene%stribeck) call add_stribeck_forces(scene, mode%sgn, a%v, a%t, f)
+      call mode_acceleration(scene, mode, a%t, f, acc0)
+      acc_rounding = 1.0e3_wp * eps_wp * sum(abs(f)) / minval(scene%body_mass)
+    end subroutine start_forces
   end subroutine locate_nbody
 
   !> The slip cubic p of body i (sliding direction sgn) over the step from t less its

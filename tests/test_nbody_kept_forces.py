@@ -42,3 +42,31 @@ def test_kept_forces_are_forgotten_at_impacts_and_mode_changes():
         assert np.max(np.abs(three.events["t"][mine] - alone.events["t"])) < TOL
         assert np.max(np.abs(three.x[:, i] - alone.x[:, 0])) < TOL
         assert np.max(np.abs(three.v[:, i] - alone.v[:, 0])) < TOL
+
+
+def test_kept_forces_under_constant_forces_are_forgotten_too():
+    """Under constant forces (no sine, no table) a slot holds at any time (kept_forces_type's
+    timeless: the end's forces serve the next step whatever the clock's rounding), so after
+    every event point the first stage would take a stale one were it not forgotten. The same
+    three-body comparison with the sines replaced by constant forces: body 1 pressed by its
+    spring and a constant force onto the wall, bouncing until it rests there; body 2 a
+    block on a spring, launched, its friction turning it round until it sticks."""
+    three = impact1d.simulate(impact1d.Scene(
+        m=[1.0, 1.0, 1.0], x=[0.0, 10.0, 20.0], v=[-1.5, 3.0, 0.0], mu=[0.0, 0.2, 0.0], mus=[0.0, 0.3, 0.0],
+        k=[40.0, 100.0, 0.0], x_rest=[0.0, 10.0, 0.0], c=[0.4, 0.0, 0.0], f=[-1.0, 0.5, 0.0], **WALL, **RUN))
+    oscillator = impact1d.simulate(impact1d.Scene(m1=1.0, x1=0.0, v1=-1.5, k1=40.0, x1_rest=0.0, c1=0.4, f1=-1.0,
+                                                  **WALL, **RUN))
+    block = impact1d.simulate(impact1d.Scene(m1=1.0, x1=10.0, v1=3.0, mu1=0.2, mus1=0.3, k1=100.0, x1_rest=10.0,
+                                             f1=0.5, **RUN))
+    kinds = list(three.events["kind"])
+    assert kinds.count("left") >= 5 and kinds.count("stick2") == 1
+    # (body 2 turns round at each of its stops, an event point that logs nothing, then sticks)
+    turning = np.sign(three.v[:, 1])
+    turning = turning[turning != 0]
+    assert np.count_nonzero(turning[1:] != turning[:-1]) >= 5
+    for i, alone, own in ((0, oscillator, ("left",)), (1, block, ("stick2",))):
+        mine = np.isin(three.events["kind"], own)
+        assert [kind.replace("2", "1") for kind in three.events["kind"][mine]] == list(alone.events["kind"])
+        assert np.max(np.abs(three.events["t"][mine] - alone.events["t"])) < TOL
+        assert np.max(np.abs(three.x[:, i] - alone.x[:, 0])) < TOL
+        assert np.max(np.abs(three.v[:, i] - alone.v[:, 0])) < TOL

@@ -1,10 +1,11 @@
 !> The compensated state: a clock advanced by 10^6 steps of 1e-5 s keeps its digits, and a
 !> state assigned to another is copied whole, into the arrays it has when their size fits;
-!> product_error is the exact rounding error of a product (a gear ratio's gap).
+!> product_error is the exact rounding error of a product (a gear ratio's gap); take_state
+!> swaps two states (values up to 8 bodies, allocations beyond).
 program test_state
   use, intrinsic :: iso_c_binding, only: c_ptr, c_loc, c_associated
   use impact1d_kinds, only: wp
-  use impact1d_state, only: state_type, new_state, add_compensated, product_error
+  use impact1d_state, only: state_type, new_state, add_compensated, product_error, take_state
   use testing, only: check, finish
   implicit none
   integer, parameter :: n_steps = 1000000
@@ -26,6 +27,11 @@ program test_state
   call check(abs(naive - 10.0_wp) > naive_drift_floor, 'the plain sum does drift (the check can fail)')
 
   call assignment_copies()
+  call takes(1)
+  call takes(2)
+  call takes(8)
+  call takes(9)
+  call takes(50)
   call product_errors()
   call finish('test_state')
 
@@ -84,4 +90,41 @@ contains
     b = none
     call check(.not. allocated(b%x) .and. .not. allocated(b%v), 'state assignment: a state of no bodies frees them')
   end subroutine assignment_copies
+
+  !> take_state(to, from) on n bodies: to has from's values, clock and ledger, from has to's
+  !> old arrays' values (the run's trial state, to be overwritten), both at their size.
+  subroutine takes(n)
+    integer, intent(in) :: n
+    type(state_type) :: to, from
+    character(len=8) :: bodies
+    integer :: i
+    write (bodies, '(i0)') n
+    call new_state(n, to)
+    call new_state(n, from)
+    do i = 1, n
+      to%x(i) = i
+      to%x_lo(i) = 1.0e-17_wp * i
+      to%v(i) = -i
+      to%v_lo(i) = -1.0e-17_wp * i
+      from%x(i) = 100 + i
+      from%x_lo(i) = 3.0e-15_wp * i
+      from%v(i) = 0.5_wp * i
+      from%v_lo(i) = -3.0e-18_wp * i
+    end do
+    from%t = 0.25_wp
+    from%t_lo = 1.0e-18_wp
+    from%work = 2.0_wp
+    from%damping_loss = 0.5_wp
+    call take_state(to, from)
+    call check(size(to%x) == n .and. size(to%v_lo) == n .and. size(from%x) == n .and. size(from%v_lo) == n, &
+      'take_state, ' // trim(bodies) // ' bodies: both keep their size')
+    call check(all(to%x == [(100.0_wp + i, i = 1, n)]) .and. all(to%x_lo == [(3.0e-15_wp * i, i = 1, n)]) .and. &
+      all(to%v == [(0.5_wp * i, i = 1, n)]) .and. all(to%v_lo == [(-3.0e-18_wp * i, i = 1, n)]), &
+      'take_state, ' // trim(bodies) // ' bodies: to has from''s positions and velocities')
+    call check(all(from%x == [(real(i, wp), i = 1, n)]) .and. all(from%v_lo == [(-1.0e-17_wp * i, i = 1, n)]), &
+      'take_state, ' // trim(bodies) // ' bodies: from has to''s old values')
+    call check(to%t == 0.25_wp .and. to%t_lo == 1.0e-18_wp .and. to%work == 2.0_wp .and. to%damping_loss == 0.5_wp, &
+      'take_state, ' // trim(bodies) // ' bodies: the clock and the ledger taken')
+  end subroutine takes
+
 end program test_state
