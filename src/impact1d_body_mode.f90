@@ -23,7 +23,7 @@ module impact1d_body_mode
   use impact1d_cluster_mode, only: cluster_work_type, cluster_reserve, cluster_mode, cluster_solved
   use impact1d_lcp, only: lcp_too_large
   use impact1d_path_mode, only: path_work_type, path_reserve, path_order, path_mode
-  use impact1d_friction_laws, only: slip, sliding_bound
+  use impact1d_friction_laws, only: slip, sliding_bound, belt_moving, belt_rate
   implicit none
   private
   public :: body_mode_type, mode_work_type, new_mode, solve_body_mode, same_mode, mode_solved
@@ -72,8 +72,12 @@ module impact1d_body_mode
   !> The mode solve's memory, sized by the run (new_mode) and grown at event points only when
   !> a cluster is larger than any before.
   type :: mode_work_type
-    type(cluster_work_type) :: cluster
-    type(path_work_type) :: path
+    !> The dense solve's (allocated by its first cluster, dense_reserve: a run whose clusters are
+    !> all paths or bodies alone, a short call's, does not copy its 2 kB in and out)
+    type(cluster_work_type), allocatable :: cluster
+    !> The path solve's (allocated by mode_reserve: a run with no cluster to solve, a short
+    !> call's, does not copy its 2.9 kB in and out)
+    type(path_work_type), allocatable :: path
     !> Solve every cluster densely, paths too (tests compare the two solves).
     logical :: dense_only = .false.
     integer, allocatable :: root(:)                  !< (0:N) union-find
@@ -94,11 +98,12 @@ module impact1d_body_mode
 contains
 
   !> A mode of n bodies and n_rows rows with nothing held (each body alone, no friction),
-  !> and the work of its solves.
+  !> and the work of its solves. Both as declared (a run's new memory, nothing allocated):
+  !> intent(out) would have gfortran build their default initialisation and copy it in.
   subroutine new_mode(n, n_rows, mode, work)
     integer, intent(in) :: n, n_rows
-    type(body_mode_type), intent(out) :: mode
-    type(mode_work_type), intent(out) :: work
+    type(body_mode_type), intent(inout) :: mode
+    type(mode_work_type), intent(inout) :: work
     integer :: i
     allocate(mode%active(n_rows), mode%stuck(n), mode%sgn(n), mode%f_slide(n), mode%group(n), &
       mode%group_mass(0:n), mode%drive(n))
@@ -359,6 +364,8 @@ contains
       work%row_normal(2, j) = scene%row_normal(2, k)
     end do
     if (scene%n_frictions > 0) call gather_pairs(scene, work, c, nb, nr, v)
+    if (allocated(work%cluster)) work%cluster%biased = .false.
+    if (scene%belt_moves) call gather_belt_frames(scene, work, c, nb, nr, v, t)
     call gathered_mode(work, nb, nr, status)
     if (status /= cluster_solved) return
     do j = 1, nb
@@ -371,6 +378,36 @@ contains
     end do
     if (scene%n_frictions > 0) call scatter_pairs(scene, work, c, v, mode)
   end subroutine solve_cluster
+
+  !> Cluster c's rows between frames that accelerate apart: a body at rest on a belt of sine
+  !> speed is solved in its belt's frame (its force shifted by -m V': impact1d_friction_laws'
+  !> shift_to_belts), so a row's acceleration n.a is n.a' + n.b, b_i = V_i'(t) for such a
+  !> body, else 0 (the dense solve's row_bias; a wall, or a body in another frame, stays
+  !> where it is while the belt carries its neighbour on). O(rows) per such cluster.
+  subroutine gather_belt_frames(scene, work, c, nb, nr, v, t)
+    type(scene_type), intent(in) :: scene
+    type(mode_work_type), intent(inout) :: work
+    integer, intent(in) :: c, nb, nr
+    real(wp), intent(in) :: v(:), t
+    integer :: j, k, e, i
+    call dense_reserve(work, nb, nr, 0)
+    do j = 1, nr
+      k = work%row(work%first_row(c) + j - 1)
+      work%cluster%row_bias(j) = 0.0_wp
+      work%cluster%row_bias_rate(j) = 0.0_wp
+      do e = 1, 2
+        i = scene%row_body(e, k)
+        if (i == 0) cycle
+        if (.not. belt_moving(scene, i)) cycle
+        if (slip(scene, i, v(i), t) /= 0.0_wp) cycle
+        work%cluster%row_bias(j) = work%cluster%row_bias(j) + scene%row_normal(e, k) * belt_rate(scene, i, t, 2)
+        work%cluster%row_bias_rate(j) = work%cluster%row_bias_rate(j) + scene%row_normal(e, k) * &
+          belt_rate(scene, i, t, 3)
+      end do
+      work%cluster%biased = work%cluster%biased .or. work%cluster%row_bias(j) /= 0.0_wp .or. &
+        work%cluster%row_bias_rate(j) /= 0.0_wp
+    end do
+  end subroutine gather_belt_frames
 
   !> Cluster c's friction contacts (&friction): the force of those that slide added to
   !> their ends' applied forces, those at relative rest given to the dense solve as boxes
@@ -388,7 +425,7 @@ contains
     do j = 1, scene%n_frictions
       if (pair_of_cluster(scene, work, j, v, c)) np = np + 1
     end do
-    call cluster_reserve(work%cluster, nb, max(nr, 1), np)
+    call dense_reserve(work, nb, nr, np)
     work%cluster%n_pairs = 0
     do j = 1, scene%n_frictions
       if (.not. pair_of_cluster(scene, work, j, v, c)) cycle
@@ -436,10 +473,14 @@ contains
     type(mode_work_type), intent(inout) :: work
     integer, intent(in) :: nb, nr
     integer, intent(out) :: status
+    logical :: paired
     work%candidate(1:nr) = .true.
     ! (a cluster with friction contacts at relative rest takes the dense solve: the path
-    ! solve has no boxes on relative coordinates)
-    if (.not. work%dense_only .and. work%cluster%n_pairs == 0) then
+    ! solve has no boxes on relative coordinates; one with rows between belts' frames too:
+    ! it has no row_bias)
+    paired = .false.
+    if (allocated(work%cluster)) paired = work%cluster%n_pairs > 0 .or. work%cluster%biased
+    if (.not. work%dense_only .and. .not. paired) then
       if (path_order(work%path, nb, work%row_body(:, 1:nr), work%row_normal(:, 1:nr))) then
         call path_mode(work%path, work%mass(1:nb), work%force(1:nb), work%rate(1:nb), work%friction(1:nb), &
           work%static(1:nb), work%velocity(1:nb), work%row_body(:, 1:nr), work%row_normal(:, 1:nr), &
@@ -450,11 +491,20 @@ contains
     end if
     status = lcp_too_large
     if (max(nr, 1) + 2 * nb > max_dense_unknowns) return
-    call cluster_reserve(work%cluster, nb, max(nr, 1))
+    call dense_reserve(work, nb, nr, 0)
     call solve_gathered(work, nb, nr, status)
     if (status /= cluster_solved) return
     call prefer_friction(work, nb, nr, status)
   end subroutine gathered_mode
+
+  !> The dense solve's memory for nb bodies, nr rows and np friction contacts at relative
+  !> rest, made at its first cluster.
+  subroutine dense_reserve(work, nb, nr, np)
+    type(mode_work_type), intent(inout) :: work
+    integer, intent(in) :: nb, nr, np
+    if (.not. allocated(work%cluster)) allocate(work%cluster)
+    call cluster_reserve(work%cluster, nb, max(nr, 1), np)
+  end subroutine dense_reserve
 
   !> The gathered problem of nb bodies and nr rows (work's arrays) solved by cluster_mode.
   subroutine solve_gathered(work, nb, nr, status)
@@ -532,6 +582,7 @@ contains
   subroutine mode_reserve(work, nb, nr)
     type(mode_work_type), intent(inout) :: work
     integer, intent(in) :: nb, nr
+    if (.not. allocated(work%path)) allocate(work%path)
     call path_reserve(work%path, nb)
     if (allocated(work%mass)) then
       if (size(work%mass) >= nb .and. size(work%candidate) >= max(nr, 1)) return

@@ -70,6 +70,12 @@ module impact1d_cluster_mode
     real(wp), allocatable, private :: pair_beta(:)   !< (max_pairs) its bound in this solve
     integer, allocatable, private :: pair_slot(:)    !< (max_pairs) its box slot (after the bodies'), else 0
     logical, allocatable, private :: pair_broken(:)  !< (max_pairs) broken away: bound pair_slide
+    !> Rows whose ends are solved in frames that accelerate apart (a body at rest on a belt of
+    !> sine speed is solved in its belt's frame, a = b + a': impact1d_body_mode's solve_cluster
+    !> sets these, biased false by default): row k's w = n_k.a' + row_bias(k) is the rows'
+    !> acceleration n_k.a in the still frame, row_bias = n_k.b (its rate row_bias_rate).
+    logical :: biased = .false.
+    real(wp), allocatable :: row_bias(:), row_bias_rate(:)   !< (max_rows)
   end type cluster_work_type
 
 contains
@@ -95,13 +101,13 @@ contains
     if (work%max_bodies >= max_bodies .and. work%max_rows >= max_rows .and. allocated(work%m)) return
     if (allocated(work%q)) deallocate(work%q, work%dq, work%z, work%w, work%dz, work%dw, &
       work%beta, work%base, work%da, work%row_var, work%slot, work%root, work%broken, &
-      work%group_mass, work%group_sum)
+      work%group_mass, work%group_sum, work%row_bias, work%row_bias_rate)
     if (allocated(work%m)) deallocate(work%m)
     mb = max(max_bodies, work%max_bodies)
     mr = max(max_rows, work%max_rows)
     s = mr + 2 * (mb + work%max_pairs)
     allocate(work%m(s, s), work%q(s), work%dq(s), work%z(s), work%w(s), work%dz(s), work%dw(s), &
-      work%beta(mb), work%base(mb), work%da(mb), work%row_var(mr), &
+      work%beta(mb), work%base(mb), work%da(mb), work%row_var(mr), work%row_bias(mr), work%row_bias_rate(mr), &
       work%slot(mb), work%root(0:mb), work%broken(mb), &
       work%group_mass(0:mb), work%group_sum(0:mb))
     call lcp_reserve(work%lcp, s)
@@ -225,6 +231,10 @@ contains
     real(wp), intent(in) :: row_normal(:, :)
     integer :: p, e, i, box
     p = work%row_var(k)
+    if (work%biased) then
+      work%q(p) = work%q(p) + work%row_bias(k)
+      work%dq(p) = work%dq(p) + work%row_bias_rate(k)
+    end if
     do e = 1, 2
       i = row_body(e, k)
       if (i == 0) cycle
@@ -381,10 +391,15 @@ contains
 
   contains
 
-    !> Row k closed and staying closed: n.a and its rate zero.
+    !> Row k closed and staying closed: n.a and its rate zero (in the still frame: biased).
     logical function closed(k)
       integer, intent(in) :: k
-      closed = row_closed(row_body, row_normal, k, mass, acceleration, work%da, tol_f, tol_rate)
+      if (work%biased) then
+        closed = row_closed(row_body, row_normal, k, mass, acceleration, work%da, tol_f, tol_rate, &
+          work%row_bias(k), work%row_bias_rate(k))
+      else
+        closed = row_closed(row_body, row_normal, k, mass, acceleration, work%da, tol_f, tol_rate)
+      end if
     end function closed
 
     !> A wall, or a body-body row of the form (-1, 1) or (1, -1): it makes its ends move alike.

@@ -264,17 +264,25 @@ contains
 
   !> Row k closed and staying closed under accelerations a with rates da: n.a and n.da zero
   !> within the zero force tol_f and rate tol_rate through the row's ends' inverse masses.
-  pure logical function row_closed(row_body, row_normal, k, mass, a, da, tol_f, tol_rate) result(closed)
+  !> bias, bias_rate: added to n.a and n.da (ends solved in accelerating frames:
+  !> impact1d_cluster_mode's row_bias).
+  pure logical function row_closed(row_body, row_normal, k, mass, a, da, tol_f, tol_rate, bias, bias_rate) &
+      result(closed)
     integer, intent(in) :: row_body(:, :), k
     real(wp), intent(in) :: row_normal(:, :), mass(:), a(:), da(:), tol_f, tol_rate
-    real(wp) :: inverse_mass
+    real(wp), intent(in), optional :: bias, bias_rate
+    real(wp) :: inverse_mass, shift, shift_rate
     integer :: e
     inverse_mass = 0.0_wp
     do e = 1, 2
       if (row_body(e, k) > 0) inverse_mass = inverse_mass + abs(row_normal(e, k)) / mass(row_body(e, k))
     end do
-    closed = abs(row_rate(row_body, row_normal, k, a)) <= 2.0_wp * tol_f * inverse_mass .and. &
-      abs(row_rate(row_body, row_normal, k, da)) <= 2.0_wp * tol_rate * inverse_mass
+    shift = 0.0_wp
+    shift_rate = 0.0_wp
+    if (present(bias)) shift = bias
+    if (present(bias_rate)) shift_rate = bias_rate
+    closed = abs(row_rate(row_body, row_normal, k, a) + shift) <= 2.0_wp * tol_f * inverse_mass .and. &
+      abs(row_rate(row_body, row_normal, k, da) + shift_rate) <= 2.0_wp * tol_rate * inverse_mass
   end function row_closed
 
   !> The selected rows numbered 1..n_selected in row order (row_var(k), 0 for the others) and

@@ -33,7 +33,9 @@ module impact1d_nbody_event
   !> next at the same instant.
   type :: point_work_type
     type(mode_work_type) :: mode
-    type(impact_work_type) :: impact
+    !> (allocated by the first joint impact of a closed group: a run that has none, a short
+    !> call's, does not copy its default-initialised 4.7 kB in and out)
+    type(impact_work_type), allocatable :: impact
     !> The last event point's instant and the velocity scale its impulses came from (N).
     real(wp) :: scale_time = -huge(1.0_wp)
     real(wp), allocatable :: scale(:)
@@ -78,15 +80,17 @@ contains
   end subroutine new_point_work
 
   !> What the event points of a run share, set at its first: the rows on each body, the
-  !> rigid groups when there are no rigid links (each body alone), a scratch mode.
+  !> rigid groups when there are no rigid links (each body alone); the scratch mode at its
+  !> first use (scratch_mode).
   subroutine first_point(scene, mode, work)
     type(scene_type), intent(in) :: scene
     type(body_mode_type), intent(in) :: mode
     type(point_work_type), intent(inout) :: work
     integer :: i
+    ! (an earlier run's scratch made anew at its first use: scratch_mode)
+    if (allocated(work%scratch%stuck)) deallocate(work%scratch%stuck)
     ! (the rigid rows only: the compliant stops' rows after them are elements, never closed)
     call clusters_build(work%incidence, scene%n_bodies, scene%row_body(:, 1:scene%n_rows))
-    work%scratch = mode
     if (allocated(work%closed_rows)) deallocate(work%closed_rows, work%local)
     allocate(work%closed_rows(max(scene%n_rows, 1)), work%local(0:scene%n_bodies))
     work%local = 0
@@ -132,7 +136,8 @@ contains
     end if
     call nbody_force(scene, s%t, s%x, s%x_lo, s%v, f, mode%engaged)
     call nbody_rate(scene, s%t, s%v, df, mode%engaged)
-    call close_rows(scene, initial, merge(index, 0, found == found_row), s, closed, work%closed_rows, work%n_closed)
+    call close_rows(scene, initial, merge(index, 0, found == found_row), mode%active, s, closed, work%closed_rows, &
+      work%n_closed)
     ! Velocity scale of each body entering this event point: impulses redistribute velocity
     ! but cannot create precision, so what is below its rounding is zero.
     if (initial) then
@@ -141,6 +146,7 @@ contains
       call mode_acceleration(scene, mode, s%t, f, acc)
     end if
     entry_scale = abs(s%v) + abs(acc) * scene%dt
+    if (scene%belt_moves) call belt_scale(scene, s%t, entry_scale)
     if (same_instant(scene, s%t, work%scale_time)) entry_scale = max(entry_scale, work%scale)
     do i = 1, scene%n_bodies
       stopped(i) = scene%body_static(i) > 0.0_wp .and. slip(scene, i, s%v(i), s%t) /= 0.0_wp .and. ((found == &
@@ -171,8 +177,6 @@ contains
     ! (solved in place: the old mode is not read past here but for its friction contacts'
     ! stuck flags, kept for the log; a failed solve ends the run)
     if (scene%n_frictions > 0 .and. .not. initial) pair_was_stuck = mode%friction_stuck
-    if (scene%belt_moves) call refuse_held_belts(scene, candidate, s, error)
-    if (allocated(error)) return
     ! (geared groups' scaled accelerations are set_groups' alone: no scoped shortcut)
     if (initial .or. .not. work%frictionless .or. scene%drives%n > 0 .or. scene%geared) then
       call solve_mode_at(scene, work%mode, s%t, f, df, s%v, candidate, mode, status)
@@ -191,6 +195,9 @@ contains
         ': no consistent contact and friction state (complementarity problem has no solution)')
       return
     end if
+    if (scene%belt_moves) call refuse_held_belts(scene, mode, s, error)
+    if (allocated(error)) return
+    if (scene%belt_moves) call still_on_belts(scene, mode, s)
     call log_mode_change(scene, initial, f, df, candidate, mode, s, event_log, sink, stats)
     if (scene%n_frictions > 0 .and. .not. initial) call log_pairs(scene, pair_was_stuck, mode, s, sink, stats)
   end subroutine nbody_event_point
@@ -273,43 +280,101 @@ contains
     call solve_body_mode(scene, work, f_seen, df_seen, v, t, candidate, mode, status)
   end subroutine solve_mode_at
 
-  !> A body at rest on a belt of sine speed (slip 0 at s%t) may not be an end of a candidate
-  !> row (closed, at rest): the mode solve takes such a body in its belt's frame alone
-  !> (shift_to_belts), and a row would join it to bodies or a wall in other frames, which the
-  !> cluster solves do not take yet: the run ends there, naming the body and the row.
-  subroutine refuse_held_belts(scene, candidate, s, error)
+  !> A body stuck on a belt of sine speed may not be an end of a held row, but for a row
+  !> between two bodies stuck on belts of the same acceleration: the mode solve takes such
+  !> rows (impact1d_body_mode's gather_belt_frames), but a body held against a stuck one
+  !> would ride its belt, which the groups' motion (group 0 still but for each stuck body's
+  !> own belt) does not take yet: the run ends there, naming the body and the row. A row
+  !> that the belt carries its body away from, or a body that slides on its belt against a
+  !> wall or a neighbour, runs.
+  subroutine refuse_held_belts(scene, mode, s, error)
     type(scene_type), intent(in) :: scene
-    logical, intent(in) :: candidate(:)
+    type(body_mode_type), intent(in) :: mode
     type(state_type), intent(in) :: s
     type(error_type), allocatable, intent(inout) :: error
     integer :: k, e, i
     do k = 1, scene%n_rows
-      if (.not. candidate(k)) cycle
+      if (.not. mode%active(k)) cycle
+      if (same_belt_frame(k)) cycle
       do e = 1, 2
         i = scene%row_body(e, k)
         if (i == 0) cycle
-        if (.not. belt_moving(scene, i)) cycle
-        if (slip(scene, i, s%v(i), s%t) /= 0.0_wp) cycle
+        if (.not. (mode%stuck(i) .and. belt_moving(scene, i))) cycle
         call raise(error, status_simulation, 'at t = ' // trim(fmt(s%t)) // ': body ' // trim(fmt(i)) // &
-          ', at rest on its belt of sine speed (belt_amp), is held by the contact ' // trim(scene%row_name(k)) // &
-          ': a body on such a belt cannot stick while in contact yet (docs/method.md section 12)')
+          ', stuck on its belt of sine speed (belt_amp), holds the contact ' // trim(scene%row_name(k)) // &
+          ' closed: a body held against one stuck on such a belt cannot ride it yet (docs/method.md section 12)')
         return
       end do
     end do
+
+  contains
+
+    !> Row k joins two stuck bodies whose belts accelerate alike (their row's n.b and its
+    !> rate zero: each rides its own belt, the row stays closed).
+    logical function same_belt_frame(k)
+      integer, intent(in) :: k
+      integer :: a, b
+      a = scene%row_body(1, k)
+      b = scene%row_body(2, k)
+      same_belt_frame = .false.
+      if (a == 0) return
+      if (.not. (mode%stuck(a) .and. mode%stuck(b))) return
+      same_belt_frame = scene%row_normal(1, k) * belt_rate(scene, a, s%t, 2) + &
+        scene%row_normal(2, k) * belt_rate(scene, b, s%t, 2) == 0.0_wp .and. &
+        scene%row_normal(1, k) * belt_rate(scene, a, s%t, 3) + scene%row_normal(2, k) * belt_rate(scene, b, s%t, 3) &
+        == 0.0_wp
+    end function same_belt_frame
   end subroutine refuse_held_belts
 
+  !> A body on a belt of sine speed that the mode holds still (against a wall) and slides:
+  !> its velocity exactly 0, not its belt's speed within rounding of 0 where it stopped on
+  !> its belt (else it creeps off the wall by that rounding); the rounding's energy is
+  !> friction's, as zero_velocity books it.
+  pure subroutine still_on_belts(scene, mode, s)
+    type(scene_type), intent(in) :: scene
+    type(body_mode_type), intent(in) :: mode
+    type(state_type), intent(inout) :: s
+    integer :: i
+    do i = 1, scene%n_bodies
+      if (mode%group(i) /= 0 .or. mode%stuck(i) .or. s%v(i) == 0.0_wp) cycle
+      if (mode%drive(i) /= 0 .or. .not. belt_moving(scene, i)) cycle
+      call add_compensated(s%friction_loss, s%friction_lo, 0.5_wp * scene%body_mass(i) * s%v(i)**2)
+      s%v(i) = 0.0_wp
+      s%v_lo(i) = 0.0_wp
+    end do
+  end subroutine still_on_belts
+
+  !> A body on a belt of sine speed has the belt's velocity scale too, that of V's terms
+  !> (|belt_v| + |belt_amp|, its rounding's) and of a step's change |V'| dt: held still
+  !> against a wall while it slides, it stops on its belt where the belt's speed is within
+  !> rounding of 0, not at 0 (a rounding of approach, no impact).
+  pure subroutine belt_scale(scene, t, scale)
+    type(scene_type), intent(in) :: scene
+    real(wp), intent(in) :: t
+    real(wp), intent(inout) :: scale(:)
+    integer :: i
+    do i = 1, scene%n_bodies
+      if (belt_moving(scene, i)) scale(i) = scale(i) + abs(scene%body_belt(i)) + abs(scene%body_belt_amp(i)) + &
+        abs(belt_rate(scene, i, t, 2)) * scene%dt
+    end do
+  end subroutine belt_scale
+
   !> The closed rows (the located one, gaps within rounding; at the start, within the
-  !> rounding of the user's decimals), a rigid link's two rows together, each snapped onto
-  !> its constraint.
-  pure subroutine close_rows(scene, initial, located, s, closed, rows, n_closed)
+  !> rounding of the user's decimals; in a geared scene with friction the rows the mode
+  !> held), a rigid link's two rows together, each snapped onto its constraint.
+  pure subroutine close_rows(scene, initial, located, held, s, closed, rows, n_closed)
     type(scene_type), intent(in) :: scene
     logical, intent(in) :: initial
     integer, intent(in) :: located
+    logical, intent(in) :: held(:)      !< the rows the mode held up to here
     type(state_type), intent(inout) :: s
     logical, intent(out) :: closed(:)
     integer, intent(out) :: rows(:), n_closed    !< the closed rows in row order
     integer :: k
     real(wp) :: size_scale
+    logical :: keep_held
+    keep_held = scene%geared .and. .not. initial
+    if (keep_held) keep_held = any(scene%body_static > 0.0_wp)
     do k = 1, scene%n_rows
       closed(k) = k == located .or. row_gap(scene, k, s) <= row_gap_tolerance(scene, k, s, 0.0_wp)
       if (initial .and. .not. closed(k)) then
@@ -317,6 +382,12 @@ contains
         if (scene%row_body(1, k) > 0) size_scale = max(size_scale, abs(s%x(scene%row_body(1, k))))
         closed(k) = row_gap(scene, k, s) <= gap_rounding * size_scale
       end if
+      ! A held geared row's ends move at s_b V and s_a V, each rounded: its gap drifts from
+      ! the limit by that rounding, beyond the low parts' (a unit row's ends move alike), and
+      ! would open a mesh that a geared group pressed at a stop. (With friction only: without
+      ! it the same rule merges input/geared_train.nml's mesh1 impact one ulp after mesh2's
+      ! into mesh2's event point, which moves its golden bits; docs/method.md section 14.)
+      if (keep_held) closed(k) = closed(k) .or. held(k)
     end do
     do k = 1, scene%n_rows
       if (scene%row_partner(k) > 0) closed(k) = closed(k) .or. closed(scene%row_partner(k))
@@ -899,6 +970,7 @@ contains
     ! (with moving grounds the projection is taken in their frame: frame_velocity)
     frame = 0.0_wp
     if (scene%drives%n > 0) frame = frame_velocity(scene, closed, t)
+    if (.not. allocated(work%impact)) allocate(work%impact)
     call path_impact_reserve(work%impact%path, nb)
     call path_projection(work%impact%path, scene%body_mass(body(:nb)), v(body(:nb)) - frame(body(:nb)), row_local(:, :nr), &
       scene%row_normal(:, rows(:nr)), tol(rows(:nr)), v_local(:nb), impulse_local(:nr), pushed_local(:nr), fits)
@@ -1047,6 +1119,7 @@ contains
     type(run_stats), intent(inout) :: stats
     real(wp) :: a_up, a_down, remaining, v_bounce(scene%n_bodies)
     type(error_type), allocatable :: unchecked
+    call scratch_mode(mode, work)
     a_up = free_gap_acceleration(s%v)
     if (a_up >= 0.0_wp) return
     call impulse(scene, work, k, 1.0_wp, s%t, s%v, v_bounce)
@@ -1127,7 +1200,9 @@ contains
     a_gap = 0.0_wp
     a_end = 0.0_wp
     ! (friction contacts between bodies join clusters the rows' incidence lists do not see)
-    scoped = scene%drives%n == 0 .and. scene%n_frictions == 0 .and. .not. scene%geared
+    ! (belts of sine speed: the bodies at rest on them are solved in their frames, which
+    ! solve_mode_at shifts to, this not)
+    scoped = scene%drives%n == 0 .and. scene%n_frictions == 0 .and. .not. scene%geared .and. .not. scene%belt_moves
     if (.not. scoped) return
     do e = 1, 2
       if (scene%row_body(e, k) == 0) cycle
@@ -1140,6 +1215,15 @@ contains
     if (scene%row_body(1, k) > 0) a_gap = a_gap + scene%row_normal(1, k) * a_end(1)
     a_gap = a_gap + 0.0_wp
   end subroutine scoped_gap_acceleration
+
+  !> work%scratch (cluster_acceleration's mode) made a copy of mode at the run's first scoped
+  !> solve, not at its first event point (seven allocations a short call need not make): its
+  !> entries are written before they are read, so any mode of the run's sizes serves.
+  subroutine scratch_mode(mode, work)
+    type(body_mode_type), intent(in) :: mode
+    type(point_work_type), intent(inout) :: work
+    if (.not. allocated(work%scratch%stuck)) work%scratch = mode
+  end subroutine scratch_mode
 
   !> Body i's acceleration in the mode of its cluster (the bodies joined to it by candidate
   !> rows: closed, other than row k, normal velocity within rounding at v), the cluster
@@ -1285,6 +1369,7 @@ contains
     integer, intent(out) :: status
     integer :: body(max_scope), rows(max_scope_rows), nb, nr, p, i, k
     logical :: fits
+    call scratch_mode(mode, work)
     if (work%mode_tracked) then
       do p = 1, work%n_mode_bodies
         call alone(work%mode_bodies(p))
@@ -1674,12 +1759,18 @@ contains
     end subroutine relative_to_belts
 
     !> Row j's gap acceleration (order 2) or its rate (3) at the bodies' a (with its moving
-    !> ground end's).
+    !> ground end's; the accelerating belts' taken back: a is relative to them).
     real(wp) function row_acceleration(j, a, order)
       integer, intent(in) :: j, order
       real(wp), intent(in) :: a(:)
+      integer :: e
       row_acceleration = row_velocity(scene, j, a)
       if (scene%drives%n > 0) row_acceleration = row_acceleration + ground_motion(scene, j, s%t, order)
+      if (.not. scene%belt_moves) return
+      do e = 1, 2
+        if (scene%row_body(e, j) > 0) row_acceleration = row_acceleration + scene%row_normal(e, j) * &
+          belt_rate(scene, scene%row_body(e, j), s%t, order)
+      end do
     end function row_acceleration
 
     !> Row j's |n| . tol (its ends' tolerances).

@@ -746,7 +746,9 @@ contains
     end do
     do i = 1, scene%n_bodies
       if (scene%body_static(i) == 0.0_wp .or. mode%sgn(i) == 0.0_wp) cycle
-      if (mode%group(i) == 0) then
+      ! (a body held still, against a wall, that slides on a belt of sine speed: its slip
+      ! -V(t) stops where the belt does, on the cubic below, the body's part 0)
+      if (mode%group(i) == 0 .and. .not. still_on_sine_belt(scene, mode, i)) then
         ! A body held to a moving ground that slides: its velocity is w'(t), whose zero may
         ! fall between two doubles of the clock; past it within the clock's rounding
         ! (gaps_hold) it stops at once, for the event point to take the new direction.
@@ -769,6 +771,9 @@ contains
         q(1) = q(1) + abs(p(1) - mode%sgn(i) * acc0(i))
       end if
       if (scene%belt_moves) call belt_less(scene, i, mode%sgn(i), a%t, step, p, q)
+      ! (held still, its velocity is 0 and its slip -V: within V's rounding of its zero, the
+      ! stop the event point took)
+      if (mode%group(i) == 0) q(0) = q(0) + velocity_rounding * (abs(scene%body_belt(i)) + abs(scene%body_belt_amp(i)))
       candidate = earliest_crossing(p, step, q)
       if (candidate < theta) then
         theta = candidate
@@ -800,6 +805,17 @@ contains
       acc_rounding = 1.0e3_wp * eps_wp * sum(abs(f)) / minval(scene%body_mass)
     end subroutine start_forces
   end subroutine locate_nbody
+
+  !> Whether body i, held still (group 0) and sliding, is on a belt of sine speed and on no
+  !> moving ground (locate_nbody: its slip's stop is the belt's).
+  pure logical function still_on_sine_belt(scene, mode, i)
+    type(scene_type), intent(in) :: scene
+    type(body_mode_type), intent(in) :: mode
+    integer, intent(in) :: i
+    still_on_sine_belt = .false.
+    if (.not. scene%belt_moves) return
+    still_on_sine_belt = belt_moving(scene, i) .and. mode%drive(i) == 0
+  end function still_on_sine_belt
 
   !> The slip cubic p of body i (sliding direction sgn) over the step from t less its
   !> accelerating belt's: the belt's speed on its own Hermite cubic (V and V' at the step's
@@ -1045,11 +1061,15 @@ contains
     logical function begun(probe, f)
       type(body_mode_type), intent(in) :: probe
       real(wp), intent(in) :: f(:)
-      real(wp) :: acc(scene%n_bodies), way(scene%n_bodies), lead(0:scene%n_bodies)
+      real(wp) :: acc(scene%n_bodies), way(scene%n_bodies), lead(0:scene%n_bodies), s(scene%n_bodies)
       logical :: against
       integer :: i, k
+      ! (a geared group's load is sum s_i f_i, body i moving s_i times its coordinate:
+      ! docs/method.md section 14)
+      s = 1.0_wp
       if (scene%geared) then
         call probe%geared_response(f + probe%f_slide, acc)
+        s = probe%scale
       else
         call probe%acceleration(f, acc)
       end if
@@ -1059,16 +1079,16 @@ contains
         way(i) = probe%sgn(i)
         if (way(i) == 0.0_wp) way(i) = sign(1.0_wp, acc(i))
         if (mode%stuck(i) .and. .not. probe%stuck(i)) then
-          lead(probe%group(i)) = lead(probe%group(i)) + (f(i) - scene%body_static(i) * way(i))
+          lead(probe%group(i)) = lead(probe%group(i)) + s(i) * (f(i) - scene%body_static(i) * way(i))
         else
-          lead(probe%group(i)) = lead(probe%group(i)) + (f(i) + probe%f_slide(i))
+          lead(probe%group(i)) = lead(probe%group(i)) + s(i) * (f(i) + probe%f_slide(i))
           if (mode%sgn(i) /= probe%sgn(i)) begun = .true.
         end if
       end do
       against = .false.
       do i = 1, scene%n_bodies
         if (mode%stuck(i) .and. .not. probe%stuck(i) .and. probe%group(i) > 0) &
-          against = against .or. way(i) * lead(probe%group(i)) < 0.0_wp
+          against = against .or. way(i) * s(i) * lead(probe%group(i)) < 0.0_wp
       end do
       do k = 1, scene%n_rows
         if (mode%active(k) .and. .not. probe%active(k)) against = against .or. row_velocity(scene, k, acc) < 0.0_wp

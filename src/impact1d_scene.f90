@@ -832,8 +832,9 @@ contains
 
   !> A body on a belt of sine speed (belt_amp /= 0) may not be an end of a &friction record:
   !> stuck, it accelerates with its own belt, which the mode solve takes body by body (a
-  !> cluster solve holds its bodies in one frame). (Its contacts are refused where one would
-  !> hold it at rest on its belt: impact1d_nbody_event's refuse_held_belts.)
+  !> cluster solve holds its bodies in one frame). (Its contacts are refused where one is held
+  !> between it stuck and a body that would ride its belt: impact1d_nbody_event's
+  !> refuse_held_belts.)
   subroutine refuse_belt_contacts(scene, error)
     type(scene_type), intent(in) :: scene
     type(error_type), allocatable, intent(inout) :: error
@@ -872,8 +873,10 @@ contains
 
   !> The records' gear ratios (impact1d_chain's gear_ratio checked each record): a scene
   !> with one other than 1 is geared, which only the N-body engine runs, so far without the
-  !> vissim method, moving grounds, friction or the friction laws (refused by name: the
-  !> event point's friction tests and moving frames take groups as moving alike).
+  !> vissim method, moving grounds, friction between bodies (&friction) or the friction laws
+  !> (refused by name: moving frames and friction contacts take groups as moving alike).
+  !> Each body's own Coulomb friction against the ground (mu, mus) is allowed: a geared
+  !> group slides and sticks as one (docs/method.md section 14).
   subroutine set_gears(records, scene, error)
     type(mechanism_records), intent(in) :: records
     type(scene_type), intent(inout) :: scene
@@ -886,11 +889,11 @@ contains
     what = ''
     if (scene%method == 'vissim') what = "method = 'vissim' (the tutorial's scheme)"
     if (scene%drives%n > 0) what = 'a moving ground (ground_v, ground_amp, ground_table, x_left_v ...)'
-    if (any(scene%body_static > 0.0_wp) .or. scene%n_frictions > 0) what = 'friction (mu, mus, &friction)'
+    if (scene%n_frictions > 0) what = 'friction between bodies (&friction)'
     if (scene%belts .or. scene%stribeck) what = 'belt_v, belt_amp, v_s or c_v'
     if (len(what) > 0) call raise(error, status_input, 'a gear ratio (ratio other than 1) cannot be ' // &
       'combined with ' // what // ' yet: geared scenes run on the N-body engine''s event method, ' // &
-      'frictionless, on still grounds')
+      'on still grounds, with friction only of each body against the ground (mu, mus)')
   end subroutine set_gears
 
   !> A scene with a moving ground runs on the N-body engine (whatever its N), which has no

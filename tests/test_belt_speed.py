@@ -159,15 +159,103 @@ def test_belt_speed_inputs_are_checked(fields, words):
         impact1d.simulate(scene)
 
 
-def test_body_held_at_rest_on_its_belt_by_a_contact_ends_the_run():
-    """A block at rest on the belt of (b) and against the right wall (x_right = x1): the
-    mode solve would need the wall's frame and the belt's at once, which it does not take
-    yet: the run ends (SimulationError) naming the body, its belt and the contact. Without
-    the wall in reach the same block runs (a wall 1 m away: (b)'s events)."""
-    with pytest.raises(impact1d.SimulationError, match="body 1, at rest on its belt of sine speed.*right"):
-        impact1d.simulate(dataclasses.replace(block(0.5, 0.3, 1e-3), x_right=0.0))
-    far = impact1d.simulate(dataclasses.replace(block(0.5, 0.3, 1e-3), x_right=1.0))
-    assert [e["kind"] for e in far.events] == ["slip1", "stick1", "slip1"]
+# A block against the right wall (x_right = 0 = x1) pushed into it by a constant force P,
+# on a belt V(t) = V0 + A cos(w t) (V0 = -0.1: belt_phase = pi / 2). While V > 0 the belt
+# drags the block into the wall: it slides (slip -V < 0, friction +F), held there. At t0,
+# V's first zero (w t0 = acos(-V0 / A)), the belt turns away from the wall, accelerating at
+# V'(t0) = -A w sin(w t0): the block, at rest on its belt with the wall closed, is solved in
+# the belt's frame against the still wall (the row's acceleration n.a' + n.V'):
+# (A) P + m A w sin(w t0) <= S: it sticks and rides the belt off the wall,
+#     x = V0 (t - t0) + (A / w) (sin(w t) - sin(w t0)), v = V(t) (stuck throughout: |m V' - P|
+#     <= S for every t; the belt's mean V0 < 0 never brings it back);
+# (B) S < P + m A w sin(w t0) and P < F: it breaks away and leaves the wall sliding, a =
+#     (P - F) / m, until its slip a (t - t0) - V(t) is zero again (mpmath.findroot), where
+#     it sticks (|m V' - P| <= S there);
+# (C) P > F: the wall holds it (contact force P - F), its slip -V(t) turns at each zero of V:
+#     x = 0 throughout, friction's loss F times the integral of |V| (the belt's work).
+V0 = -0.1
+WALL_T0 = math.acos(-V0 / A) / W
+
+
+def walled(mus, mu, push, dt, t_end):
+    """The block against the right wall, pushed into it, on the belt V0 + A cos(w t)."""
+    return impact1d.Scene(m1=M, mu1=mu, mus1=mus, g=G, x1=0.0, v1=0.0, f1=push, x_right=0.0, t_end=t_end,
+                          dt=dt, belt_v=[V0], belt_amp=[A], belt_period=[P], belt_phase=[math.pi / 2])
+
+
+@pytest.mark.parametrize("dt", [1e-3, 0.05])
+def test_block_stuck_on_its_belt_rides_off_the_wall(dt):
+    """(A): stick1 and release_right at t0 (the belt's zero, 1e-15 s), then x and v the
+    belt's integral and speed at every sample (1e-14); the ledger closes. Before this change
+    the run ended at t0 (a contact on a body at rest on its belt was refused)."""
+    push = 3.0
+    assert push + M * A * W * math.sin(W * WALL_T0) <= 1.0 * M * G
+    result = impact1d.simulate(walled(1.0, 0.5, push, dt, 0.6))
+    assert [e["kind"] for e in result.events] == ["rest_right", "stick1", "release_right"]
+    assert result.events["t"][1:] == pytest.approx([WALL_T0, WALL_T0], abs=1e-15)
+    frame = result.to_dataframe()
+    t = frame["t"].to_numpy()
+    after = t > WALL_T0
+    assert np.all(frame["x1"][~after] == 0.0)
+    np.testing.assert_allclose(frame["x1"][after], V0 * (t[after] - WALL_T0) + A / W * (np.sin(W * t[after]) -
+                               math.sin(W * WALL_T0)), rtol=0, atol=1e-14)
+    np.testing.assert_allclose(frame["v1"][after], V0 + A * np.cos(W * t[after]), rtol=0, atol=1e-14)
+    assert abs(result.energy_residual) < (1e-9 if dt < 0.01 else 1e-4)
+
+
+@pytest.mark.parametrize("dt", [1e-3, 0.05])
+def test_block_breaks_away_from_its_belt_and_the_wall(dt):
+    """(B): release_right at t0, x = a (t - t0)^2 / 2 and v = a (t - t0) while it slides
+    (1e-13), stick1 where the slip is zero again (50-digit findroot, 1e-12 s)."""
+    push, mus, mu = 3.0, 0.6, 0.4
+    assert push + M * A * W * math.sin(W * WALL_T0) > mus * M * G and push < mu * M * G
+    result = impact1d.simulate(walled(mus, mu, push, dt, 0.4))
+    acc = (push - mu * M * G) / M
+    with mp.workdps(50):
+        w, t0 = 2 * mp.pi / mp.mpf(P), mp.acos(-mp.mpf(V0) / mp.mpf(A)) / (2 * mp.pi / mp.mpf(P))
+        t_s = mp.findroot(lambda t: mp.mpf(acc) * (t - t0) - (mp.mpf(V0) + mp.mpf(A) * mp.cos(w * t)), mp.mpf("0.3"))
+        assert abs(M * A * w * mp.sin(w * t_s) + push) <= mus * M * G
+    assert [e["kind"] for e in result.events] == ["rest_right", "release_right", "stick1"]
+    assert result.events["t"][1:] == pytest.approx([WALL_T0, float(t_s)], abs=1e-12)
+    frame = result.to_dataframe()
+    t = frame["t"].to_numpy()
+    sliding = (t > WALL_T0) & (t < float(t_s))
+    assert np.count_nonzero(sliding) >= (3 if dt > 0.01 else 150)
+    np.testing.assert_allclose(frame["v1"][sliding], acc * (t[sliding] - WALL_T0), rtol=0, atol=1e-13)
+    np.testing.assert_allclose(frame["x1"][sliding], acc * (t[sliding] - WALL_T0) ** 2 / 2, rtol=0, atol=1e-13)
+    assert abs(result.energy_residual) < (1e-9 if dt < 0.01 else 1e-4)
+
+
+@pytest.mark.parametrize("dt", [1e-3, 0.05])
+def test_block_pressed_harder_than_friction_stays_at_the_wall(dt):
+    """(C): x = v = 0 at every sample through five of V's zeros (no stick: it slides on the
+    belt there, the wall holding it); friction's loss is F times the integral of |V| (mpmath's
+    quad), the belt's work the same."""
+    mu = 0.2
+    result = impact1d.simulate(walled(0.6, mu, 6.0, dt, 1.2))
+    assert [e["kind"] for e in result.events] == ["rest_right"]
+    frame = result.to_dataframe()
+    assert np.all(frame["x1"] == 0.0) and np.all(frame["v1"] == 0.0)
+    with mp.workdps(30):
+        w = 2 * mp.pi / mp.mpf(P)
+        first = mp.acos(-mp.mpf(V0) / A) / w
+        zeros = sorted(z for n in range(3) for z in (first + n * P, n * P + P - first) if z < mp.mpf("1.2"))
+        assert len(zeros) == 5
+        loss = mu * M * G * mp.quad(lambda t: abs(mp.mpf(V0) + A * mp.cos(w * t)), [0] + zeros + [mp.mpf("1.2")])
+    assert frame["friction_loss"].iloc[-1] == pytest.approx(float(loss), rel=1e-9 if dt < 0.01 else 1e-4)
+    assert frame["drive_work"].iloc[-1] == pytest.approx(frame["friction_loss"].iloc[-1], rel=1e-12)
+
+
+def test_body_held_against_one_stuck_on_its_belt_ends_the_run():
+    """Two blocks touching (d_min = 0), each on its own belt: block 2 at rest on a belt of sine
+    speed with ample static friction, block 1 (no friction) pushed into it by f1: held
+    against it, block 1 would ride block 2's belt, which the groups' motion does not take
+    yet: the run ends (SimulationError) naming the stuck body and the contact."""
+    scene = impact1d.Scene(m=[M, M], mu=[0.0, 0.8], mus=[0.0, 1.0], g=G, x=[0.0, 0.0], v=[0.0, 0.0], f=[3.0, 0.0],
+                           d_min=0.0, belt_v=[0.0, A], belt_amp=[0.0, A], belt_period=[P, P],
+                           belt_phase=[0.0, -math.pi / 2], t_end=0.5, dt=1e-3)
+    with pytest.raises(impact1d.SimulationError, match="body 2, stuck on its belt of sine speed"):
+        impact1d.simulate(scene)
 
 
 def test_cli_and_read_output_keep_the_belt_speed(tmp_path):

@@ -38,7 +38,36 @@ tension T = k (g - rest) + c g' pulls b by -T and a by +n T. Scenes with a ratio
     their backlash and the rattle has died, the train turns as one with shaft 2 at 3 times
     shaft 1 and shaft 3 at 3/2 times, accelerating at (T1 + (3/2) T3) / (J1 + 9 J2 +
     (9/4) J3) (virtual work on x1).
-(f) Bad input refused by name.
+(f) Bad input refused by name: friction between bodies (&friction), the friction laws, the
+    vissim method and moving grounds stay refused with gears.
+(g) Bearing friction (mu, mus on &bodies: the friction torque mu_i J_i g against each
+    shaft's own rotation; g = 1 here, so F_i = mu_i J_i). A geared group (bodies joined by
+    held geared rows, x_i' = s_i V: s1 = 1, s2 = n across a held mesh on x2 - n x1) is one
+    coordinate V: its mass M = J1 + n^2 J2, its load T1 + n T2 and its friction
+    F_eff = F1 + n F2 (sum |s_i| F_i, virtual work) against the sign of V. So:
+    (g1) from rest on the drive flank, a torque T on gear 1 above the static sum
+         Fs1 + n Fs2 turns the pair at A = (T - F1 - n F2) / M, v1 = A t, v2 = n A t
+         (the mesh stays pressed: gear 2's own motion under its friction alone would be
+         slower, -F2/J2 < n (T - F1)/J1); below it the pair stays stuck.
+    (g2) given V0 and no torque, the pair decelerates at F_eff / M (the mesh pressed when
+         F2/J2 > n F1/J1: gear 2 alone would slow faster) and stops at t* = V0 M / F_eff,
+         both shafts sticking there; turned backwards (V0 < 0) under a torque T it slows at
+         (T + F_eff)/M, stops at t* = |V0| M / (T + F_eff), and then turns forward at
+         (T - F_eff)/M if T > Fs_eff, or sticks.
+    (g3) breakaway under a sine torque on gear 2, T2(t) = -(T0 + A sin(w t)) pressing the
+         drive flank: the pair stays stuck while n (T0 + A sin(w t)) <= Fs1 + n Fs2 and
+         breaks away at sin(w t_b) = ((Fs1 + n Fs2)/n - T0)/A (located on the mode
+         failing: the group's load weighs each body's force and static bound by s_i).
+    (g4) a rattle with friction on the free gear: gear 1 driven by T (no friction), gear 2
+         with Coulomb friction F2 and no torque, the mesh with backlash [-d, d] and
+         restitution r. Between events both move at constant acceleration (T/J1;
+         -F2 sgn(v2)/J2 while gear 2 slides, 0 once it sticks: the open mesh puts no force on
+         it), so each gap is a quadratic and gear 2's stop v2(t) = 0 is linear; the mpmath
+         reference (friction_rattle_reference) steps the events at 50 digits. With
+         T < n F2 every impact finds gear 2 stuck and leaves it sliding; the motion
+         scales by one factor per cycle (all the gaps start at -d, velocities scale by q,
+         times by q), so the impacts' intervals shrink geometrically by q and accumulate
+         at t_1 + (t_2 - t_1) / (1 - q) after which the pair is stuck (T < n Fs2).
 """
 
 from __future__ import annotations
@@ -251,7 +280,7 @@ def test_bad_ratios_are_refused_by_name(change, message):
 
 
 @pytest.mark.parametrize("extra, message", [
-    ({"mu": [0.1, 0.0]}, "friction"),
+    ({"frictions": [{"a": 1, "b": 2, "mu": 0.1, "normal": 1.0, "name": "pad"}]}, r"friction between bodies \(&friction\)"),
     ({"method": "vissim"}, "vissim"),
     ({"belt_v": [0.0, 1.0]}, "belt_v"),
 ])
@@ -390,3 +419,171 @@ def test_a_geared_rattle_with_tooth_stiffness_closes_the_ledger():
     np.testing.assert_allclose(r.pe, 0.5 * 20.0 * g**2 + 0.5 * 200.0 * r.x[:, 0]**2, rtol=1e-12, atol=1e-15)
     assert r.damping_loss[-1] > 0
     assert np.max(np.abs(r.residual)) < 1e-12
+
+
+# (g) Bearing friction on geared shafts. g = 1: the friction torque of shaft i is mu_i J_i.
+DF = 0.0625     # a backlash of 1/8 (exact in binary): the start on the drive flank exactly
+
+
+def geared_friction(torque, v0, mu, mus=None, dt=1e-3, t_end=1.5, **extra):
+    """Gears 1, 2 (J1, J2, ratio N) on the drive flank of a mesh with backlash [-DF, DF] (x2
+    - 3 x1 = -DF), turning as one at v1 = v0 (v2 = n v0), bearing friction mu (g = 1)."""
+    kw = dict(m=[J1, J2], x=[0.5, 1.5 - DF], v=[v0, N * v0], f=list(torque), t_end=t_end, dt=dt, g=1.0,
+              mu=list(mu), contacts=[{"a": 1, "b": 2, "d_min": -DF, "d_max": DF, "ratio": N, "name": "mesh"}],
+              **extra)
+    if mus is not None:
+        kw["mus"] = list(mus)
+    return impact1d.Scene(**kw)
+
+
+@pytest.mark.parametrize("dt", [1e-3, 0.1])
+def test_a_driven_geared_pair_with_bearing_friction_turns_at_the_group_acceleration(dt):
+    """(g1): F1 = 0.5, F2 = 0.1, T = 2 > F1 + n F2 = 0.8: v1 = A t with A = (T - F1 - n F2) /
+    (J1 + n^2 J2), v2 = n v1, x1 = x1(0) + A t^2 / 2; the ledger closes with friction's loss
+    sum F_i |v_i| dt = (F1 + n F2) A t^2 / 2."""
+    r = impact1d.simulate(geared_friction([2.0, 0.0], 0.0, [0.5, 0.2], dt=dt))
+    acc = (2.0 - 0.5 - N * 0.1) / (J1 + N**2 * J2)
+    assert [e["kind"] for e in r.events] == ["rest_mesh_min"]
+    np.testing.assert_allclose(r.v[:, 0], acc * r.t, rtol=0, atol=1e-14)
+    np.testing.assert_allclose(r.v[:, 1], N * acc * r.t, rtol=0, atol=1e-14)
+    np.testing.assert_allclose(r.x[:, 0], 0.5 + acc * r.t**2 / 2, rtol=0, atol=1e-14)
+    np.testing.assert_allclose(r.friction_loss, (0.5 + N * 0.1) * acc * r.t**2 / 2, rtol=0, atol=1e-14)
+    assert np.max(np.abs(r.residual)) < 1e-14
+
+
+@pytest.mark.parametrize("dt", [1e-3, 0.1])
+def test_a_geared_pair_below_the_static_sum_stays_stuck(dt):
+    """(g1): T = 0.75 exceeds gear 1's own static bound Fs1 = 0.5 but not Fs1 + n Fs2 = 0.8:
+    the pair does not move (and 0.85 > 0.8 moves it)."""
+    r = impact1d.simulate(geared_friction([0.75, 0.0], 0.0, [0.5, 0.2], dt=dt))
+    assert np.all(r.v == 0.0) and np.all(r.x == r.x[0])
+    r = impact1d.simulate(geared_friction([0.85, 0.0], 0.0, [0.5, 0.2], dt=dt))
+    np.testing.assert_allclose(r.v[:, 0], 0.05 / (J1 + N**2 * J2) * r.t, rtol=0, atol=1e-14)
+
+
+@pytest.mark.parametrize("dt", [1e-3, 0.1])
+@pytest.mark.parametrize("torque, v0", [(0.0, 0.2), (1.0, -0.2), (2.0, -0.2)])
+def test_a_geared_pair_with_bearing_friction_stops_at_the_closed_form_instant(dt, torque, v0):
+    """(g2): F1 = 0.1, F2 = 0.5 (F2/J2 = 1 > n F1/J1 = 0.3: the mesh stays pressed while the
+    pair slows), F_eff = F1 + n F2 = 1.6, M = J1 + n^2 J2 = 5.5. The stop at t* = |V0| M /
+    (F_eff + T sgn(-V0)), located within 1e-12 s; then both shafts stick (T = 0, or T = 1 <
+    1.6), each logged, or (T = 2 > 1.6) the pair turns forward at (T - F_eff)/M with no
+    event (a reversal, not a stick)."""
+    mass, f_eff = J1 + N**2 * J2, 0.1 + N * 0.5
+    t_stop = abs(v0) * mass / (f_eff + (torque if v0 < 0 else 0.0))
+    r = impact1d.simulate(geared_friction([torque, 0.0], v0, [0.1, 1.0], dt=dt))
+    before = r.t < t_stop
+    np.testing.assert_allclose(r.v[before, 0], v0 * (1 - r.t[before] / t_stop), rtol=0, atol=1e-14)
+    if torque < f_eff:
+        assert [e["kind"] for e in r.events] == ["rest_mesh_min", "stick1", "stick2"]
+        assert r.events[1]["t"] == pytest.approx(t_stop, abs=1e-12)
+        assert r.events[2]["t"] == r.events[1]["t"]
+        assert np.all(r.v[~before] == 0.0)
+    else:
+        assert [e["kind"] for e in r.events] == ["rest_mesh_min"]
+        after = ~before
+        np.testing.assert_allclose(r.v[after, 0], (torque - f_eff) / mass * (r.t[after] - t_stop), rtol=0,
+                                   atol=1e-14)
+    np.testing.assert_allclose(r.v[:, 1], N * r.v[:, 0], rtol=0, atol=1e-14)
+    assert np.max(np.abs(r.residual)) < 1e-14
+
+
+@pytest.mark.parametrize("dt", [1e-3, 0.1])
+def test_a_stuck_geared_pair_breaks_away_where_the_scaled_loads_reach_the_static_sum(dt):
+    """(g3): mus = (0.6, 1.0) (Fs1 = 0.6, Fs2 = 0.5), a torque -(T0 + A sin(w t)) on gear 2,
+    T0 = 0.5, A = 4, w = pi: the group's load n (T0 + A sin(w t)) reaches Fs1 + n Fs2 = 2.1
+    at sin(w t_b) = (0.7 - 0.5) / 4; both shafts slip there, located within 1e-12 s."""
+    r = impact1d.simulate(geared_friction([0.0, -0.5], 0.0, [0.1, 0.6], mus=[0.6, 1.0], dt=dt, t_end=1.0,
+                                          f_amp=[0.0, -4.0], f_period=[1.0, 2.0]))
+    t_b = math.asin(((0.6 + N * 0.5) / N - 0.5) / 4.0) / math.pi
+    assert [e["kind"] for e in r.events] == ["rest_mesh_min", "slip1", "slip2"]
+    assert r.events[1]["t"] == pytest.approx(t_b, abs=1e-12)
+    assert r.events[2]["t"] == r.events[1]["t"]
+    assert np.all(r.v[r.t < t_b] == 0.0)
+    assert np.all(r.v[r.t > t_b, 0] < 0.0)
+    np.testing.assert_allclose(r.v[:, 1], N * r.v[:, 0], rtol=0, atol=1e-14)
+
+
+F2_RATTLE = 1.0     # gear 2's friction torque: T = 2 < n F2 = 3, gear 2 stops between impacts
+
+
+def friction_rattle_reference(n_events=40):
+    """(g4)'s events at 50 digits: [(t, kind, (v1, v2) before, (v1, v2) after)], kind a flank
+    or 'stick2' (gear 2's stop)."""
+    mp.mp.dps = 50
+    j1, j2, n, torque, d, r, f2 = (mp.mpf(x) for x in (J1, J2, N, T, D, R, F2_RATTLE))
+    t, x1, x2, v1, v2 = mp.mpf(0), mp.mpf(0), mp.mpf(0), mp.mpf(0), mp.mpf(0)
+    a1 = torque / j1
+    events = []
+    while len(events) < n_events:
+        a2 = -f2 / j2 * mp.sign(v2)
+        g, u, acc = x2 - n * x1, v2 - n * v1, a2 - n * a1
+        found = [(-v2 / a2, "stick2")] if v2 != 0 else []
+        for limit, kind, side in ((-d, "mesh_min", -1), (d, "mesh_max", 1)):
+            # g + u tau + acc tau^2 / 2 = limit, reached moving towards it (acc /= 0 here)
+            disc = u**2 - 2 * acc * (g - limit)
+            if disc < 0:
+                continue
+            roots = sorted(((-u - mp.sqrt(disc)) / acc, (-u + mp.sqrt(disc)) / acc))
+            found += [(tau, kind) for tau in roots if tau > mp.mpf(10)**-40 and side * (u + acc * tau) > 0][:1]
+        tau, kind = min(found)
+        t += tau
+        x1, v1 = x1 + v1 * tau + a1 * tau**2 / 2, v1 + a1 * tau
+        x2, v2 = x2 + v2 * tau + a2 * tau**2 / 2, v2 + a2 * tau
+        before = (v1, v2)
+        if kind == "stick2":
+            v2 = mp.mpf(0)
+        else:
+            p = -(1 + r) * (v2 - n * v1) / (1 / j2 + n**2 / j1)
+            v1, v2 = v1 - n * p / j1, v2 + p / j2
+        events.append((t, kind, before, (v1, v2)))
+    return events
+
+
+@pytest.mark.parametrize("dt", [1e-3, 0.1])
+def test_a_rattle_with_friction_on_the_free_gear_has_the_closed_form_stops_and_impacts(dt):
+    """(g4): the first 40 events (impacts on the drive flank, gear 2's stops between them)
+    at the reference's times within 1e-12 s and velocities within 1e-12; the series
+    accumulates at t_1 + (t_2 - t_1) / (1 - q) (q from the reference's intervals, the same
+    for every cycle), where the pair ends stuck."""
+    ref = friction_rattle_reference()
+    assert [kind for _, kind, _, _ in ref[:4]] == ["mesh_min", "stick2", "mesh_min", "stick2"]
+    scene = impact1d.Scene(m=[J1, J2], x=[0.0, 0.0], f=[T, 0.0], t_end=1.5, dt=dt, g=1.0,
+                           mu=[0.0, F2_RATTLE / J2],
+                           contacts=[{"a": 1, "b": 2, "d_min": -D, "r_min": R, "d_max": D, "r_max": R,
+                                      "ratio": N, "name": "mesh"}])
+    r = impact1d.simulate(scene)
+    for (t, kind, before, after), e in zip(ref, r.events):
+        assert e["kind"] == kind
+        assert e["t"] == pytest.approx(float(t), abs=1e-12)
+        np.testing.assert_allclose([e[2], e[3]], [float(x) for x in before], rtol=0, atol=1e-12)
+        np.testing.assert_allclose([e[4], e[5]], [float(x) for x in after], rtol=0, atol=1e-12)
+    hits = [t for t, kind, _, _ in ref if kind == "mesh_min"]
+    q = (hits[2] - hits[1]) / (hits[1] - hits[0])
+    assert abs((hits[3] - hits[2]) / (hits[2] - hits[1]) - q) < mp.mpf(10)**-40
+    t_inf = float(hits[0] + (hits[1] - hits[0]) / (1 - q))
+    assert max(e["t"] for e in r.events) == pytest.approx(t_inf, abs=1e-10)
+    assert np.all(r.v[r.t > t_inf + 1e-9] == 0.0)
+    assert np.max(np.abs(r.residual)) < 1e-12
+
+
+def test_a_three_gear_train_with_bearing_friction_turns_at_its_reduced_acceleration():
+    """(g) on (e)'s train: friction torques F_i = mu_i J_i (g = 1) on all three shafts; after
+    the rattle the train turns as one (1 : 3 : 3/2) at (T1 + (3/2) T3 - F1 - 3 F2 - (3/2)
+    F3) / (J1 + 9 J2 + (9/4) J3): each shaft's friction weighed by its speed ratio."""
+    torque, masses, mu = (2.0, 0.0, -0.1), (1.0, 0.5, 2.0), (0.05, 0.1, 0.02)
+    scene = impact1d.Scene(m=list(masses), x=[0.0, 0.0, 0.0], f=list(torque), t_end=2.0, dt=1e-3, g=1.0,
+                           mu=list(mu),
+                           contacts=[{"a": 1, "b": 2, "d_min": -0.01, "d_max": 0.01, "r_min": 0.5, "r_max": 0.5,
+                                      "ratio": 3.0, "name": "mesh1"},
+                                     {"a": 2, "b": 3, "d_min": -0.01, "d_max": 0.01, "r_min": 0.5, "r_max": 0.5,
+                                      "ratio": 0.5, "name": "mesh2"}])
+    r = impact1d.simulate(scene)
+    f = [m * u for m, u in zip(masses, mu)]
+    acc = (torque[0] + 1.5 * torque[2] - f[0] - 3 * f[1] - 1.5 * f[2]) / (masses[0] + 9 * masses[1] + 2.25 * masses[2])
+    last = max(e["t"] for e in r.events)
+    assert last < 1.0
+    late = r.t > last + 1e-6
+    np.testing.assert_allclose(r.v[late], np.outer(r.v[late, 0], [1.0, 3.0, 1.5]), rtol=0, atol=1e-13)
+    np.testing.assert_allclose(np.diff(r.v[late, 0]) / np.diff(r.t[late]), acc, rtol=1e-9)
+    assert np.max(np.abs(r.residual)) < 1e-13
