@@ -244,9 +244,10 @@ def _at(study, dt):
 
 def kept_sections() -> str:
     """The sections measured apart from this run, kept as they were written: the core since
-    7f0f942 (bench/results/core_regression.md: builds of other commits) and long chains
-    (bench/results/chains.md: bench/chains.py, many minutes of runs)."""
-    paths = [common.RESULTS / name for name in ("core_regression.md", "chains.md")]
+    7f0f942 (bench/results/core_regression.md: builds of other commits), long chains
+    (bench/results/chains.md: bench/chains.py, many minutes of runs) and one engine for one and
+    two bodies (bench/results/one_engine.md: bench/after_switch.py, builds of other commits)."""
+    paths = [common.RESULTS / name for name in ("core_regression.md", "chains.md", "one_engine.md")]
     return "".join("\n" + path.read_text().rstrip() + "\n" for path in paths if path.exists())
 
 
@@ -301,8 +302,10 @@ def performance_md(perf, info, cvode=None, siconos=None) -> str:
         f"solve_ivp calls (~{c3['scipy_median_s'] / c3['scipy_restarts'] * 1e3:.1f} ms each). "
         f"impact1d takes the tutorial's {c3['steps']} steps; between impacts, where the forces "
         "are constant and no gap can close within the next steps (a closed-form bound), they "
-        "run in a tight loop without event location (`glide` in src/impact1d_solver.f90), "
-        "and the time left is the impacts, the located steps next to them and the samples.",
+        "are taken in closed form, without forces, mode solves or event location (`glide` in "
+        "src/impact1d_nbody_glide.f90: the arithmetic of nbody_step's RK4 step under the mode's "
+        "constant accelerations), and the time left is the impacts, the located steps next to "
+        "them and the samples.",
         "",
         "## The stepping loop against a bare RK4 loop",
         "",
@@ -326,36 +329,32 @@ def performance_md(perf, info, cvode=None, siconos=None) -> str:
         f"Constant forces: the engine is {verdict_2} the 2x aim "
         f"({loop['wall']['ratio_median']:.2f} times the bare loop's time per step; through "
         f"`impact1d.simulate` {loop['simulate_s']:.3f} s, "
-        f"{loop['simulate_steps_per_s'] / 1e6:.0f} M steps/s). Its step is RK4's closed form "
-        "under a constant acceleration (x + h v + h^2 a / 2, what RK4's four stages add up "
-        "to) with the clock, positions and velocities kept as compensated sums "
-        "(renormalised once per run of steps), and the work and friction loss booked once "
-        "from the displacement (exact under constant forces). So it ends where the motion "
+        f"{loop['simulate_steps_per_s'] / 1e6:.0f} M steps/s). Its step is the N-body engine's "
+        "closed-form step (`glide` in src/impact1d_nbody_glide.f90): the arithmetic of "
+        "nbody_step's RK4 step under the mode's constant accelerations, without forces, mode "
+        "solves or location, the clock, positions, velocities, work and friction loss kept as "
+        "compensated sums, the work by Simpson's rule every step. So it ends where the motion "
         f"does: at t = {loop['steps'] * loop['dt']:g} s exactly, while the bare loop's plain "
         f"clock is {common.fmt(loop['bare_clock_error'])} s off.",
         "",
         f"Sine force: {sine['wall']['ratio_median']:.1f} times the bare loop per step "
         f"(bare: {common.fmt(sine['bare_clock_error'])} s clock error). This is the "
-        "general step, the one for tables and sines: the force at the step's start, middle "
-        "and end (the end's is kept for the next step), the mode's accelerations, seven "
-        "compensated sums (clock, positions, velocities, work, friction loss) and the ledger "
-        "by Simpson's rule, then the stop and sample bookkeeping and a finite-state check. "
+        "general step (`nbody_step` in src/impact1d_nbody_step.f90): RK4's four stages, the "
+        "external forces at the step's start, middle and end (the end's kept for the next "
+        "step's first stage), the mode's accelerations at each stage, the compensated sums "
+        "(clock, positions, velocities, work, friction loss) and the ledger by Simpson's rule, "
+        "then the step's event location, the sample bookkeeping and a finite-state check. "
         "Wall time is about twice CPU time on this shared machine; the ratios are the same "
         "by both clocks.",
         "",
         f"Spring (bench/scenes/springflight.nml, body 1 on a spring to the ground): "
         f"{spring['wall']['ratio_median']:.1f} times the bare loop per step (issue 10's aim: "
         f"within 2.5x; {'met' if spring['wall']['ratio_median'] <= 2.5 else '**not met**'}). "
-        "The forces depend on the state, so RK4's four stages are taken in full "
-        "(`state_dependent_step` in src/impact1d_stepping.f90): the external forces at the "
-        "step's start, middle and end evaluated once each, the springs' force at each stage "
-        "and at the end (kept for the next step), the ledger by Simpson's rule. A scene that "
-        "names no spring never enters that step: the constant and sine rows above are "
-        "the scenes of the release before springs, with the same steps (its bench, run "
-        "the same way: 0.61x under constant forces, 1.89x under the sine; case 3 through "
-        "`simulate` timed against that release's build side by side: 0.109 ms then, 0.108 now "
-        "per call with samples every 0.01 s, 0.80 and 0.82 ms with a sample every step, the "
-        "min of 15 x 30 calls).",
+        "The forces depend on the state: the same general step (`nbody_step`), the elements' "
+        "forces (`add_element_forces` in src/impact1d_elements.f90) at each of RK4's stages. "
+        "Until session 12 these three scenes ran on the two-body engine (its lanes' kernels, "
+        "deleted since; measured at 7ae8c29, wall clock: 0.38x under constant forces, 1.82x "
+        "under the sine, 2.64x with the spring).",
         "",
         "## Cost against t_end and against the number of events",
         "",

@@ -217,7 +217,7 @@ contains
       if (status /= mode_solved) return
     end do
     ! A moving body with static friction but no sliding friction (mu = 0 < mus) has a
-    ! direction too, as in the two-body engine (impact1d_event_point's moving_sign): its stop
+    ! direction too, as in the deleted two-body engine (its event point's moving_sign): its stop
     ! is watched, where static friction may hold it (its sliding force -0 sgn stays 0).
     do i = 1, scene%n_bodies
       if (mode%sgn(i) == 0.0_wp .and. slip(scene, i, v(i), t) /= 0.0_wp .and. scene%body_static(i) > 0.0_wp) &
@@ -524,7 +524,7 @@ contains
   !> rates (so that it does not close into the row even at the rate), and its ends stay
   !> joined through the other held rows and stuck bodies (the ground joining its own): a
   !> frictionless body resting on a stuck one keeps its row, which friction does not carry
-  !> (the choice of impact1d_modes, "more bodies stuck, then more contacts held", and of
+  !> (the choice of the deleted impact1d_modes, "more bodies stuck, then more contacts held", and of
   !> tests/exact_nbody.py: the least contact force, and a force-free row held while its ends
   !> are not otherwise joined).
   subroutine prefer_friction(work, nb, nr, status)

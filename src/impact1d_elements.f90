@@ -176,7 +176,7 @@ contains
 
   !> df += the rate of the spring forces at velocities v (at time t: relative to a moving
   !> ground end; the dampers' part needs the accelerations: left out, as impact1d_springs
-  !> does).
+  !> did, deleted with the two-body engine).
   pure subroutine add_element_rates(scene, v, df, t)
     type(scene_type), intent(in) :: scene
     real(wp), intent(in) :: v(:)
@@ -257,8 +257,8 @@ contains
   end function row_anchor
 
   !> Compliant stop row r's gap at positions x + dx (at time t: a moving ground end where it
-  !> is then); negative past its limit (the penetration p = -gap). The two-body engine's
-  !> impact1d_loads stop_gap in the same order of operations.
+  !> is then); negative past its limit (the penetration p = -gap). The deleted two-body engine's
+  !> impact1d_loads stop_gap had the same order of operations.
   pure real(wp) function stop_gap(scene, r, x, dx, t)
     type(scene_type), intent(in) :: scene
     integer, intent(in) :: r
@@ -366,8 +366,8 @@ contains
 
   !> What the stops not engaged lost from positions x_a + dx_a (time t_a) to x_b + dx_b
   !> (t_b): released inside (p > 0, k p + c p' < 0) a stop pushes on nothing while its
-  !> stored k p^2 / 2 falls, so that fall is its damping's loss, exactly (impact1d_loads'
-  !> stop_release_loss).
+  !> stored k p^2 / 2 falls, so that fall is its damping's loss, exactly (as the deleted
+  !> impact1d_loads' stop_release_loss).
   pure real(wp) function stop_release_loss(scene, engaged, x_a, dx_a, x_b, dx_b, t_a, t_b) result(loss)
     type(scene_type), intent(in) :: scene
     logical, intent(in) :: engaged(:)

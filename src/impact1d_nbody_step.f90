@@ -869,7 +869,7 @@ contains
   end subroutine gap_cubic
 
   !> The compliant stops' events on the step's dense output c from a (docs/method.md section
-  !> 10; impact1d_location's locate_stops for the two-body engine), if earlier than theta:
+  !> 10; as the deleted two-body engine's impact1d_location did), if earlier than theta:
   !> an open stop's gap closing (its engagement: found_row), an engaged stop's force F =
   !> -(k gap + c gap') falling through zero (its release: found_stop), and a stop released
   !> inside (gap < 0) whose F rises through zero (engaged again: found_stop). On the cubic

@@ -1,9 +1,9 @@
 """The N-body engine's closed-form steps (src/impact1d_nbody_glide.f90) against the 50-digit
 reference (tests/exact_nbody.py) on constant-force scenes of five bodies, at dt = 1e-3 and at
 dt = 0.1: under constant forces RK4 is exact, so the glided steps and the located ones give
-the reference's events and final state at either step.  (One and two bodies run on the
-two-body engine from Python: tests/fortran/test_nbody_glide.f90 runs them through run_nbody,
-glide on and off, bit for bit, and against closed forms.)
+the reference's events and final state at either step.  (One and two bodies, which ran on
+the two-body engine until session 12: tests/fortran/test_nbody_glide.f90 runs them through
+run_nbody, glide on and off, bit for bit, and against closed forms.)
 """
 
 from __future__ import annotations
